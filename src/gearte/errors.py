@@ -1,0 +1,72 @@
+"""Exception hierarchy of gearte.
+
+Every error raised on bad input names the field (as a dotted path into the case file or the
+argument name of the API), the offending value and the allowed range or the reason.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = [
+    "GearteError",
+    "ParameterError",
+    "CaseFileError",
+    "ConvergenceError",
+    "DivergenceError",
+    "SchedulerError",
+]
+
+
+class GearteError(Exception):
+    """Base class of all errors gearte raises on purpose."""
+
+
+class ParameterError(GearteError, ValueError):
+    """A parameter is out of its physical range or parameters contradict each other.
+
+    Parameters
+    ----------
+    field : str
+        Name of the parameter, as the user wrote it (``"stage.eccentricity_mm"``, ``"K1"``).
+    value : Any
+        The offending value.
+    reason : str
+        Why it is wrong, ideally with the allowed range (``"must be < 1"``).
+    """
+
+    def __init__(self, field: str, value: Any, reason: str) -> None:
+        self.field = field
+        self.value = value
+        self.reason = reason
+        super().__init__(f"{field} = {value!r}: {reason}")
+
+
+class CaseFileError(GearteError):
+    """A case file cannot be read or does not validate.
+
+    ``errors`` holds one ``(field, message)`` pair per problem; ``str(err)`` lists them one per
+    line, so a user sees every problem of a file at once.
+    """
+
+    def __init__(self, source: str, errors: list[tuple[str, str]]) -> None:
+        self.source = source
+        self.errors = errors
+        lines = [f"{source}: {len(errors)} error(s)"]
+        lines += [f"  {field}: {msg}" for field, msg in errors]
+        super().__init__("\n".join(lines))
+
+
+class ConvergenceError(GearteError, RuntimeError):
+    """An iterative solver did not converge.
+
+    The message names the solver, the iteration count, the last residual and the tolerance.
+    """
+
+
+class DivergenceError(GearteError, RuntimeError):
+    """A time integration diverged (non-finite state) or left its stability limit."""
+
+
+class SchedulerError(GearteError, ConnectionError):
+    """A distributed scheduler could not be reached or failed."""

@@ -1,0 +1,101 @@
+"""The one unit system of gearte and the helpers that convert at the edges.
+
+Inside gearte every quantity is in **mm, N, N·mm, MPa, rad, s** (and kg, with mass-spring models
+in consistent units stated where they appear). Angles leave the library in arcmin, arcsec or
+degrees only through the helpers below; strings that name a quantity carry its unit in brackets,
+e.g. ``"geometric_te_mean [arcmin]"``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = [
+    "ARCMIN_PER_RAD",
+    "ARCSEC_PER_RAD",
+    "DEG_PER_RAD",
+    "rad_to_arcmin",
+    "arcmin_to_rad",
+    "rad_to_arcsec",
+    "arcsec_to_rad",
+    "rad_to_deg",
+    "deg_to_rad",
+    "um_to_mm",
+    "mm_to_um",
+    "Nm_to_Nmm",
+    "Nmm_to_Nm",
+    "format_dms",
+]
+
+DEG_PER_RAD: float = 180.0 / np.pi
+ARCMIN_PER_RAD: float = 10800.0 / np.pi
+ARCSEC_PER_RAD: float = 648000.0 / np.pi
+
+
+def rad_to_arcmin(x: ArrayLike) -> np.ndarray | float:
+    """Angle [rad] → [arcmin]."""
+    return np.asarray(x, dtype=float) * ARCMIN_PER_RAD if np.ndim(x) else float(x) * ARCMIN_PER_RAD
+
+
+def arcmin_to_rad(x: ArrayLike) -> np.ndarray | float:
+    """Angle [arcmin] → [rad]."""
+    return np.asarray(x, dtype=float) / ARCMIN_PER_RAD if np.ndim(x) else float(x) / ARCMIN_PER_RAD
+
+
+def rad_to_arcsec(x: ArrayLike) -> np.ndarray | float:
+    """Angle [rad] → [arcsec]."""
+    return np.asarray(x, dtype=float) * ARCSEC_PER_RAD if np.ndim(x) else float(x) * ARCSEC_PER_RAD
+
+
+def arcsec_to_rad(x: ArrayLike) -> np.ndarray | float:
+    """Angle [arcsec] → [rad]."""
+    return np.asarray(x, dtype=float) / ARCSEC_PER_RAD if np.ndim(x) else float(x) / ARCSEC_PER_RAD
+
+
+def rad_to_deg(x: ArrayLike) -> np.ndarray | float:
+    """Angle [rad] → [deg]."""
+    return np.asarray(x, dtype=float) * DEG_PER_RAD if np.ndim(x) else float(x) * DEG_PER_RAD
+
+
+def deg_to_rad(x: ArrayLike) -> np.ndarray | float:
+    """Angle [deg] → [rad]."""
+    return np.asarray(x, dtype=float) / DEG_PER_RAD if np.ndim(x) else float(x) / DEG_PER_RAD
+
+
+def um_to_mm(x: ArrayLike) -> np.ndarray | float:
+    """Length [µm] → [mm]."""
+    return np.asarray(x, dtype=float) * 1e-3 if np.ndim(x) else float(x) * 1e-3
+
+
+def mm_to_um(x: ArrayLike) -> np.ndarray | float:
+    """Length [mm] → [µm]."""
+    return np.asarray(x, dtype=float) * 1e3 if np.ndim(x) else float(x) * 1e3
+
+
+def Nm_to_Nmm(x: ArrayLike) -> np.ndarray | float:  # noqa: N802 - unit names
+    """Torque [N·m] → [N·mm]."""
+    return np.asarray(x, dtype=float) * 1e3 if np.ndim(x) else float(x) * 1e3
+
+
+def Nmm_to_Nm(x: ArrayLike) -> np.ndarray | float:  # noqa: N802 - unit names
+    """Torque [N·mm] → [N·m]."""
+    return np.asarray(x, dtype=float) * 1e-3 if np.ndim(x) else float(x) * 1e-3
+
+
+def format_dms(angle_rad: float, *, arcsec_decimals: int = 0) -> str:
+    """Format an angle [rad] as the papers print it: ``9′59″`` (degrees shown only if ≥ 1°).
+
+    >>> format_dms(arcmin_to_rad(9 + 59 / 60))
+    "9′59″"
+    """
+    sign = "-" if angle_rad < 0 else ""
+    total = abs(angle_rad) * ARCSEC_PER_RAD
+    total = round(total, arcsec_decimals)
+    deg = int(total // 3600)
+    rest = total - 3600 * deg
+    minutes = int(rest // 60)
+    sec = rest - 60 * minutes
+    sec_s = f"{sec:.{arcsec_decimals}f}" if arcsec_decimals else f"{int(round(sec))}"
+    head = f"{deg}°" if deg else ""
+    return f"{sign}{head}{minutes}′{sec_s}″"
