@@ -1,0 +1,1 @@
+"""Solvers kept separate from the models: contact fixed points, nonlinear equilibria, ODE integrators."""

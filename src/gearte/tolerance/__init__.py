@@ -1,0 +1,1 @@
+"""General tolerance engine: distributions, stack-up, Monte-Carlo and contributions."""
