@@ -9,9 +9,10 @@ Exit codes: 0 ok · 1 the analysis failed (non-convergence, divergence) · 2 bad
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import click
@@ -74,6 +75,19 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
         sys.exit(EXIT_INTERNAL)
 
 
+@contextlib.contextmanager
+def _executor(scheduler: str | None, workers: int | None) -> Iterator[Any]:
+    """The Dask executor of ``--scheduler`` (connected once, before any work; closed after), or
+    ``None`` for the local default."""
+    if scheduler is None:
+        yield None
+        return
+    from gearte.execution import open_executor
+
+    with open_executor(scheduler, workers) as ex:
+        yield ex
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="gearte", message="gearte %(version)s")
 def main() -> None:
@@ -134,14 +148,15 @@ def run(
         from gearte.studies import RunOptions, run_case
 
         c = load_case(case)
-        opts = RunOptions(
-            progress=not no_progress,
-            seed=seed,
-            samples=samples,
-            scheduler=scheduler,
-            workers=workers,
-        )
-        result = run_case(c, opts)
+        with _executor(scheduler, workers) as executor:
+            opts = RunOptions(
+                progress=not no_progress,
+                seed=seed,
+                samples=samples,
+                scheduler=executor,
+                workers=workers,
+            )
+            result = run_case(c, opts)
         target = out_dir or os.path.join("out", result.name)
         paths = write_outputs(result, target, report=not no_report)
         for w in result.warnings:

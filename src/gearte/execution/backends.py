@@ -1,0 +1,476 @@
+"""Where chunks run: sequentially, on local threads or processes, or on a Dask cluster.
+
+A backend is a :class:`ChunkExecutor`: ``submit`` a chunk, ``next_done`` the ones that finished
+(in completion order; :func:`~gearte.execution.map_chunks` restores chunk order), ``close``. One
+executor can serve many ``map_chunks`` calls (a sweep, a study with several sampled analyses), so a
+pool or a cluster connection is made once: ``with open_executor("tcp://host:8786") as ex: ...``.
+
+``dask.distributed`` is imported only when a Dask backend is asked for; gearte works without it.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import logging
+import multiprocessing
+import socket
+import threading
+import uuid
+from collections.abc import Callable
+from typing import Any
+from urllib.parse import urlsplit
+
+from gearte.errors import ParameterError, SchedulerError
+from gearte.execution.streams import default_workers
+
+__all__ = [
+    "ChunkExecutor",
+    "Batch",
+    "SequentialExecutor",
+    "PoolExecutor",
+    "DaskExecutor",
+    "open_executor",
+    "LOCAL_SCHEDULERS",
+    "CONNECT_TIMEOUT_S",
+]
+
+#: Names accepted as ``scheduler`` that select a local backend instead of a Dask address.
+LOCAL_SCHEDULERS = ("sequential", "synchronous", "threads", "processes", "local-cluster")
+
+#: Seconds to wait for a Dask scheduler before giving up with :class:`SchedulerError`.
+CONNECT_TIMEOUT_S = 5.0
+
+_CLUSTER_EXTRA = "pip install 'gearte[cluster]' (or: pip install 'dask[distributed]')"
+
+
+class ChunkExecutor:
+    """Runs chunk functions somewhere; the interface :func:`map_chunks` drives.
+
+    Attributes
+    ----------
+    name : str
+        ``"sequential"``, ``"threads"``, ``"processes"`` or ``"dask"``.
+    workers : int
+        Chunks that can run at once (sizes the submission window).
+    """
+
+    name = "base"
+    workers = 1
+
+    def batch(self) -> Batch:
+        """A new set of chunks to submit and collect (one per :func:`map_chunks` call)."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Release pools, clients and clusters this executor created (idempotent)."""
+
+    def __enter__(self) -> ChunkExecutor:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name} workers={self.workers}>"
+
+
+class Batch:
+    """Chunks of one :func:`map_chunks` call in flight on an executor."""
+
+    def __init__(self) -> None:
+        self.pending: dict[Any, int] = {}
+
+    def __len__(self) -> int:
+        return len(self.pending)
+
+    def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
+        """Start ``func(task)`` as chunk ``index``."""
+        raise NotImplementedError
+
+    def next_done(self) -> list[tuple[int, Any]]:
+        """Block until at least one chunk finished; ``[(index, result), ...]``.
+
+        Raises the exception of a failed chunk.
+        """
+        raise NotImplementedError
+
+    def cancel(self) -> None:
+        """Cancel unfinished chunks (after a failure or an interrupt)."""
+        self.pending.clear()
+
+
+class _SequentialBatch(Batch):
+    def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
+        self.pending[object()] = index
+        self._result = func(task)
+
+    def next_done(self) -> list[tuple[int, Any]]:
+        (index,) = self.pending.values()
+        self.pending.clear()
+        return [(index, self._result)]
+
+
+class SequentialExecutor(ChunkExecutor):
+    """Runs each chunk in the calling thread when it is submitted (no parallelism, no pickling)."""
+
+    name = "sequential"
+    workers = 1
+
+    def batch(self) -> Batch:
+        return _SequentialBatch()
+
+
+class _PoolBatch(Batch):
+    def __init__(self, pool: cf.Executor) -> None:
+        super().__init__()
+        self._pool = pool
+
+    def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
+        self.pending[self._pool.submit(func, task)] = index
+
+    def next_done(self) -> list[tuple[int, Any]]:
+        done, _ = cf.wait(list(self.pending), return_when=cf.FIRST_COMPLETED)
+        out = [(self.pending[f], f.result()) for f in done]
+        for f in done:
+            del self.pending[f]
+        return out
+
+    def cancel(self) -> None:
+        for f in self.pending:
+            f.cancel()
+        super().cancel()
+
+
+class PoolExecutor(ChunkExecutor):
+    """A local pool of threads (``kind="threads"``) or processes (``kind="processes"``).
+
+    Threads suit gearte's kernels (numba ``nogil`` functions and numpy calls release the GIL):
+    nothing is pickled. Processes suit pure-Python chunk functions; ``func`` and the tasks must
+    then be picklable (module-level functions) and each process imports gearte once.
+    """
+
+    def __init__(self, kind: str = "threads", workers: int | None = None) -> None:
+        nw = default_workers() if workers is None else int(workers)
+        if nw < 1:
+            raise ParameterError("workers", workers, "must be ≥ 1")
+        self.name = kind
+        self.workers = nw
+        if kind == "threads":
+            self._pool: cf.Executor = cf.ThreadPoolExecutor(nw, thread_name_prefix="gearte")
+        elif kind == "processes":
+            methods = multiprocessing.get_all_start_methods()
+            ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+            self._pool = cf.ProcessPoolExecutor(nw, mp_context=ctx)
+        else:  # pragma: no cover - guarded by open_executor
+            raise ParameterError("scheduler", kind, f"must be one of {LOCAL_SCHEDULERS}")
+
+    def batch(self) -> Batch:
+        return _PoolBatch(self._pool)
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _import_distributed() -> Any:
+    try:
+        import distributed
+    except ImportError:
+        raise SchedulerError(
+            "a Dask scheduler was asked for but dask.distributed is not installed: "
+            + _CLUSTER_EXTRA
+        ) from None
+    return distributed
+
+
+def _probe_tcp(address: str, timeout_s: float) -> None:
+    """Fail fast (milliseconds, not the full timeout) when nothing listens at a tcp address."""
+    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    if parts.scheme not in ("tcp", "tls"):
+        return
+    try:
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:
+        raise SchedulerError(f"invalid Dask scheduler address {address!r}: {exc}") from None
+    if not host or port is None:
+        raise SchedulerError(
+            f"invalid Dask scheduler address {address!r}: expected tcp://host:port "
+            "(the scheduler's default port is 8786)"
+        )
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s) as sock:
+            if parts.scheme == "tcp":
+                # A Dask server speaks first (its handshake): silence means something else.
+                sock.settimeout(timeout_s)
+                if not sock.recv(1, socket.MSG_PEEK):
+                    raise ConnectionResetError(0, "closed the connection at once")
+    except TimeoutError:
+        raise SchedulerError(
+            f"no answer from a Dask scheduler at {address!r} within {timeout_s:g} s; check the "
+            "address and port (the scheduler's default port is 8786)"
+        ) from None
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise SchedulerError(
+            f"cannot reach the Dask scheduler at {address!r} ({reason}); check the address and "
+            "that `dask scheduler` is running there and the port is open"
+        ) from None
+
+
+def _connect(distributed: Any, address: str, timeout_s: float) -> Any:
+    """``distributed.Client(address)``, given up after ``timeout_s`` (plus a grace second).
+
+    The client's own timeout does not cover every stage of the handshake, so it is built in a
+    watchdog thread; a client that never answers is abandoned rather than waited for.
+    """
+    box: dict[str, Any] = {}
+
+    def target() -> None:
+        try:
+            box["client"] = distributed.Client(
+                address, timeout=f"{timeout_s}s", set_as_default=False
+            )
+        except BaseException as exc:  # noqa: BLE001 - handed to the calling thread
+            box["error"] = exc
+
+    th = threading.Thread(target=target, name="gearte-dask-connect", daemon=True)
+    th.start()
+    th.join(timeout_s + 1.0)
+    if th.is_alive():
+        raise SchedulerError(
+            f"the Dask scheduler at {address!r} did not complete the connection within "
+            f"{timeout_s:g} s; check the address, the port and the network"
+        )
+    exc = box.get("error")
+    if isinstance(exc, OSError | TimeoutError):
+        raise SchedulerError(
+            f"cannot connect to the Dask scheduler at {address!r} within {timeout_s:g} s "
+            f"({exc}); check the address (tcp://host:8786) and that the scheduler is running"
+        ) from None
+    if exc is not None:
+        raise SchedulerError(
+            f"{address!r} does not answer as a Dask scheduler ({type(exc).__name__}: {exc}); "
+            "check the address and port"
+        ) from None
+    return box["client"]
+
+
+def _worker_gearte_version() -> str:
+    """Runs on each Dask worker: the gearte version it imports."""
+    import gearte
+
+    return gearte.__version__
+
+
+class DaskExecutor(ChunkExecutor):
+    """Chunks as Dask futures on a distributed cluster.
+
+    Parameters
+    ----------
+    scheduler : str or distributed.Client or distributed.deploy.Cluster
+        A scheduler address (``tcp://host:8786``), a connected ``Client`` (left open on
+        :meth:`close`), a cluster object (``LocalCluster``, dask-jobqueue, dask-kubernetes; left
+        running), or ``"local-cluster"`` to start a ``LocalCluster`` of ``workers`` processes here
+        (shut down on :meth:`close`).
+    workers : int, optional
+        Worker processes of a ``"local-cluster"``.
+    retries : int
+        Extra attempts of a chunk that *raised*. A chunk whose worker died is re-run by the
+        scheduler regardless (up to ``distributed.scheduler.allowed-failures`` times).
+    connect_timeout_s : float
+        How long to wait for the scheduler.
+    check_versions : bool
+        Check that every worker imports the same gearte version as this process.
+
+    Notes
+    -----
+    Each chunk becomes one future with a unique key; its result is fetched once and released, and
+    :func:`map_chunks` reduces results in chunk order. A lost worker only makes the scheduler run
+    its chunks again elsewhere — from the same task (same seed), so with the same result — hence
+    nothing is lost or counted twice.
+    """
+
+    name = "dask"
+
+    def __init__(
+        self,
+        scheduler: Any,
+        workers: int | None = None,
+        *,
+        retries: int = 0,
+        connect_timeout_s: float = CONNECT_TIMEOUT_S,
+        check_versions: bool = True,
+    ) -> None:
+        distributed = _import_distributed()
+        self._owned: list[Any] = []
+        self.retries = int(retries)
+        self._token = uuid.uuid4().hex[:8]
+        try:
+            if isinstance(scheduler, distributed.Client):
+                self.client = scheduler
+            elif scheduler == "local-cluster":
+                nw = default_workers() if workers is None else int(workers)
+                if nw < 1:
+                    raise ParameterError("workers", workers, "must be ≥ 1")
+                cluster = distributed.LocalCluster(
+                    n_workers=nw,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=logging.ERROR,
+                )
+                self._owned.append(cluster)
+                self.client = distributed.Client(cluster, set_as_default=False)
+                self._owned.insert(0, self.client)
+            elif isinstance(scheduler, str):
+                _probe_tcp(scheduler, connect_timeout_s)
+                self.client = _connect(distributed, scheduler, connect_timeout_s)
+                self._owned.append(self.client)
+            elif hasattr(scheduler, "scheduler_address"):  # a Cluster object
+                self.client = distributed.Client(scheduler, set_as_default=False)
+                self._owned.append(self.client)
+            else:
+                raise ParameterError(
+                    "scheduler",
+                    scheduler,
+                    "must be a Dask address (tcp://host:8786), a distributed.Client, a cluster, "
+                    f"a gearte ChunkExecutor or one of {LOCAL_SCHEDULERS}",
+                )
+            if check_versions:
+                self._check_versions()
+        except BaseException:
+            self.close()
+            raise
+
+    @property
+    def workers(self) -> int:  # type: ignore[override]
+        try:
+            return max(1, sum(self.client.nthreads().values()))
+        except Exception:  # noqa: BLE001 - a sizing hint only
+            return 1
+
+    def _check_versions(self) -> None:
+        import gearte
+
+        try:
+            versions = self.client.run(_worker_gearte_version)
+        except Exception as exc:  # noqa: BLE001 - unpickling fails where gearte is missing
+            raise SchedulerError(
+                f"the Dask workers cannot run gearte ({type(exc).__name__}: {exc}); install "
+                f"gearte {gearte.__version__} in the workers' environment"
+            ) from None
+        wrong = {w: v for w, v in versions.items() if v != gearte.__version__}
+        if wrong:
+            listed = ", ".join(f"{w} has {v}" for w, v in sorted(wrong.items()))
+            raise SchedulerError(
+                f"Dask workers run another gearte version than this process "
+                f"({gearte.__version__}): {listed}; install the same version everywhere"
+            )
+
+    def batch(self) -> Batch:
+        return _DaskBatch(self)
+
+    def close(self) -> None:
+        for obj in getattr(self, "_owned", []):
+            with contextlib.suppress(Exception):
+                obj.close()
+        self._owned = []
+
+    def __repr__(self) -> str:
+        return f"<DaskExecutor {getattr(self.client, 'scheduler', None)}>"
+
+
+class _DaskBatch(Batch):
+    def __init__(self, executor: DaskExecutor) -> None:
+        super().__init__()
+        self._ex = executor
+        self._ac: Any = None
+
+    def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
+        ex = self._ex
+        key = f"gearte-{label}-{ex._token}-{index}"
+        fut = ex.client.submit(func, task, key=key, retries=ex.retries, pure=False)
+        self.pending[fut] = index
+        if self._ac is None:
+            self._ac = _import_distributed().as_completed([fut], loop=ex.client.loop)
+        else:
+            self._ac.add(fut)
+
+    def next_done(self) -> list[tuple[int, Any]]:
+        distributed = _import_distributed()
+        from distributed.comm import CommClosedError
+
+        try:
+            batch = self._ac.next_batch(block=True)
+            results = self._ex.client.gather(batch)
+        except distributed.KilledWorker as exc:
+            raise SchedulerError(
+                f"a chunk killed its Dask workers repeatedly ({exc}); it likely runs out of "
+                "memory or crashes the interpreter — try a smaller chunk size"
+            ) from None
+        except CommClosedError as exc:
+            raise SchedulerError(f"lost the connection to the Dask scheduler ({exc})") from None
+        except distributed.client.FutureCancelledError as exc:
+            raise SchedulerError(f"the Dask scheduler cancelled a chunk ({exc})") from None
+        out = [(self.pending.pop(f), r) for f, r in zip(batch, results, strict=True)]
+        for fut in batch:
+            fut.release()
+        return out
+
+    def cancel(self) -> None:
+        with contextlib.suppress(Exception):
+            self._ex.client.cancel(list(self.pending))
+        if self._ac is not None:
+            with contextlib.suppress(Exception):
+                self._ac.clear()
+        super().cancel()
+
+
+def open_executor(
+    scheduler: Any = None,
+    workers: int | None = None,
+    *,
+    retries: int = 0,
+    connect_timeout_s: float = CONNECT_TIMEOUT_S,
+) -> ChunkExecutor:
+    """The executor for a ``scheduler`` / ``workers`` pair (use it as a context manager).
+
+    Parameters
+    ----------
+    scheduler : None, str, distributed.Client, cluster or ChunkExecutor
+        ``None``: local threads (sequential when ``workers == 1``). ``"sequential"``
+        (alias ``"synchronous"``), ``"threads"``, ``"processes"``: local backends.
+        ``"local-cluster"``: a Dask ``LocalCluster`` of ``workers`` processes started here.
+        Any other string: a Dask scheduler address. A ``Client`` or a cluster object: use it.
+        A ``ChunkExecutor``: returned as is.
+    workers : int, optional
+        Local threads or processes; default: the cores this process may use.
+    retries : int
+        Dask only: extra attempts of a chunk that raised.
+    connect_timeout_s : float
+        Dask only: seconds to wait for the scheduler before :class:`SchedulerError`.
+
+    Raises
+    ------
+    SchedulerError
+        The scheduler cannot be reached, dask.distributed is missing, or the workers run another
+        gearte version.
+    """
+    if isinstance(scheduler, ChunkExecutor):
+        return scheduler
+    if workers is not None and int(workers) < 1:
+        raise ParameterError("workers", workers, "must be ≥ 1")
+    if scheduler is None:
+        if workers is not None and int(workers) == 1:
+            return SequentialExecutor()
+        return PoolExecutor("threads", workers)
+    if isinstance(scheduler, str):
+        s = scheduler.strip()
+        if s in ("sequential", "synchronous"):
+            return SequentialExecutor()
+        if s in ("threads", "processes"):
+            return PoolExecutor(s, workers)
+        if not s:
+            raise ParameterError("scheduler", scheduler, "empty scheduler address")
+        scheduler = s
+    return DaskExecutor(scheduler, workers, retries=retries, connect_timeout_s=connect_timeout_s)

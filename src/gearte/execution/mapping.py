@@ -1,0 +1,149 @@
+"""``map_chunks``: run chunk functions on a backend, results reduced in chunk order."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Iterable
+from typing import Any, TypeVar
+
+from gearte.errors import ParameterError
+from gearte.execution.backends import ChunkExecutor, open_executor
+from gearte.execution.progress import ChunkProgress
+
+__all__ = ["map_chunks"]
+
+T = TypeVar("T")
+R = TypeVar("R")
+A = TypeVar("A")
+
+_NOTHING: Any = object()
+
+
+def map_chunks(
+    func: Callable[[T], R],
+    tasks: Iterable[T],
+    *,
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool | None = None,
+    description: str = "working",
+    retries: int = 0,
+    reduce: Callable[[Any, R], Any] | None = None,
+    initial: Any = _NOTHING,
+    on_result: Callable[[int, R], None] | None = None,
+    options: Any = None,
+    max_in_flight: int | None = None,
+) -> Any:
+    """Run ``func(task)`` for every task; hand the results back in task order.
+
+    Parameters
+    ----------
+    func : callable
+        A pure function of one task (e.g. a :class:`~gearte.execution.Chunk`). For processes and
+        Dask it must be picklable: a module-level function of an importable module.
+    tasks : iterable
+        The work items, one per chunk; their number and content must not depend on the backend
+        (use :func:`~gearte.execution.seeded_chunks`). Consumed lazily.
+    workers : int, optional
+        Local threads or processes; default ``options.workers`` or all cores. ``1`` runs
+        sequentially in this thread.
+    scheduler : str, distributed.Client, cluster or ChunkExecutor, optional
+        Where to run (see :func:`~gearte.execution.open_executor`); default ``options.scheduler``
+        or local threads. An executor or client passed in is left open; one created here (from an
+        address, ``"processes"``, ``"local-cluster"``) is shut down before returning, also on
+        errors and Ctrl-C.
+    progress : bool, optional
+        Progress bar over chunks (terminal only); default ``options.progress`` or ``True``.
+    description : str
+        Label of the progress bar and of the Dask task keys.
+    retries : int
+        Dask only: extra attempts of a chunk that raised. A chunk whose worker was lost is re-run
+        by the scheduler regardless.
+    reduce : callable, optional
+        ``acc = reduce(acc, result)``, applied in task order as results arrive; the return value
+        is then the final ``acc`` and results are not kept (memory independent of the number of
+        chunks). E.g. ``reduce=RunningStats.merge, initial=RunningStats()``.
+    initial : any, optional
+        Start value of ``reduce``; default: the first result.
+    on_result : callable, optional
+        ``on_result(index, result)``, called in task order (after ``reduce``).
+    options : gearte.studies.RunOptions, optional
+        Supplies ``workers``, ``scheduler`` and ``progress`` when those are not given.
+    max_in_flight : int, optional
+        Chunks submitted ahead of the first unfinished one; bounds the results held while waiting
+        for a slow early chunk. Default ``4 × workers`` when reducing, unbounded otherwise.
+
+    Returns
+    -------
+    list or any
+        The results in task order; or the reduced value when ``reduce`` is given; or ``None``
+        when only ``on_result`` is given.
+
+    Notes
+    -----
+    Results are combined in task order whatever the order chunks finish in, so floating-point
+    reductions give the same bits on every backend and worker count. A failing chunk cancels the
+    others and its exception propagates unchanged.
+    """
+    if options is not None:
+        workers = getattr(options, "workers", None) if workers is None else workers
+        scheduler = getattr(options, "scheduler", None) if scheduler is None else scheduler
+        progress = getattr(options, "progress", True) if progress is None else progress
+    if progress is None:
+        progress = True
+    if max_in_flight is not None and max_in_flight < 1:
+        raise ParameterError("max_in_flight", max_in_flight, "must be ≥ 1")
+    total = len(tasks) if hasattr(tasks, "__len__") else None  # type: ignore[arg-type]
+    keep = reduce is None and on_result is None
+    label = re.sub(r"[^A-Za-z0-9_.]+", "_", description).strip("_") or "chunk"
+
+    owned = not isinstance(scheduler, ChunkExecutor)
+    executor = open_executor(scheduler, workers, retries=retries)
+    results: list[Any] = []
+    acc = initial
+    try:
+        window = max_in_flight or (4 * max(1, executor.workers) if not keep else None)
+        if executor.name == "sequential":
+            window = 1  # computed at submission: hand each result back before the next
+        batch = executor.batch()
+        buffer: dict[int, Any] = {}
+        frontier = 0  # index of the next result to hand back
+        submitted = 0
+        it = iter(tasks)
+        exhausted = False
+        with ChunkProgress(total, description, bool(progress)) as bar:
+            try:
+                while True:
+                    while not exhausted and (window is None or submitted < frontier + window):
+                        try:
+                            task = next(it)
+                        except StopIteration:
+                            exhausted = True
+                            break
+                        batch.submit(func, task, submitted, label)
+                        submitted += 1
+                    if not len(batch):
+                        break
+                    for index, result in batch.next_done():
+                        buffer[index] = result
+                        bar.advance()
+                    while frontier in buffer:
+                        result = buffer.pop(frontier)
+                        if keep:
+                            results.append(result)
+                        if reduce is not None:
+                            acc = result if acc is _NOTHING else reduce(acc, result)
+                        if on_result is not None:
+                            on_result(frontier, result)
+                        frontier += 1
+            except BaseException:
+                batch.cancel()
+                raise
+    finally:
+        if owned:
+            executor.close()
+    if keep:
+        return results
+    if reduce is not None:
+        return None if acc is _NOTHING else acc
+    return None

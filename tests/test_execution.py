@@ -1,0 +1,266 @@
+"""Execution layer (issue 7): determinism across backends, ordered incremental reduction, Dask
+fault tolerance, unreachable schedulers.
+
+One Dask ``LocalCluster`` of worker *processes* is shared by this module (start-up costs seconds).
+The chunk function shipped to the workers is ``gearte.execution.check.sample_chunk``: a
+module-level function of an importable module, as Dask requires.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import socket
+import threading
+import time
+from functools import partial
+
+import pytest
+
+from gearte.errors import ParameterError, SchedulerError
+from gearte.execution import (
+    Chunk,
+    RunningStats,
+    map_chunks,
+    open_executor,
+    seeded_chunks,
+)
+from gearte.execution.check import check_backend, sample_chunk
+
+distributed = pytest.importorskip("distributed")
+
+SAMPLES, CHUNK, SEED = 120_000, 5_000, 7  # 24 chunks
+
+
+def _stats(**kwargs) -> RunningStats:
+    return map_chunks(
+        sample_chunk,
+        seeded_chunks(SAMPLES, CHUNK, SEED),
+        reduce=RunningStats.merge,
+        initial=RunningStats(),
+        progress=False,
+        **kwargs,
+    )
+
+
+@pytest.fixture(scope="module")
+def reference() -> RunningStats:
+    """The undisturbed, sequential result every backend must reproduce bit for bit."""
+    return _stats(workers=1)
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(
+        n_workers=3,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.CRITICAL,
+    )
+    c = distributed.Client(cluster, set_as_default=False)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def _closed_port() -> int:
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def test_same_seed_identical_statistics_1_and_2_workers_processes_and_local_cluster(
+    reference, client
+):
+    assert reference.count == SAMPLES and reference.extra["chunks"] == SAMPLES // CHUNK
+    runs = {
+        "threads, 2 workers": _stats(workers=2),
+        "processes, 2 workers": _stats(scheduler="processes", workers=2),
+        "dask LocalCluster (client)": _stats(scheduler=client),
+        "dask LocalCluster (address)": _stats(scheduler=client.scheduler.address),
+    }
+    for name, s in runs.items():
+        assert s.as_tuple() == reference.as_tuple(), name
+        assert s.extra == reference.extra, name
+
+
+def test_statistics_do_not_depend_on_chunk_size_beyond_rounding(reference):
+    """Chunking changes the streams (by design), not the physics: same distribution."""
+    other = map_chunks(
+        sample_chunk,
+        seeded_chunks(SAMPLES, 7_000, SEED),
+        reduce=RunningStats.merge,
+        workers=2,
+        progress=False,
+    )
+    assert other.count == reference.count
+    assert abs(other.mean - reference.mean) < 5 * reference.standard_error
+
+
+def test_results_come_back_in_task_order_from_a_lazy_iterable():
+    def slow_square(i: int) -> int:
+        time.sleep(0.02 * ((7 - i) % 4))  # finish out of order
+        return i * i
+
+    got = map_chunks(slow_square, (i for i in range(12)), workers=2, progress=False)
+    assert got == [i * i for i in range(12)]
+    seen: list[int] = []
+    out = map_chunks(
+        slow_square, range(12), workers=2, progress=False, on_result=lambda i, r: seen.append(i)
+    )
+    assert out is None and seen == list(range(12))
+
+
+def test_reduction_holds_a_bounded_window_behind_a_slow_first_chunk():
+    events: list[tuple[str, int]] = []
+    lock = threading.Lock()
+
+    def task(i: int) -> int:
+        with lock:
+            events.append(("start", i))
+        if i == 0:
+            time.sleep(0.3)
+        with lock:
+            events.append(("end", i))
+        return i
+
+    total = map_chunks(
+        task,
+        range(20),
+        workers=2,
+        progress=False,
+        reduce=lambda a, b: a + b,
+        max_in_flight=3,
+    )
+    assert total == sum(range(20))
+    before_first_done = events[: events.index(("end", 0))]
+    assert max(i for kind, i in before_first_done if kind == "start") <= 2
+
+
+def test_a_failing_chunk_propagates_its_error():
+    def task(i: int) -> int:
+        if i == 5:
+            raise ParameterError("x", i, "fails on purpose")
+        return i
+
+    for kw in ({"workers": 1}, {"workers": 2}):
+        with pytest.raises(ParameterError, match="on purpose"):
+            map_chunks(task, range(10), progress=False, **kw)
+
+
+def test_options_object_and_progress_bar_on_a_terminal(monkeypatch):
+    from gearte.studies import RunOptions
+
+    monkeypatch.setattr("sys.stderr.isatty", lambda: True, raising=False)
+    out = map_chunks(lambda x: x + 1, range(5), options=RunOptions(workers=1, progress=True))
+    assert out == [1, 2, 3, 4, 5]
+    assert map_chunks(abs, [], workers=2, reduce=max, progress=False) is None
+
+
+def test_bad_workers_and_scheduler_values_name_the_field():
+    with pytest.raises(ParameterError, match="workers"):
+        map_chunks(abs, [1], workers=0)
+    with pytest.raises(ParameterError, match="scheduler"):
+        open_executor(scheduler=3.5)
+    with pytest.raises(SchedulerError, match="tcp://host:port"):
+        open_executor("tcp://no-port-here")
+
+
+def test_worker_lost_mid_study_is_retried_and_result_is_bit_identical(reference, client):
+    """Kill one worker process while chunks run: none lost, none counted twice, same bits."""
+    pids = client.run(os.getpid)
+    killed: list[str] = []
+
+    def kill_a_busy_worker(index: int, _result: RunningStats) -> None:
+        if index != 2 or killed:
+            return
+        busy = [w for w, keys in client.processing().items() if keys and w in pids]
+        victim = busy[0] if busy else sorted(pids)[0]
+        os.kill(pids[victim], signal.SIGKILL)
+        killed.append((victim, bool(busy)))
+
+    stats = map_chunks(
+        partial(sample_chunk, delay_s=0.15),
+        seeded_chunks(SAMPLES, CHUNK, SEED),
+        scheduler=client,
+        reduce=RunningStats.merge,
+        on_result=kill_a_busy_worker,
+        progress=False,
+        description="worker loss",
+    )
+    assert killed == [(killed[0][0], True)], "no busy worker was killed"
+    assert stats.extra["chunks"] == SAMPLES // CHUNK  # every chunk exactly once
+    assert stats.as_tuple() == reference.as_tuple()
+    assert stats.extra == reference.extra
+
+
+def test_client_passed_in_stays_open_and_internal_ones_are_closed(client):
+    r = check_backend(client, samples=20_000, chunk_size=5_000)
+    assert r["identical"] and r["backend"] == "dask"
+    assert client.status == "running"
+    with open_executor(client.scheduler.address) as ex:
+        assert ex.workers >= 1
+        out = map_chunks(
+            sample_chunk, [Chunk(0, 10, seeded_chunks(10, 10, 1)[0].seed)], scheduler=ex
+        )
+        assert out[0].count == 10
+    assert ex.client.status == "closed"
+    assert client.status == "running"
+
+
+def test_workers_with_another_gearte_version_are_refused(client, monkeypatch):
+    import gearte
+
+    monkeypatch.setattr(gearte, "__version__", "0.0.0+other")
+    with pytest.raises(SchedulerError, match="same version"):
+        open_executor(client)
+
+
+def test_unreachable_scheduler_fails_fast_with_a_clear_error():
+    port = _closed_port()
+    t0 = time.perf_counter()
+    with pytest.raises(SchedulerError, match=f"127.0.0.1:{port}"):
+        map_chunks(abs, [1, 2], scheduler=f"tcp://127.0.0.1:{port}", progress=False)
+    assert time.perf_counter() - t0 < 5.0
+
+
+def test_silent_listener_is_not_waited_for():
+    """Something accepts the connection but never speaks Dask: give up after the timeout."""
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen(1)
+        address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+        t0 = time.perf_counter()
+        with pytest.raises(SchedulerError, match="no answer"):
+            open_executor(address, connect_timeout_s=0.5)
+        assert time.perf_counter() - t0 < 3.0
+
+
+def test_missing_dask_names_the_cluster_extra(monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(SchedulerError, match=r"gearte\[cluster\]"):
+        open_executor("tcp://127.0.0.1:8786")
+    # the local backends do not need it
+    assert map_chunks(abs, [-1, -2], workers=2, progress=False) == [1, 2]
+
+
+def test_cli_prints_an_unreachable_scheduler_without_traceback(tmp_path):
+    from click.testing import CliRunner
+
+    from gearte.cli import main
+
+    case = tmp_path / "c.toml"
+    case.write_text('[case]\nkind = "foundation_test"\n[demo]\nlength_mm = 4.0\n')
+    port = _closed_port()
+    r = CliRunner().invoke(
+        main, ["run", str(case), "--scheduler", f"tcp://127.0.0.1:{port}", "--out", str(tmp_path)]
+    )
+    assert r.exit_code == 2, r.output
+    assert "scheduler" in r.output and f"127.0.0.1:{port}" in r.output
+    assert "Traceback" not in r.output
