@@ -169,6 +169,91 @@ def run(
 
 
 @main.command()
+@click.argument("case")
+@click.option(
+    "--vary",
+    "vary",
+    multiple=True,
+    required=True,
+    metavar="KEY=START:STOP:N",
+    help="A case parameter to vary (dotted path, e.g. stage.eccentricity_mm=1.0:1.6:7, or "
+    "KEY=V1,V2,...). Repeat for a full-factorial grid.",
+)
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False),
+    default=None,
+    help="Output folder (default: out/sweep_<case name>).",
+)
+@click.option("--seed", type=int, default=None, help="Override the case's seed (all points).")
+@click.option(
+    "--samples",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Override Monte-Carlo sample counts.",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Local worker threads (default: all cores).",
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Run the points on a Dask cluster, e.g. tcp://host:8786.",
+)
+@click.option("--no-plots", is_flag=True, help="Write the table only.")
+@click.option("--no-progress", is_flag=True, help="Hide the progress bar.")
+@click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
+def sweep(
+    case: str,
+    vary: tuple[str, ...],
+    out_dir: str | None,
+    seed: int | None,
+    samples: int | None,
+    workers: int | None,
+    scheduler: str | None,
+    no_plots: bool,
+    no_progress: bool,
+    debug: bool,
+) -> None:
+    """Run CASE over a grid of parameter values; write sweep.csv, sweep.json and plots."""
+
+    def _sweep() -> None:
+        from gearte.sweep import parse_vary, run_sweep, write_sweep
+
+        varies = [parse_vary(v) for v in vary]
+        with _executor(scheduler, workers) as executor:
+            result = run_sweep(
+                case,
+                varies,
+                seed=seed,
+                samples=samples,
+                scheduler=executor,
+                workers=workers,
+                progress=not no_progress,
+            )
+        target = out_dir or os.path.join("out", f"sweep_{result.name}")
+        paths = write_sweep(result, target, plots=not no_plots)
+        failed = [e for e in result.errors if e]
+        click.echo(
+            f"{result.name}: {len(result.points)} points × {len(result.columns)} scalar results "
+            f"in {result.elapsed_s:.2f} s ({result.backend})"
+        )
+        if failed:
+            click.echo(f"warning: {len(failed)} point(s) failed; see the error column", err=True)
+        click.echo(f"  wrote {paths['csv']}")
+        click.echo(f"  wrote {paths['json']}")
+        if paths["plots"]:
+            click.echo(f"  wrote {len(paths['plots'])} plots in {paths['plots'][0].parent}")
+
+    _guarded(_sweep, debug)
+
+
+@main.command()
 @click.argument("cases", nargs=-1, required=True)
 def validate(cases: tuple[str, ...]) -> None:
     """Check case files without running them; print every problem, one per line."""

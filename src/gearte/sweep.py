@@ -1,0 +1,531 @@
+"""Parameter sweeps: a grid over case parameters, run through the execution layer.
+
+``gearte sweep CASE.toml --vary stage.eccentricity_mm=1.0:1.6:7 --vary ...`` or, in Python,
+
+>>> from gearte.sweep import run_sweep, write_sweep                       # doctest: +SKIP
+>>> sweep = run_sweep("hu2020_rv80e_initial", {"stage.eccentricity_mm": "1.0:1.6:7"})
+>>> write_sweep(sweep, "out/sweep")                                       # doctest: +SKIP
+
+Each key is a dotted path into the case file (``section.field``; list items by index,
+``pins.0.radius_mm``). The grid is the full factorial of the varied keys, the first key varying
+slowest. Every point is validated like a case file before anything runs, so a wrong key or an
+out-of-range value is reported at once with its field path. Every point runs with the same seed
+(common random numbers): differences between points come from the parameters, not from sampling
+noise.
+
+Points run through :func:`gearte.execution.map_chunks`: in parallel (one point per worker, each
+point's own sampled work sequential) when there are at least as many points as workers, otherwise
+one after another with each point's sampled work spread over the workers. Results are identical
+either way.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import itertools
+import math
+import os
+import re
+import time
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from gearte.errors import CaseFileError, GearteError, ParameterError
+
+__all__ = ["Vary", "parse_vary", "grid_points", "SweepResult", "run_sweep", "write_sweep"]
+
+_NUM_RE = re.compile(r"^[+-]?\d+$")
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One varied key and its values."""
+
+    key: str
+    values: tuple[Any, ...]
+
+
+def _parse_scalar(text: str) -> Any:
+    t = text.strip()
+    if _NUM_RE.match(t):
+        return int(t)
+    try:
+        return float(t)
+    except ValueError:
+        pass
+    if t.lower() in ("true", "false"):
+        return t.lower() == "true"
+    return t
+
+
+def _tidy(x: float) -> float:
+    """Round away linspace noise (``1.3000000000000003`` → ``1.3``): 12 significant digits."""
+    return float(f"{x:.12g}")
+
+
+def _range_values(key: str, spec: str) -> tuple[Any, ...]:
+    parts = spec.split(":")
+    if len(parts) != 3:
+        raise ParameterError(f"--vary {key}", spec, "expected START:STOP:N, e.g. 1.0:1.6:7")
+    start, stop, n_text = (p.strip() for p in parts)
+    if not _NUM_RE.match(n_text) or int(n_text) < 1:
+        raise ParameterError(f"--vary {key}", spec, f"N = {n_text!r} must be an integer ≥ 1")
+    n = int(n_text)
+    try:
+        a, b = float(start), float(stop)
+    except ValueError:
+        raise ParameterError(f"--vary {key}", spec, "START and STOP must be numbers") from None
+    if not (math.isfinite(a) and math.isfinite(b)):
+        raise ParameterError(f"--vary {key}", spec, "START and STOP must be finite")
+    if n == 1:
+        if a != b:
+            raise ParameterError(
+                f"--vary {key}", spec, "N = 1 gives one point: write KEY=VALUE or START = STOP"
+            )
+        values = [a]
+    else:
+        values = [_tidy(a + (b - a) * i / (n - 1)) for i in range(n)]
+    if _NUM_RE.match(start) and _NUM_RE.match(stop) and all(v.is_integer() for v in values):
+        return tuple(int(v) for v in values)
+    return tuple(values)
+
+
+def parse_vary(spec: str) -> Vary:
+    """Parse ``KEY=START:STOP:N`` (``N`` evenly spaced values, ends included) or
+    ``KEY=V1,V2,...`` (explicit values) or ``KEY=VALUE``.
+
+    Integer ``START``/``STOP`` with integral steps give integers (for counts).
+
+    >>> parse_vary("stage.eccentricity_mm=1.0:1.5:6").values
+    (1.0, 1.1, 1.2, 1.3, 1.4, 1.5)
+    >>> parse_vary("stage.pins=38,40").values
+    (38, 40)
+    """
+    key, sep, rhs = spec.partition("=")
+    key, rhs = key.strip(), rhs.strip()
+    if not sep or not key or not rhs:
+        raise ParameterError(
+            "--vary", spec, "expected KEY=START:STOP:N or KEY=V1,V2,... (e.g. demo.x_mm=1:2:5)"
+        )
+    if ":" in rhs:
+        return Vary(key, _range_values(key, rhs))
+    values = tuple(_parse_scalar(v) for v in rhs.split(",") if v.strip())
+    if not values:
+        raise ParameterError(f"--vary {key}", rhs, "no values given")
+    return Vary(key, values)
+
+
+def _as_vary(key: str, spec: Any) -> Vary:
+    if isinstance(spec, Vary):
+        return spec
+    if isinstance(spec, str):
+        return parse_vary(f"{key}={spec}")
+    try:
+        values = tuple(v.item() if hasattr(v, "item") else v for v in spec)
+    except TypeError:
+        values = (spec,)
+    if not values:
+        raise ParameterError(f"vary[{key!r}]", spec, "no values given")
+    return Vary(key, values)
+
+
+def grid_points(vary: Sequence[Vary]) -> list[dict[str, Any]]:
+    """Full-factorial grid, first key varying slowest: ``[{key: value, ...}, ...]``."""
+    keys = [v.key for v in vary]
+    return [
+        dict(zip(keys, combo, strict=True))
+        for combo in itertools.product(*[v.values for v in vary])
+    ]
+
+
+def _set_path(data: dict[str, Any], key: str, value: Any) -> None:
+    """Set ``data[a][b][c] = value`` for ``key = "a.b.c"`` (creating missing tables)."""
+    parts = key.split(".")
+    if any(not p for p in parts):
+        raise ParameterError("vary", key, "empty part in the dotted key")
+    if parts[0] == "case":
+        raise ParameterError("vary", key, "the [case] table (kind, title, ...) cannot be varied")
+    node: Any = data
+    for i, part in enumerate(parts):
+        last = i == len(parts) - 1
+        where = ".".join(parts[:i]) or "(top level)"
+        if isinstance(node, dict):
+            if last:
+                node[part] = value
+            else:
+                if part not in node:
+                    node[part] = {}
+                node = node[part]
+        elif isinstance(node, list) and part.isdigit():
+            idx = int(part)
+            if idx >= len(node):
+                raise ParameterError(
+                    "vary", key, f"{where} has {len(node)} items; index {idx} is out of range"
+                )
+            if last:
+                node[idx] = value
+            else:
+                node = node[idx]
+        else:
+            raise ParameterError(
+                "vary", key, f"{where} is a value ({node!r}), not a table: cannot set {part!r}"
+            )
+
+
+def _deep_copy(data: Any) -> Any:
+    if isinstance(data, dict):
+        return {k: _deep_copy(v) for k, v in data.items()}
+    if isinstance(data, list):
+        return [_deep_copy(v) for v in data]
+    return data
+
+
+def _base_case(case: Any) -> tuple[dict[str, Any], str, str]:
+    """The case as a plain dict, where it came from and its name."""
+    if isinstance(case, Mapping):
+        data = _deep_copy(dict(case))
+        name = str(data.get("case", {}).get("name") or data.get("case", {}).get("kind", "case"))
+        return data, "<dict>", name
+    if hasattr(case, "model_dump"):  # a validated Case
+        data = case.model_dump(mode="json")
+        return data, f"<{case.case.kind} case>", str(case.case.name or case.case.kind)
+    from gearte.cases import case_path
+
+    path = case_path(case)
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CaseFileError(str(path), [("(file)", f"cannot read: {exc}")]) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseFileError(str(path), [("(file)", f"TOML syntax error: {exc}")]) from None
+    meta = data.get("case")
+    if isinstance(meta, dict) and "name" not in meta:
+        meta["name"] = Path(path).stem
+    return data, str(path), Path(path).stem
+
+
+def _scalars(result: Any) -> dict[str, Any]:
+    """Every scalar value of a StudyResult: ``"analysis.value name"`` → number (mappings
+    flattened with dots; arrays, lists and strings left out)."""
+    import numpy as np
+
+    out: dict[str, Any] = {}
+
+    def visit(prefix: str, value: Any) -> None:
+        if isinstance(value, Mapping):
+            for k, v in value.items():
+                visit(f"{prefix}.{k}", v)
+        elif isinstance(value, bool | np.bool_):
+            out[prefix] = bool(value)
+        elif isinstance(value, int | np.integer):
+            out[prefix] = int(value)
+        elif isinstance(value, float | np.floating):
+            out[prefix] = float(value)
+        elif isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "biuf":
+            visit(prefix, value.item())
+
+    for a in result.analyses:
+        for name, value in a.values.items():
+            visit(f"{a.name}.{name}", value)
+    return out
+
+
+def _run_point(task: tuple[int, dict[str, Any], str, str, dict[str, Any]]) -> dict[str, Any]:
+    """Run one grid point (module-level: shipped to Dask workers). Returns its scalars or the
+    error that stopped it (non-convergence and the like; bugs propagate)."""
+    index, data, kind, kind_module, opts = task
+    from gearte.studies import RunOptions, available_kinds, register_kind, run_case
+
+    if kind not in available_kinds():  # a plugin kind on a fresh worker
+        register_kind(kind, kind_module)
+    t0 = time.perf_counter()
+    try:
+        result = run_case(data, RunOptions(**opts))
+    except CaseFileError:
+        raise
+    except GearteError as exc:
+        return {
+            "index": index,
+            "values": {},
+            "error": f"{type(exc).__name__}: {exc}",
+            "warnings": [],
+            "elapsed": time.perf_counter() - t0,
+        }
+    return {
+        "index": index,
+        "values": _scalars(result),
+        "error": None,
+        "warnings": list(result.warnings),
+        "elapsed": time.perf_counter() - t0,
+    }
+
+
+@dataclass
+class SweepResult:
+    """Results of a sweep: one row per grid point.
+
+    Attributes
+    ----------
+    name, kind, title, source : str
+        The base case.
+    vary : list of Vary
+        The varied keys and their values.
+    points : list of dict
+        ``{key: value}`` of each grid point.
+    values : list of dict
+        Scalar results of each point (``"analysis.value [unit]"`` → number).
+    errors : list of str or None
+        Why a point failed (non-convergence, ...), ``None`` where it ran.
+    """
+
+    name: str
+    kind: str
+    title: str
+    source: str
+    vary: list[Vary]
+    points: list[dict[str, Any]]
+    values: list[dict[str, Any]]
+    errors: list[str | None]
+    warnings: list[list[str]] = field(default_factory=list)
+    seed: int | None = None
+    samples: int | None = None
+    elapsed_s: float = 0.0
+    point_elapsed_s: list[float] = field(default_factory=list)
+    backend: str = ""
+
+    @property
+    def keys(self) -> list[str]:
+        return [v.key for v in self.vary]
+
+    @property
+    def columns(self) -> list[str]:
+        """Names of the scalar results, in order of first appearance."""
+        cols: dict[str, None] = {}
+        for row in self.values:
+            cols.update(dict.fromkeys(row))
+        return list(cols)
+
+    def column(self, name: str) -> list[Any]:
+        """Values of one result (or varied key) over the points; NaN where missing."""
+        if name in self.keys:
+            return [p[name] for p in self.points]
+        if name not in self.columns:
+            raise KeyError(f"no result {name!r}; have {self.columns}")
+        return [row.get(name, math.nan) for row in self.values]
+
+    def rows(self) -> list[dict[str, Any]]:
+        """The table: varied keys, every scalar result, ``error``."""
+        cols = self.columns
+        return [
+            {**p, **{c: v.get(c) for c in cols}, "error": e or ""}
+            for p, v, e in zip(self.points, self.values, self.errors, strict=True)
+        ]
+
+    def to_csv(self) -> str:
+        buf = io.StringIO()
+        w = csv.DictWriter(
+            buf, fieldnames=[*self.keys, *self.columns, "error"], lineterminator="\n"
+        )
+        w.writeheader()
+        for row in self.rows():
+            w.writerow(
+                {
+                    k: ("" if v is None else repr(v) if isinstance(v, float) else v)
+                    for k, v in row.items()
+                }
+            )
+        return buf.getvalue()
+
+    def to_dict(self) -> dict[str, Any]:
+        from gearte import __version__
+        from gearte.results import to_jsonable
+
+        return {
+            "gearte_version": __version__,
+            "case": {
+                "name": self.name,
+                "kind": self.kind,
+                "title": self.title,
+                "source": self.source,
+            },
+            "vary": {v.key: list(v.values) for v in self.vary},
+            "seed": self.seed,
+            "samples": self.samples,
+            "backend": self.backend,
+            "elapsed [s]": round(self.elapsed_s, 4),
+            "columns": self.columns,
+            "points": [
+                {
+                    "params": p,
+                    "values": to_jsonable(v),
+                    "error": e,
+                    "warnings": w,
+                    "elapsed [s]": round(t, 4),
+                }
+                for p, v, e, w, t in zip(
+                    self.points,
+                    self.values,
+                    self.errors,
+                    self.warnings,
+                    self.point_elapsed_s,
+                    strict=True,
+                )
+            ],
+        }
+
+    def to_json(self, indent: int | None = 1) -> str:
+        import json
+
+        return json.dumps(self.to_dict(), indent=indent, ensure_ascii=False, allow_nan=False)
+
+
+def run_sweep(
+    case: Any,
+    vary: Mapping[str, Any] | Sequence[Vary | str],
+    *,
+    seed: int | None = None,
+    samples: int | None = None,
+    scheduler: Any = None,
+    workers: int | None = None,
+    progress: bool = True,
+) -> SweepResult:
+    """Run ``case`` at every point of a grid over its parameters.
+
+    Parameters
+    ----------
+    case : path, bundled case name, dict or validated Case
+        The base case.
+    vary : mapping or sequence
+        ``{"section.field": spec}`` where ``spec`` is ``"START:STOP:N"``, ``"V1,V2,..."`` or a
+        sequence of values; or a sequence of ``"KEY=..."`` strings / :class:`Vary`.
+    seed, samples : int, optional
+        Override the case's seed and Monte-Carlo sample counts (the same for every point).
+    scheduler, workers :
+        Where to run, as for :func:`gearte.execution.map_chunks` (a Dask address or ``Client``
+        runs the points on the cluster).
+    progress : bool
+        Progress bar over points (terminal only).
+
+    Raises
+    ------
+    ParameterError
+        A malformed ``vary`` entry, or a key that cannot be set.
+    CaseFileError
+        A point does not validate: the message names the field, the value and the point.
+    """
+    from gearte.execution import map_chunks, open_executor
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies import get_kind
+
+    if isinstance(vary, Mapping):
+        varies = [_as_vary(k, s) for k, s in vary.items()]
+    else:
+        varies = [v if isinstance(v, Vary) else parse_vary(v) for v in vary]
+    if not varies:
+        raise ParameterError("vary", vary, "give at least one key to vary")
+    dup = [k for k, n in _count([v.key for v in varies]).items() if n > 1]
+    if dup:
+        raise ParameterError("vary", dup[0], "key given more than once")
+
+    base, source, name = _base_case(case)
+    points = grid_points(varies)
+    cases: list[dict[str, Any]] = []
+    validated = None
+    for p in points:
+        data = _deep_copy(base)
+        for k, v in p.items():
+            _set_path(data, k, v)
+        where = ", ".join(f"{k}={v!r}" for k, v in p.items())
+        validated = load_case_dict(data, source=f"{source} at {where}")
+        cases.append(data)
+    assert validated is not None
+    kind = str(validated.case.kind)
+    kind_module = get_kind(kind).__name__
+    title = str(validated.case.title)
+
+    t0 = time.perf_counter()
+    with open_executor(scheduler, workers) as ex:
+        by_points = len(points) >= ex.workers or ex.workers == 1
+        inner = {"progress": False, "seed": seed, "samples": samples}
+        if by_points:
+            inner |= {"scheduler": None, "workers": 1}
+            tasks = [(i, c, kind, kind_module, inner) for i, c in enumerate(cases)]
+            out = map_chunks(
+                _run_point, tasks, scheduler=ex, progress=progress, description=f"sweep {name}"
+            )
+        else:  # few points: one after another, each spreading its samples over the workers
+            inner |= {"scheduler": ex, "workers": workers}
+            out = [_run_point((i, c, kind, kind_module, inner)) for i, c in enumerate(cases)]
+        backend = ex.name
+    return SweepResult(
+        name=name,
+        kind=kind,
+        title=title,
+        source=source,
+        vary=varies,
+        points=points,
+        values=[o["values"] for o in out],
+        errors=[o["error"] for o in out],
+        warnings=[o["warnings"] for o in out],
+        seed=seed,
+        samples=samples,
+        elapsed_s=time.perf_counter() - t0,
+        point_elapsed_s=[o["elapsed"] for o in out],
+        backend=f"{backend} ({'points' if by_points else 'samples'} in parallel)",
+    )
+
+
+def _count(items: Sequence[str]) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for i in items:
+        counts[i] = counts.get(i, 0) + 1
+    return counts
+
+
+def _atomic_write_bytes(path: Path, data: bytes) -> None:
+    import tempfile
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def write_sweep(
+    result: SweepResult, out_dir: str | os.PathLike[str], *, plots: bool = True
+) -> dict[str, Any]:
+    """Write ``sweep.csv``, ``sweep.json`` and (unless ``plots=False``) one PNG per scalar
+    result and varied key under ``plots/``. Figures are rendered before any file is written.
+
+    Returns
+    -------
+    dict
+        ``{"csv": path, "json": path, "plots": [paths]}``.
+    """
+    out = Path(out_dir)
+    rendered: list[tuple[Path, bytes]] = []
+    if plots:
+        from gearte.plotting.sweep import figures
+
+        for stem, fig in figures(result):
+            buf = io.BytesIO()
+            fig.fig.savefig(buf, format="png", dpi=110)
+            rendered.append((out / "plots" / f"{stem}.png", buf.getvalue()))
+    csv_text, json_text = result.to_csv(), result.to_json()
+    paths: dict[str, Any] = {"csv": out / "sweep.csv", "json": out / "sweep.json", "plots": []}
+    _atomic_write_bytes(paths["csv"], csv_text.encode("utf-8"))
+    _atomic_write_bytes(paths["json"], json_text.encode("utf-8"))
+    for p, data in rendered:
+        _atomic_write_bytes(p, data)
+        paths["plots"].append(p)
+    return paths

@@ -1,0 +1,168 @@
+"""Parameter sweeps (issue 7): grid parsing, validation of every point, table and plots, CLI,
+identical results on every backend (common random numbers across points)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import pytest
+from click.testing import CliRunner
+
+from gearte.errors import CaseFileError, ParameterError
+from gearte.studies import register_kind
+from gearte.sweep import grid_points, parse_vary, run_sweep, write_sweep
+
+register_kind("mc_test", "sweep_mc_kind")
+
+DEMO = {"case": {"kind": "foundation_test", "title": "demo"}, "demo": {"length_mm": 1.0}}
+MC = {"case": {"kind": "mc_test", "title": "mc", "name": "mc"}, "mc": {"sigma_mm": 1.0}}
+
+
+@pytest.mark.parametrize(
+    "spec, key, values",
+    [
+        ("s.e_mm=1.0:1.5:6", "s.e_mm", (1.0, 1.1, 1.2, 1.3, 1.4, 1.5)),
+        ("a.n=2:8:4", "a.n", (2, 4, 6, 8)),
+        ("a.n=1:2:3", "a.n", (1.0, 1.5, 2.0)),
+        ("a.x = 0.5", "a.x", (0.5,)),
+        ("a.x=1,2.5,true,steel", "a.x", (1, 2.5, True, "steel")),
+        ("a.x=3:3:1", "a.x", (3,)),
+    ],
+)
+def test_parse_vary(spec, key, values):
+    v = parse_vary(spec)
+    assert v.key == key and v.values == values
+
+
+@pytest.mark.parametrize(
+    "spec, match",
+    [
+        ("a.x", "KEY=START:STOP:N"),
+        ("=1:2:3", "KEY=START:STOP:N"),
+        ("a.x=1:2", "START:STOP:N"),
+        ("a.x=1:2:0", "integer ≥ 1"),
+        ("a.x=1:2:2.5", "integer ≥ 1"),
+        ("a.x=one:2:3", "numbers"),
+        ("a.x=1:2:1", "one point"),
+        ("a.x=1:inf:3", "finite"),
+    ],
+)
+def test_bad_vary_specs_name_the_spec(spec, match):
+    with pytest.raises(ParameterError, match=match) as err:
+        parse_vary(spec)
+    assert "vary" in err.value.field
+
+
+def test_grid_is_full_factorial_first_key_slowest():
+    pts = grid_points([parse_vary("a=1,2"), parse_vary("b=x,y,z")])
+    assert [(p["a"], p["b"]) for p in pts] == [
+        (1, "x"),
+        (1, "y"),
+        (1, "z"),
+        (2, "x"),
+        (2, "y"),
+        (2, "z"),
+    ]
+
+
+def test_sweep_table_has_every_scalar_per_point():
+    r = run_sweep(DEMO, {"demo.length_mm": "1:10:4", "demo.count": [2, 4]}, progress=False)
+    assert len(r.points) == 8 and r.keys == ["demo.length_mm", "demo.count"]
+    # arrays ("x [mm]") are left out; mappings are flattened
+    assert r.columns == ["demo.total_length [mm]", "demo.map.a", "demo.n"]
+    for p, total in zip(r.points, r.column("demo.total_length [mm]"), strict=True):
+        # foundation kind: sum of linspace(0, L, count) = L * count / 2
+        assert total == pytest.approx(p["demo.length_mm"] * p["demo.count"] / 2)
+    assert all(e is None for e in r.errors)
+
+
+@pytest.mark.parametrize(
+    "vary, exc, field",
+    [
+        ({"demo.colour": "1,2"}, CaseFileError, "demo.colour"),
+        ({"demo.length_mm": "-1:1:3"}, CaseFileError, "demo.length_mm"),
+        ({"demo.count": "1:2:3"}, CaseFileError, "demo.count"),  # 1.5 is not a count
+        ({"demo.length_mm.x": "1,2"}, ParameterError, "demo.length_mm.x"),
+        ({"case.kind": "x"}, ParameterError, "case.kind"),
+        ({}, ParameterError, "vary"),
+    ],
+)
+def test_bad_keys_and_values_are_clear_errors_before_anything_runs(vary, exc, field):
+    with pytest.raises(exc) as err:
+        run_sweep(DEMO, vary, progress=False)
+    assert field in str(err.value)
+
+
+def test_a_failing_point_is_recorded_not_fatal(tmp_path):
+    case = {**MC, "mc": {"sigma_mm": 1.0, "fail_above_mm": 2.5, "samples": 2_000}}
+    r = run_sweep(case, {"mc.sigma_mm": "1:3:3"}, workers=1, progress=False)
+    assert [e is None for e in r.errors] == [True, True, False]
+    assert "ConvergenceError" in r.errors[2]
+    assert math.isnan(r.column("error.sd [mm]")[2])
+    paths = write_sweep(r, tmp_path, plots=False)
+    rows = list(csv.DictReader(paths["csv"].open()))
+    assert rows[2]["error"].startswith("ConvergenceError") and rows[2]["error.sd [mm]"] == ""
+
+
+def _mc_sweep(**kw):
+    return run_sweep(
+        MC, {"mc.sigma_mm": "1,2,4", "mc.offset_mm": "0,0.5"}, seed=11, progress=False, **kw
+    )
+
+
+def test_sweep_results_identical_on_every_backend_and_common_random_numbers():
+    ref = _mc_sweep(workers=1)
+    assert ref.backend.startswith("sequential")
+    for kw in ({"workers": 2}, {"scheduler": "local-cluster", "workers": 2}):
+        other = _mc_sweep(**kw)
+        assert other.values == ref.values, kw
+    # fewer points than workers: the points run one after another, samples in parallel
+    one = run_sweep(MC, {"mc.sigma_mm": "2"}, seed=11, workers=2, progress=False)
+    assert "samples in parallel" in one.backend
+    assert one.values[0] == ref.values[2]
+    # same seed at every point: sd scales exactly with sigma, mean shifts with the offset
+    sd = dict(
+        zip(
+            [(p["mc.sigma_mm"], p["mc.offset_mm"]) for p in ref.points],
+            ref.column("error.sd [mm]"),
+            strict=True,
+        )
+    )
+    assert sd[(2, 0)] == pytest.approx(2 * sd[(1, 0)], rel=1e-12)
+    assert sd[(4, 0.5)] == pytest.approx(4 * sd[(1, 0)], rel=1e-12)
+
+
+def test_outputs_csv_json_and_one_plot_per_result_and_key(tmp_path):
+    r = run_sweep(DEMO, {"demo.length_mm": "1:3:3", "demo.count": "2,3"}, progress=False)
+    paths = write_sweep(r, tmp_path / "sw")
+    rows = list(csv.DictReader(paths["csv"].open()))
+    assert len(rows) == 6 and rows[0]["demo.length_mm"] == "1" and rows[0]["error"] == ""
+    assert float(rows[5]["demo.total_length [mm]"]) == pytest.approx(4.5)
+    data = json.loads(paths["json"].read_text())
+    assert data["vary"] == {"demo.length_mm": [1, 2, 3], "demo.count": [2, 3]}
+    assert data["points"][5]["values"]["demo.total_length [mm]"] == pytest.approx(4.5)
+    assert len(paths["plots"]) == len(r.columns) * len(r.keys) == 6
+    assert all(p.stat().st_size > 1000 for p in paths["plots"])
+
+
+def test_cli_sweep_writes_outputs_and_reports_bad_keys(tmp_path):
+    from gearte.cli import main
+
+    case = tmp_path / "demo.toml"
+    case.write_text('[case]\nkind = "foundation_test"\n[demo]\nlength_mm = 4.0\n')
+    runner = CliRunner()
+    out = tmp_path / "out"
+    r = runner.invoke(
+        main,
+        ["sweep", str(case), "--vary", "demo.length_mm=1:2:3", "--out", str(out), "--no-progress"],
+    )
+    assert r.exit_code == 0, r.output
+    assert "3 points" in r.output
+    assert (out / "sweep.csv").is_file() and (out / "sweep.json").is_file()
+    assert len(list((out / "plots").glob("*.png"))) == 3
+    for bad, field in (("demo.colour=1:2:3", "demo.colour"), ("demo.length_mm", "--vary")):
+        r = runner.invoke(main, ["sweep", str(case), "--vary", bad, "--out", str(out)])
+        assert r.exit_code == 2, r.output
+        assert field in r.output and "Traceback" not in r.output
