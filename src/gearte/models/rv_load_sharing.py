@@ -38,132 +38,62 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
+from gearte.geometry.cycloid import CycloidStage, normal_clearance_unclosed
 from gearte.geometry.rv import RVReducer
+from gearte.solvers.rv_equilibrium import ContactLaw, solve_positions
 
 __all__ = [
     "DofLayout",
     "RVSystem",
     "dof_layout",
-    "hu2020_contact_deformation",
-    "unrotated_clearance",
-    "loaded_flank_clearance",
-    "profile_curvature_radius",
+    "cycloid_stage",
+    "contact_law",
     "assemble",
+    "LoadSharing",
+    "load_sharing",
+    "output_positions",
+    "TransmissionError",
+    "transmission_error",
 ]
 
 
 # ------------------------------------------------------------------------------------------
-# Contact law and clearance (Hu et al. 2020, section 4)
+# The cycloid stage of the reducer and its contact law (reused from gearte.geometry.cycloid and
+# gearte.models.cycloid_contact, issue 2: one implementation of Hu 2020 eq 32–40)
 # ------------------------------------------------------------------------------------------
-def hu2020_contact_deformation(
-    force: ArrayLike,
-    rho: ArrayLike,
-    pin_radius: float,
-    youngs_modulus: float,
-    poisson_ratio: float,
-    face_width: float,
-) -> np.ndarray:
-    """Normal contact deformation of a pin on the cycloid disc [mm] (Hu 2020 eq 33–36).
+def cycloid_stage(reducer: RVReducer) -> CycloidStage:
+    """The reducer's cycloid–pin stage as a :class:`gearte.geometry.cycloid.CycloidStage`.
 
-    Parameters
-    ----------
-    force : array_like
-        Contact force ``F`` [N] (> 0).
-    rho : array_like
-        Curvature radius of the disc profile at the contact ``ρ`` [mm] (sign ignored).
-    pin_radius : float
-        ``r_rp`` [mm].
-    youngs_modulus : float
-        ``E`` [MPa].
-    poisson_ratio : float
-        ``μ`` [-].
-    face_width : float
-        ``b`` [mm].
-
-    Returns
-    -------
-    numpy.ndarray
-        ``δ`` [mm].
-
-    Notes
-    -----
-    ``δ = 2 F (1-μ²)/(π E b) [2/3 + ln(16 r_rp |ρ| / c²)]`` with the half-width as printed,
-    ``c = 4.99e-3 sqrt(4 (1-μ²) F |ρ| r_rp / (E b (|ρ| + r_rp)))``. This is the reading of
-    ``/work/shared/models/hu2020.md`` (it reproduces δ_max = 0.0116 mm at F = 1910.3 N of
-    Table 4). Issue 2 (branch ``issue2``, ``gearte.models.cycloid_contact``) implements the
-    same law for the cycloid stage alone; this copy exists because that branch was not yet
-    committed when the RV model was written.
-
-    Examples
-    --------
-    >>> float(np.round(hu2020_contact_deformation(1910.3, 43.57, 3.0, 2.06e5, 0.3, 11.0), 4))
-    0.0116
+    Its validation (K1 < 1, no undercut, pins fit, non-interfering eq 32 clearance) applies.
     """
-    f = np.asarray(force, dtype=float)
-    r = np.abs(np.asarray(rho, dtype=float))
-    one_mu2 = 1.0 - poisson_ratio**2
-    c2 = (4.99e-3) ** 2 * (
-        4.0 * one_mu2 * f * r * pin_radius / (youngs_modulus * face_width * (r + pin_radius))
-    )
-    return (
-        2.0
-        * f
-        * one_mu2
-        / (np.pi * youngs_modulus * face_width)
-        * (2.0 / 3.0 + np.log(16.0 * pin_radius * r / c2))
+    return CycloidStage(
+        z_p=reducer.pins.count,
+        r_p=reducer.pins.circle_radius,
+        r_rp=reducer.pins.pin_radius,
+        a=reducer.cranks.eccentricity,
+        b=reducer.discs.face_width,
+        dr_rp=reducer.discs.equidistant_modification,
+        dr_p=reducer.discs.shift_modification,
     )
 
 
-def unrotated_clearance(phi: ArrayLike, K1: float, d_rrp: float, d_rp: float) -> np.ndarray:  # noqa: N803
-    """Normal clearance between a modified disc and pin ``phi`` in the nominal position [mm].
+def contact_law(reducer: RVReducer, kind: str = "hu2020", stiffness: float = 2.0e5) -> ContactLaw:
+    """Pin-contact law of the reducer: Hu 2020 eq 38–40 with ρ(φ0) and the grinding pin radius.
 
-    Parameters
-    ----------
-    phi : array_like
-        Meshing phase of the pin, measured from the line of centres [rad].
-    K1 : float
-        Short-width coefficient ``a z_p/(r_p + Δr_p)`` [-].
-    d_rrp, d_rp : float
-        Equidistant ``Δr_rp`` and shift ``Δr_p`` modifications [mm] (Hu 2020 convention).
-
-    Returns
-    -------
-    numpy.ndarray
-        ``Δ_u(φ) = Δr_rp − Δr_p (1 − K1 cos φ)/S`` [mm]; symmetric in ``±φ`` (both flanks).
-
-    Notes
-    -----
-    Hu 2020 eq 32 gives the clearance *after* the disc has been turned to close the first
-    contact; it equals ``Δ_u(φ) − (Δr_rp − Δr_p sqrt(1−K1²)) sin φ / S``, i.e. ``Δ_u`` minus
-    the normal approach of a rigid rotation ``r_c β₀ = Δr_rp − Δr_p sqrt(1−K1²)`` that closes
-    the gap at ``φ₀ = arccos K1``. The RV model needs the clearance before any rotation
-    (the rotation is an unknown of the equilibrium, and both flanks matter for backlash), hence
-    this form; ``loaded_flank_clearance`` checks it against eq 32.
+    The same constants as :func:`gearte.models.cycloid_contact.compliance_constants` use in the
+    cycloid-stage contact analysis (``stage.rho0``, ``stage.r``), so both analyses share one law.
     """
-    p = np.asarray(phi, dtype=float)
-    s = np.sqrt(1.0 + K1 * K1 - 2.0 * K1 * np.cos(p))
-    return d_rrp - d_rp * (1.0 - K1 * np.cos(p)) / s
-
-
-def loaded_flank_clearance(phi: ArrayLike, K1: float, d_rrp: float, d_rp: float) -> np.ndarray:  # noqa: N803
-    """Hu 2020 eq 32: clearance after the rotation that closes the first contact [mm]."""
-    p = np.asarray(phi, dtype=float)
-    s = np.sqrt(1.0 + K1 * K1 - 2.0 * K1 * np.cos(p))
-    return (
-        d_rrp * (1.0 - np.sin(p) / s)
-        - d_rp * (1.0 - K1 * np.cos(p) - np.sqrt(1.0 - K1 * K1) * np.sin(p)) / s
+    st = cycloid_stage(reducer)
+    d = reducer.discs
+    return ContactLaw(
+        kind=kind,
+        stiffness=stiffness,
+        rho=abs(st.rho0),
+        pin_radius=st.r,
+        youngs_modulus=d.youngs_modulus,
+        poisson_ratio=d.poisson_ratio,
+        face_width=d.face_width,
     )
-
-
-def profile_curvature_radius(phi: ArrayLike, K1: float, pin_count: int, r_p: float, r_rp: float):  # noqa: N803
-    """Curvature radius of the cycloid profile [mm], Hu 2020 eq 40.
-
-    ``ρ(φ) = r_p S³ / (K1 (z_p+1) cos φ − (1 + z_p K1²)) + r_rp``; at ``φ₀ = arccos K1`` it is
-    ``−r_p sqrt(1−K1²) + r_rp`` (negative = concave).
-    """
-    p = np.asarray(phi, dtype=float)
-    s = np.sqrt(1.0 + K1 * K1 - 2.0 * K1 * np.cos(p))
-    return r_p * s**3 / (K1 * (pin_count + 1) * np.cos(p) - (1.0 + pin_count * K1 * K1)) + r_rp
 
 
 # ------------------------------------------------------------------------------------------
@@ -370,7 +300,6 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     pin_err = pins.radial_position_errors[:, None] * _u(alpha_k) + pins.tangential_position_errors[
         :, None
     ] * _u(alpha_k + np.pi / 2)
-    K1m = reducer.K1
     cB = np.zeros((P, N * zp, nd))
     cg = np.zeros((P, N * zp))
     group = np.repeat(np.arange(N), zp)
@@ -389,8 +318,13 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
         cB[:, sl, dof + 1] = n[..., 1]
         cB[:, sl, dof + 2] = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
         phi = alpha_k[None, :] - ecc[:, j][:, None]
-        gap = unrotated_clearance(
-            phi, K1m, reducer.discs.equidistant_modification, reducer.discs.shift_modification
+        gap = normal_clearance_unclosed(
+            phi,
+            z_p=zp,
+            r_p=pins.circle_radius,
+            a=a,
+            dr_rp=reducer.discs.equidistant_modification,
+            dr_p=reducer.discs.shift_modification,
         )
         gap = gap - pins.radius_errors[None, :] + np.sum(n * pin_err[None], axis=-1)
         cg[:, sl] = gap
@@ -398,3 +332,177 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     unit = np.zeros(nd)
     unit[lay.output_rotation] = -1.0  # load torque resists the drive
     return RVSystem(th, spring_B, spring_e, spring_k, cB, cg, group, pin_index, unit, labels, lay)
+
+
+# ------------------------------------------------------------------------------------------
+# Analyses over one output revolution
+# ------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LoadSharing:
+    """Quasi-static load sharing over output positions.
+
+    Attributes
+    ----------
+    theta : (P,) output angles [rad].
+    torque : float
+        Output torque [N·mm].
+    pin_force : (P, N, z_p) contact force of every pin on every disc [N].
+    pairs_in_mesh : (P, N) loaded pins per disc [-].
+    cam_bearing_load : (P, M, N) radial load of each crank's cam bearing in each disc [N].
+    carrier_bearing_load : (P, M) radial load of each crank's bearing in the carrier [N].
+    mesh_force : (P, M) sun–planet mesh force [N].
+    disc_torque : (P, N) moment of the pin forces about each disc centre [N·mm].
+    output_error : (P,) output angle error ``theta_actual − theta_nominal`` [rad]
+        (negative = output lags).
+    contact_stiffness : (P, N) secant pin stiffness per disc [N/mm].
+    q : (P, nd) all displacements [mm, rad].
+    """
+
+    theta: np.ndarray
+    torque: float
+    pin_force: np.ndarray
+    pairs_in_mesh: np.ndarray
+    cam_bearing_load: np.ndarray
+    carrier_bearing_load: np.ndarray
+    mesh_force: np.ndarray
+    disc_torque: np.ndarray
+    output_error: np.ndarray
+    contact_stiffness: np.ndarray
+    q: np.ndarray
+
+    @property
+    def peak_pin_load(self) -> float:
+        """Largest pin force over the revolution [N]."""
+        return float(self.pin_force.max())
+
+
+def _postprocess(reducer: RVReducer, system: RVSystem, sol, torque: float) -> LoadSharing:
+    M, N, zp = reducer.cranks.count, reducer.discs.count, reducer.pins.count
+    P = system.theta.size
+    w = np.einsum("psi,pi->ps", system.spring_B, sol.q) + system.spring_e
+    f = w * system.spring_k[None, :]
+    cam = f[:, system.labels["cam_bearing"]].reshape(P, M, N, 2)
+    car = f[:, system.labels["carrier_bearing"]].reshape(P, M, 2)
+    mesh = f[:, system.labels["mesh"]]
+    pin = sol.contact_force.reshape(P, N, zp)
+    lever = system.contact_B[:, :, :]  # rows hold n and the moment arm about the disc centre
+    lay = system.layout
+    arm = np.stack(
+        [lever[:, j * zp : (j + 1) * zp, lay.disc(j) + 2] for j in range(N)], axis=1
+    )  # (P, N, zp)
+    disc_torque = -np.sum(pin * arm, axis=-1)
+    return LoadSharing(
+        theta=system.theta,
+        torque=float(torque),
+        pin_force=pin,
+        pairs_in_mesh=(pin > 0.0).sum(axis=-1),
+        cam_bearing_load=np.linalg.norm(cam, axis=-1),
+        carrier_bearing_load=np.linalg.norm(car, axis=-1),
+        mesh_force=mesh,
+        disc_torque=disc_torque,
+        output_error=sol.q[:, lay.output_rotation].copy(),
+        contact_stiffness=sol.contact_stiffness,
+        q=sol.q,
+    )
+
+
+def output_positions(n_positions: int) -> np.ndarray:
+    """``n_positions`` equally spaced output angles over one revolution [rad]."""
+    if int(n_positions) != n_positions or n_positions < 1:
+        raise ParameterError("positions", n_positions, "must be an integer >= 1")
+    return np.linspace(0.0, 2.0 * np.pi, int(n_positions), endpoint=False)
+
+
+def load_sharing(
+    reducer: RVReducer,
+    torque: float,
+    theta: ArrayLike | None = None,
+    *,
+    law: ContactLaw | None = None,
+    system: RVSystem | None = None,
+    compiled: bool = True,
+) -> LoadSharing:
+    """Quasi-static load sharing of ``reducer`` under output ``torque`` [N·mm].
+
+    Parameters
+    ----------
+    reducer : RVReducer
+    torque : float
+        Output torque [N·mm]; positive resists the drive direction.
+    theta : array_like, optional
+        Output angles [rad]; default 360 positions over one revolution.
+    law : ContactLaw, optional
+        Pin-contact law; default :func:`contact_law` (Hu 2020).
+    system : RVSystem, optional
+        Pre-assembled rows (re-used across torques).
+    compiled : bool
+        Use the numba kernel (``False``: plain-Python twin).
+    """
+    if not np.isfinite(torque):
+        raise ParameterError("torque", torque, "must be finite [N·mm]")
+    if system is None:
+        system = assemble(reducer, output_positions(360) if theta is None else theta)
+    law = contact_law(reducer) if law is None else law
+    sol = solve_positions(system, torque, law, compiled=compiled)
+    return _postprocess(reducer, system, sol, torque)
+
+
+@dataclass(frozen=True)
+class TransmissionError:
+    """Loaded output angle error over a revolution, split into geometric and elastic parts.
+
+    ``total = geometric + elastic``; geometric is the output angle error at (nearly) zero load
+    ``zero_load_torque`` (errors, clearances and the preload they cause), elastic the rest.
+    All [rad].
+    """
+
+    theta: np.ndarray
+    total: np.ndarray
+    geometric: np.ndarray
+    elastic: np.ndarray
+    loaded: LoadSharing
+    unloaded: LoadSharing
+
+    @staticmethod
+    def peak_to_peak(x: np.ndarray) -> float:
+        return float(np.max(x) - np.min(x))
+
+
+def transmission_error(
+    reducer: RVReducer,
+    torque: float,
+    theta: ArrayLike | None = None,
+    *,
+    zero_load_fraction: float = 1e-3,
+    law: ContactLaw | None = None,
+) -> TransmissionError:
+    """Total (loaded), geometric (zero-load) and elastic output angle error [rad].
+
+    Parameters
+    ----------
+    reducer : RVReducer
+    torque : float
+        Output torque [N·mm] (> 0).
+    theta : array_like, optional
+        Output angles [rad] (default 360 over one revolution).
+    zero_load_fraction : float
+        The geometric TE is solved at ``zero_load_fraction * torque`` in the same direction, so
+        that the contacts close their clearance without deflecting (a zero torque leaves the
+        output free within its backlash).
+    """
+    if not torque > 0:
+        raise ParameterError("torque", torque, "must be > 0 N·mm for the TE analysis")
+    if not 0 < zero_load_fraction < 0.05:
+        raise ParameterError("zero_load_fraction", zero_load_fraction, "must be in (0, 0.05)")
+    system = assemble(reducer, output_positions(360) if theta is None else theta)
+    law = contact_law(reducer) if law is None else law
+    loaded = load_sharing(reducer, torque, law=law, system=system)
+    unloaded = load_sharing(reducer, zero_load_fraction * torque, law=law, system=system)
+    return TransmissionError(
+        theta=system.theta,
+        total=loaded.output_error,
+        geometric=unloaded.output_error,
+        elastic=loaded.output_error - unloaded.output_error,
+        loaded=loaded,
+        unloaded=unloaded,
+    )
