@@ -6,7 +6,8 @@ Case file layout::
     [case]  kind = "rv_reducer"
     [reducer]                  rated_torque_Nm
     [reducer.first_stage]      sun_teeth, planet_teeth, planets, module_mm, pressure_angle_deg,
-                               mesh_stiffness_N_per_mm | face_width_mm, sun_support_stiffness_N_per_mm
+                               mesh_stiffness_N_per_mm | face_width_mm,
+                               sun_support_stiffness_N_per_mm
     [reducer.cranks]           count, circle_radius_mm, eccentricity_mm,
                                cam_bearing = {stiffness_N_per_mm | rollers, roller_length_mm,
                                reference_load_N}, carrier_bearing = {...}
@@ -138,7 +139,8 @@ class PinsSection(StrictModel):
 
     @model_validator(mode="after")
     def _lengths(self):
-        for name in ("radius_errors_um", "radial_position_errors_um", "tangential_position_errors_um"):
+        names = ("radius_errors_um", "radial_position_errors_um", "tangential_position_errors_um")
+        for name in names:
             v = getattr(self, name)
             if v is not None and len(v) != self.count:
                 raise ValueError(f"{name} needs one value per pin ({self.count}), got {len(v)}")
