@@ -105,8 +105,8 @@ def torsion_test(
     frac = torque_path(turning_points, steps_per_segment)
     law = contact_law(reducer) if law is None else law
     # a torque of exactly zero leaves the output free inside its backlash; approach it from the
-    # side the path comes from (±1e-6 T_r), which is what a frictionless test bench records
-    eps = 1e-6
+    # side the path comes from (±1e-4 T_r), which is what a frictionless test bench records
+    eps = 1e-4
     prev = np.concatenate([[frac[0]], frac[:-1]])
     frac_eff = np.where(frac == 0.0, np.where(prev >= 0.0, eps, -eps), frac)
     if frac_eff[0] == 0.0:
@@ -120,7 +120,7 @@ def torsion_test(
 def backlash(reducer: RVReducer, *, theta: float = 0.0, law: ContactLaw | None = None) -> float:
     """Backlash θ(0⁺) − θ(0⁻) [rad] at output angle ``theta`` (0 when preloaded)."""
     law = contact_law(reducer) if law is None else law
-    eps = 1e-6 * reducer.rated_torque
+    eps = 1e-4 * reducer.rated_torque
     return float(
         _follow(reducer, theta, np.array([eps]), law)[0]
         - _follow(reducer, theta, np.array([-eps]), law)[0]
@@ -150,7 +150,7 @@ def catalogue_values(
     """Torsional rigidity, lost motion, backlash and hysteresis loss from a virtual test.
 
     Each quantity is read at its exact torque: the branches ``0 → ±T_r`` are followed with
-    warm starts through ``±1e-6, ±lost_motion_fraction, ±0.5, ±1`` × rated torque.
+    warm starts through ``±1e-4, ±lost_motion_fraction, ±0.5, ±1`` × rated torque.
     """
     if not 0 < lost_motion_fraction < 0.5:
         raise ParameterError("lost_motion_fraction", lost_motion_fraction, "must be in (0, 0.5)")
@@ -158,7 +158,7 @@ def catalogue_values(
     curve = torsion_test(
         reducer, turning_points, theta=theta, steps_per_segment=steps_per_segment, law=law
     )
-    levels = np.array([1e-6, lost_motion_fraction, 0.5, 1.0])
+    levels = np.array([1e-4, lost_motion_fraction, 0.5, 1.0])
     tr = reducer.rated_torque
     pos = _follow(reducer, theta, levels * tr, law)
     neg = _follow(reducer, theta, -levels * tr, law)
@@ -168,8 +168,8 @@ def catalogue_values(
     lost_motion = pos[1] - neg[1]
     backlash = pos[0] - neg[0]
     # hysteresis loss: zero-torque width after unloading from ±T_r (same as backlash here)
-    back_pos = _follow(reducer, theta, np.array([1.0, 0.5, 1e-6]) * tr, law)[-1]
-    back_neg = _follow(reducer, theta, -np.array([1.0, 0.5, 1e-6]) * tr, law)[-1]
+    back_pos = _follow(reducer, theta, np.array([1.0, 0.5, 1e-4]) * tr, law)[-1]
+    back_neg = _follow(reducer, theta, -np.array([1.0, 0.5, 1e-4]) * tr, law)[-1]
     return CatalogueValues(
         torsional_rigidity=float(rigidity),
         lost_motion=float(lost_motion),
