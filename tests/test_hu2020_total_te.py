@@ -72,7 +72,8 @@ def test_hu2020_modified_prototype_has_lower_total_te(te):
         print(
             f"{tag}: mean loaded lag {lag[0]:.3f}' -> {lag[1]:.3f}' "
             f"({_reduction(*lag):.1f} %), TE p-p {pp[0] * 60:.4f}\" -> {pp[1] * 60:.4f}\" "
-            f"({_reduction(*pp):.1f} %); paper {HU2020['sim [%]']} % sim, {HU2020['test [%]']} % test"
+            f"({_reduction(*pp):.1f} %); paper {HU2020['sim [%]']} % sim, "
+            f"{HU2020['test [%]']} % test"
         )
         assert lag[1] < lag[0]
     # the ripple over a revolution (no errors): only meaningful with the compliant supports
@@ -96,9 +97,11 @@ def test_hu2020_geometric_and_elastic_parts_add_up(te):
 
 def test_hu2020_pins_in_mesh_initial_vs_modified(te):
     ini, mod = (t.loaded for t in te["real"])
-    print(f"pairs in mesh {ini.pairs_in_mesh.min()}-{ini.pairs_in_mesh.max()} -> "
-          f"{mod.pairs_in_mesh.min()}-{mod.pairs_in_mesh.max()} (paper 9 -> 17); peak "
-          f"{ini.peak_pin_load:.0f} -> {mod.peak_pin_load:.0f} N (paper 1910.3 -> 1435.9 N)")  # fmt: skip
+    print(
+        f"pairs in mesh {ini.pairs_in_mesh.min()}-{ini.pairs_in_mesh.max()} -> "
+        f"{mod.pairs_in_mesh.min()}-{mod.pairs_in_mesh.max()} (paper 9 -> 17); peak "
+        f"{ini.peak_pin_load:.0f} -> {mod.peak_pin_load:.0f} N (paper 1910.3 -> 1435.9 N)"
+    )
     assert abs(int(ini.pairs_in_mesh.max()) - HU2020["pins_initial"]) <= 1
     assert mod.pairs_in_mesh.min() >= ini.pairs_in_mesh.max() + 5
     assert mod.peak_pin_load < ini.peak_pin_load

@@ -1,4 +1,7 @@
-"""Bad input to the RV reducer description and the rv_reducer case kind: clear errors naming the field."""
+"""Bad input to the RV reducer description and the rv_reducer case kind.
+
+Every error names the field, the value and the allowed range.
+"""
 
 from __future__ import annotations
 
