@@ -29,7 +29,7 @@ import numpy as np
 from gearte.errors import ParameterError
 from gearte.geometry.rv import Discs, PinRing, RVReducer
 from gearte.models.rv_catalogue import backlash
-from gearte.models.rv_load_sharing import LoadSharing, load_sharing, output_positions
+from gearte.models.rv_load_sharing import LoadSharing, output_positions, transmission_error
 
 __all__ = ["VARIABLES", "apply_changes", "DesignPoint", "Compensation", "compensate"]
 
@@ -88,12 +88,12 @@ class Compensation:
 
 def _evaluate(reducer, changes, torque, theta) -> DesignPoint:
     red = apply_changes(reducer, changes)
-    ls = load_sharing(red, torque, theta)
-    te = ls.output_error
+    te = transmission_error(red, torque, theta, mesh_samples=12)
+    ls = te.loaded
     return DesignPoint(
         changes=dict(changes),
-        total_te_peak_to_peak=float(te.max() - te.min()),
-        mean_lag=float(-te.mean()),
+        total_te_peak_to_peak=te.total_pp,
+        mean_lag=float(-te.total.mean()),
         backlash=backlash(red),
         peak_pin_load=ls.peak_pin_load,
         pairs_in_mesh_min=int(ls.pairs_in_mesh.min()),

@@ -53,6 +53,7 @@ __all__ = [
     "load_sharing",
     "output_positions",
     "TransmissionError",
+    "mesh_period",
     "transmission_error",
 ]
 
@@ -447,13 +448,25 @@ def load_sharing(
     return _postprocess(reducer, system, sol, torque)
 
 
+def mesh_period(reducer: RVReducer) -> float:
+    """Output angle [rad] after which the pin-contact pattern repeats: ``2π / (z_p z_c)``.
+
+    The eccentric turns ``-z_c θ`` and the pattern repeats when the pin phases have moved by one
+    pin pitch ``2π / z_p``; the mesh-stiffness ripple of the TE has this period.
+    """
+    return 2.0 * np.pi / (reducer.pins.count * reducer.cycloid_teeth)
+
+
 @dataclass(frozen=True)
 class TransmissionError:
     """Loaded output angle error over a revolution, split into geometric and elastic parts.
 
     ``total = geometric + elastic``; geometric is the output angle error at (nearly) zero load
     ``zero_load_torque`` (errors, clearances and the preload they cause), elastic the rest.
-    All [rad].
+    All [rad]. ``theta, total, geometric, elastic`` are on the requested positions (for plots);
+    ``*_pp`` are peak-to-peak values over those positions *plus* one finely resolved mesh period
+    around each extreme, since the mesh ripple (period :func:`mesh_period`, ``z_p z_c`` cycles per
+    revolution) is aliased by any practical uniform sampling.
     """
 
     theta: np.ndarray
@@ -462,6 +475,9 @@ class TransmissionError:
     elastic: np.ndarray
     loaded: LoadSharing
     unloaded: LoadSharing
+    total_pp: float
+    geometric_pp: float
+    elastic_pp: float
 
     @staticmethod
     def peak_to_peak(x: np.ndarray) -> float:
@@ -474,6 +490,7 @@ def transmission_error(
     theta: ArrayLike | None = None,
     *,
     zero_load_fraction: float = 1e-3,
+    mesh_samples: int = 24,
     law: ContactLaw | None = None,
 ) -> TransmissionError:
     """Total (loaded), geometric (zero-load) and elastic output angle error [rad].
@@ -489,20 +506,43 @@ def transmission_error(
         The geometric TE is solved at ``zero_load_fraction * torque`` in the same direction, so
         that the contacts close their clearance without deflecting (a zero torque leaves the
         output free within its backlash).
+    mesh_samples : int
+        Positions per mesh period in the refinement around the extremes (0: no refinement).
     """
     if not torque > 0:
         raise ParameterError("torque", torque, "must be > 0 N·mm for the TE analysis")
     if not 0 < zero_load_fraction < 0.05:
         raise ParameterError("zero_load_fraction", zero_load_fraction, "must be in (0, 0.05)")
+    if int(mesh_samples) != mesh_samples or mesh_samples < 0:
+        raise ParameterError("mesh_samples", mesh_samples, "must be an integer >= 0")
     system = assemble(reducer, output_positions(360) if theta is None else theta)
     law = contact_law(reducer) if law is None else law
     loaded = load_sharing(reducer, torque, law=law, system=system)
     unloaded = load_sharing(reducer, zero_load_fraction * torque, law=law, system=system)
+    total = loaded.output_error
+    geo = unloaded.output_error
+    ela = total - geo
+    all_t, all_g, all_e = [total], [geo], [ela]
+    if mesh_samples:
+        centres = {int(np.argmax(x)) for x in (total, geo, ela)}
+        centres |= {int(np.argmin(x)) for x in (total, geo, ela)}
+        offs = (np.arange(mesh_samples) / mesh_samples - 0.5) * mesh_period(reducer)
+        fine = np.concatenate([system.theta[c] + offs for c in sorted(centres)])
+        fsys = assemble(reducer, fine)
+        ft = load_sharing(reducer, torque, law=law, system=fsys).output_error
+        fg = load_sharing(reducer, zero_load_fraction * torque, law=law, system=fsys).output_error
+        all_t.append(ft)
+        all_g.append(fg)
+        all_e.append(ft - fg)
+    pp = TransmissionError.peak_to_peak
     return TransmissionError(
         theta=system.theta,
-        total=loaded.output_error,
-        geometric=unloaded.output_error,
-        elastic=loaded.output_error - unloaded.output_error,
+        total=total,
+        geometric=geo,
+        elastic=ela,
         loaded=loaded,
         unloaded=unloaded,
+        total_pp=pp(np.concatenate(all_t)),
+        geometric_pp=pp(np.concatenate(all_g)),
+        elastic_pp=pp(np.concatenate(all_e)),
     )

@@ -88,9 +88,7 @@ class Bearing(StrictModel):
     def stiffness(self) -> float:
         if self.stiffness_N_per_mm is not None:
             return self.stiffness_N_per_mm
-        return palmgren_radial_stiffness(
-            self.rollers, self.roller_length_mm, self.reference_load_N
-        )
+        return palmgren_radial_stiffness(self.rollers, self.roller_length_mm, self.reference_load_N)
 
 
 class FirstStageSection(StrictModel):
@@ -396,9 +394,10 @@ def _transmission_error(red, sec: TESection) -> AnalysisResult:
     )
     pp = te.peak_to_peak
     values = {
-        "total_te_peak_to_peak [arcsec]": rad_to_arcsec(pp(te.total)),
-        "geometric_te_peak_to_peak [arcsec]": rad_to_arcsec(pp(te.geometric)),
-        "elastic_te_peak_to_peak [arcsec]": rad_to_arcsec(pp(te.elastic)),
+        "total_te_peak_to_peak [arcsec]": rad_to_arcsec(te.total_pp),
+        "geometric_te_peak_to_peak [arcsec]": rad_to_arcsec(te.geometric_pp),
+        "elastic_te_peak_to_peak [arcsec]": rad_to_arcsec(te.elastic_pp),
+        "total_te_peak_to_peak_sampled [arcsec]": rad_to_arcsec(pp(te.total)),
         "mean_output_lag [arcmin]": rad_to_arcmin(-float(te.total.mean())),
         "mean_geometric_lag [arcmin]": rad_to_arcmin(-float(te.geometric.mean())),
         "mean_elastic_lag [arcmin]": rad_to_arcmin(-float(te.elastic.mean())),
@@ -415,7 +414,9 @@ def _transmission_error(red, sec: TESection) -> AnalysisResult:
             "TE = actual − nominal output angle with the input held at its kinematic position; "
             "negative = output lags. Geometric part: solved at zero_load_fraction × torque "
             "(clearances closed, errors and the preload they cause included); elastic = total − "
-            "geometric. Peak-to-peak over one output revolution.",
+            "geometric. Peak-to-peak over one output revolution: the sampled positions plus one "
+            "finely resolved mesh period (2π/(z_p z_c)) around each extreme, because the mesh "
+            "ripple has z_p z_c cycles per revolution and is aliased by uniform sampling.",
         ],
         data={"te": te},
     )
