@@ -71,7 +71,7 @@ def test_hu2020_modified_prototype_has_lower_total_te(te):
         rows[tag] = (lag, pp)
         print(
             f"{tag}: mean loaded lag {lag[0]:.3f}' -> {lag[1]:.3f}' "
-            f"({_reduction(*lag):.1f} %), TE p-p {pp[0] * 60:.4f}\" -> {pp[1] * 60:.4f}\" "
+            f'({_reduction(*lag):.1f} %), TE p-p {pp[0] * 60:.4f}" -> {pp[1] * 60:.4f}" '
             f"({_reduction(*pp):.1f} %); paper {HU2020['sim [%]']} % sim, "
             f"{HU2020['test [%]']} % test"
         )
