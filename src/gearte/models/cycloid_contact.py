@@ -275,6 +275,13 @@ def tooth_contact(
         max_iter=max_iter,
     )
     dmax = A * F * (2.0 / 3.0 + np.log(B / F))
+    if np.max(dmax) > 0.1 * stage.r:
+        raise ParameterError(
+            "torque",
+            torque,
+            f"gives a normal deformation of {np.max(dmax):.3g} mm, beyond the elastic contact "
+            f"model's range (at most 0.1 x pin radius = {0.1 * stage.r:.3g} mm)",
+        )
     approach = lr * dmax[:, None]
     in_mesh = loaded & (approach > clr)
     force = np.where(in_mesh, (approach - clr) / dmax[:, None] * F[:, None], 0.0)
