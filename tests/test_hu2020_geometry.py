@@ -133,9 +133,9 @@ def test_eq32_initial_clearance_against_envelope(params):
     The disc is turned until the first loaded-flank pin touches (bisection on the rotation); the
     remaining gaps must equal eq 32. Eq 32 is first order in the modifications: its error is of
     the order (|dr_rp| + |dr_p|)^2 / |rho(phi0)| in the working zone (phi >= phi0; bound: 3
-    times that), where the profile curvature radius is large; near the root the pin-centre path is sharply curved
-    (radius ~0.1 mm for Table 3) and the first-order formula deviates by up to ~1.7 um (see
-    docs/validation/hu2020.md), which is checked separately with a looser bound.
+    times that), where the profile curvature radius is large; near the root the pin-centre path
+    is sharply curved (radius ~0.1 mm for Table 3) and the first-order formula deviates by up to
+    ~1.7 um (see docs/validation/hu2020.md), which is checked separately with a looser bound.
     """
     st = CycloidStage(**params)
     theta = st.phi0 - 2 * np.pi * 4 / st.z_p  # pin 5 sits at phi0, where first contact closes
