@@ -277,7 +277,7 @@ def factor_contributions(
         if k == "eccentricity_error":
             out[k] = float(eccentricity_te(stage, e[k])) if e[k] != 0.0 else 0.0
         else:
-            out[k] = g[k] * e[k]
+            out[k] = g[k] * e[k] + 0.0  # + 0.0: no negative zeros in reports
     return out
 
 
