@@ -56,14 +56,17 @@ def test_cli_validate_reports_bad_case_without_traceback(name):
 # ---------------------------------------------------------------------------------------------
 # property test: random case dictionaries
 
-VALID = tomllib.loads((Path(__file__).parents[1] / "examples" / "hu2020_rv80e_initial.toml")
-                      .read_text(encoding="utf-8"))
+VALID = tomllib.loads(
+    (Path(__file__).parents[1] / "examples" / "hu2020_rv80e_initial.toml").read_text(
+        encoding="utf-8"
+    )
+)
 VALID["analyses"]["tooth_contact"]["mesh_positions"] = 3
 
 _scalars = st.one_of(
     st.none(),
     st.booleans(),
-    st.integers(min_value=-10**6, max_value=10**6),
+    st.integers(min_value=-(10**6), max_value=10**6),
     st.floats(allow_nan=True, allow_infinity=True),
     st.floats(min_value=-0.1, max_value=100.0),
     st.text(max_size=8),
