@@ -129,3 +129,52 @@ def test_random_case_dicts_raise_only_gearte_errors(case):
     assert 0 < v["K1"] < 1
     if "tooth_contact" in result:
         assert math.isfinite(result["tooth_contact"].values["max_contact_force [N]"])
+
+
+@st.composite
+def physical_range_cases(draw):
+    """Cases whose numbers all lie in the schema ranges: exercises the physical validators."""
+    pins = draw(st.integers(min_value=4, max_value=80))
+    stage = {
+        "pins": pins,
+        "pin_circle_radius_mm": draw(st.floats(min_value=5.0, max_value=300.0)),
+        "pin_radius_mm": draw(st.floats(min_value=0.2, max_value=12.0)),
+        "eccentricity_mm": draw(st.floats(min_value=0.1, max_value=6.0)),
+        "face_width_mm": draw(st.floats(min_value=1.0, max_value=60.0)),
+        "equidistant_modification_mm": draw(st.floats(min_value=-0.1, max_value=0.1)),
+        "shifted_modification_mm": draw(st.floats(min_value=-0.1, max_value=0.1)),
+        "rotation_modification_arcmin": draw(st.floats(min_value=-5.0, max_value=5.0)),
+    }
+    return {
+        "case": {"kind": "cycloid_stage", "title": "random"},
+        "stage": stage,
+        "errors": {"radial_runout": {"mean_um": 5.0, "tolerance_um": 10.0}},
+        "analyses": {
+            "geometric_te": {},
+            "tooth_contact": {
+                "torque_Nm": draw(st.floats(min_value=1.0, max_value=5000.0)),
+                "mesh_positions": 3,
+            },
+            "compensation": {},
+        },
+    }
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(physical_range_cases())
+def test_random_physical_cases_run_or_fail_cleanly(case):
+    from gearte.studies import RunOptions, run_case
+
+    try:
+        valid = load_case(case)
+    except CaseFileError as exc:
+        assert len(exc.errors) >= 1
+        return
+    try:
+        result = run_case(valid, RunOptions(progress=False))
+    except ParameterError:
+        return
+    tc = result["tooth_contact"].values
+    assert tc["pins_in_mesh"] >= 1
+    assert tc["max_contact_force [N]"] > 0
+    assert math.isfinite(result["geometric_te"].values["geometric_te_tolerance [arcmin]"])
