@@ -12,6 +12,7 @@ from gearte.errors import ParameterError
 from gearte.geometry.cycloid import (
     CycloidStage,
     curvature_radius,
+    envelope_clearance,
     initial_clearance,
     profile_xy,
     short_width_coefficient,
@@ -156,6 +157,8 @@ def test_eq32_initial_clearance_against_envelope(params):
     assert np.max(np.abs(gaps[loaded] - eq32[loaded])) <= 0.1 * np.max(eq32[loaded])
     # the pin at phi0 touches, every loaded pin has a non-negative gap
     assert np.min(gaps[loaded]) == pytest.approx(0.0, abs=1e-10)
+    # gearte's vectorised envelope (Newton foot points) equals this explicit construction
+    np.testing.assert_allclose(envelope_clearance(st, theta)[0][loaded], gaps[loaded], atol=1e-9)
 
 
 def test_rotation_modification_leaves_eq32_unchanged_and_opens_both_flanks():
