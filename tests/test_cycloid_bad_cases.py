@@ -178,3 +178,35 @@ def test_random_physical_cases_run_or_fail_cleanly(case):
     assert tc["pins_in_mesh"] >= 1
     assert tc["max_contact_force [N]"] > 0
     assert math.isfinite(result["geometric_te"].values["geometric_te_tolerance [arcmin]"])
+
+
+_any_number = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(min_value=-5.0, max_value=200.0),
+    st.integers(min_value=-5, max_value=100),
+    st.booleans(),
+    st.text(max_size=3),
+    st.none(),
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    z_p=st.one_of(st.integers(min_value=-3, max_value=120), _any_number),
+    r_p=_any_number,
+    r_rp=_any_number,
+    a=_any_number,
+    b=_any_number,
+    dr_rp=st.one_of(st.floats(min_value=-0.2, max_value=0.2), _any_number),
+    dr_p=st.one_of(st.floats(min_value=-0.2, max_value=0.2), _any_number),
+)
+def test_cycloid_stage_api_raises_only_parameter_error(z_p, r_p, r_rp, a, b, dr_rp, dr_p):
+    from gearte.geometry.cycloid import CycloidStage
+
+    try:
+        stage = CycloidStage(z_p=z_p, r_p=r_p, r_rp=r_rp, a=a, b=b, dr_rp=dr_rp, dr_p=dr_p)
+    except ParameterError as exc:
+        assert exc.field and exc.reason
+        return
+    assert 0 < stage.K1 < 1
+    assert stage.root_radius < stage.tip_radius
