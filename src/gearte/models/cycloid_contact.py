@@ -210,6 +210,7 @@ def tooth_contact(
     rtol: float = 1e-12,
     max_iter: int = 200,
     implementation: str = "numba",
+    clearance_model: str = "eq32",
 ) -> ToothContact:
     """Tooth contact analysis of one disc (Hu et al. 2020, section 4).
 
@@ -236,6 +237,10 @@ def tooth_contact(
         Iteration limit; exceeding it raises :class:`gearte.errors.ConvergenceError`.
     implementation : {"numba", "plain"}
         Compiled kernel or the plain per-pin Python twin.
+    clearance_model : {"eq32", "envelope"}
+        Initial clearances from eq 32 (the paper, first order in the modifications) or from the
+        exact envelope construction (:func:`gearte.geometry.cycloid.envelope_clearance`), both
+        closed at φ0.
 
     Returns
     -------
@@ -248,6 +253,8 @@ def tooth_contact(
         raise ParameterError("disc_share", disc_share, "must be in (0, 1]")
     if implementation not in ("numba", "plain"):
         raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
+    if clearance_model not in ("eq32", "envelope"):
+        raise ParameterError("clearance_model", clearance_model, "must be 'eq32' or 'envelope'")
     T_c = disc_share * torque
     theta = np.atleast_1d(np.asarray(mesh_angle, dtype=float))
     if not np.all(np.isfinite(theta)):
@@ -257,7 +264,12 @@ def tooth_contact(
     S = np.sqrt(1.0 + K1 * K1 - 2.0 * K1 * np.cos(phase))
     lr = np.sin(phase) / S
     loaded = lr > 1e-12
-    clr = np.where(loaded, stage.initial_clearance(phase), np.inf)
+    if clearance_model == "eq32":
+        clr = np.where(loaded, stage.initial_clearance(phase), np.inf)
+    else:
+        from gearte.geometry.cycloid import envelope_clearance
+
+        clr = np.where(loaded, envelope_clearance(stage, theta), np.inf)
     rho = stage.rho0
     A, B = compliance_constants(rho, stage.r, E, mu, stage.b)
     if F_start is None:
@@ -275,6 +287,13 @@ def tooth_contact(
         max_iter=max_iter,
     )
     dmax = A * F * (2.0 / 3.0 + np.log(B / F))
+    if np.max(dmax) > 0.1 * stage.r:
+        raise ParameterError(
+            "torque",
+            torque,
+            f"gives a normal deformation of {np.max(dmax):.3g} mm, beyond the elastic contact "
+            f"model's range (at most 0.1 x pin radius = {0.1 * stage.r:.3g} mm)",
+        )
     approach = lr * dmax[:, None]
     in_mesh = loaded & (approach > clr)
     force = np.where(in_mesh, (approach - clr) / dmax[:, None] * F[:, None], 0.0)

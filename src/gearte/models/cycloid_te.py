@@ -188,7 +188,7 @@ def _closing_ratio_grid(stage: CycloidStage, n: int = 2001) -> tuple[np.ndarray,
     return phi, np.stack([dn / lr, w / lr])
 
 
-def eccentricity_te(stage: CycloidStage, delta_a: ArrayLike) -> np.ndarray:
+def eccentricity_te(stage: CycloidStage, delta_a: ArrayLike) -> np.ndarray | float:
     """Lost-motion change [rad] caused by an eccentricity error δa [mm] (second order).
 
     Parameters
@@ -229,7 +229,7 @@ def eccentricity_te(stage: CycloidStage, delta_a: ArrayLike) -> np.ndarray:
     for s in range(0, da.size, chunk):
         vals = f[None, :] + da[s : s + chunk, None] * h[None, :]
         out[s : s + chunk] = 2.0 * (_min(vals) - base) / stage.r_c
-    return out.reshape(np.shape(delta_a)) if np.ndim(delta_a) else out
+    return out.reshape(np.shape(delta_a)) if np.ndim(delta_a) else out[0]
 
 
 def _check_errors(errors: Mapping[str, float], what: str) -> dict[str, float]:
@@ -277,7 +277,7 @@ def factor_contributions(
         if k == "eccentricity_error":
             out[k] = float(eccentricity_te(stage, e[k])) if e[k] != 0.0 else 0.0
         else:
-            out[k] = g[k] * e[k]
+            out[k] = g[k] * e[k] + 0.0  # + 0.0: no negative zeros in reports
     return out
 
 

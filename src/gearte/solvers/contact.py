@@ -173,6 +173,12 @@ def _prep(lr, clr, T_c, r_c, A, B, F0):
     F0 = np.broadcast_to(np.asarray(F0, dtype=float), (lr.shape[0],)).copy()
     if not (np.all(np.isfinite(F0)) and np.all(F0 > 0.0)):
         raise ParameterError("F_start", F0, "start values must be finite and > 0 [N]")
+    if np.any(F0 >= compliance_limit(B)):
+        raise ParameterError(
+            "F_start",
+            F0,
+            f"start values must be below the compliance limit {compliance_limit(B):.4g} N",
+        )
     return lr, clr, F0
 
 
