@@ -183,6 +183,9 @@ class Cranks:
         Radial stiffness of the needle bearing between a cam and its disc bore [N/mm].
     carrier_bearing_stiffness : float
         Radial stiffness of the (two, combined) bearings of one crank in the carrier [N/mm].
+    cam_bearing_clearance, carrier_bearing_clearance : float
+        Radial clearance of those bearings [mm] (0: none). A bearing with clearance carries
+        ``k (|w| - c)`` along its radial deflection ``w`` and nothing while ``|w| <= c``.
     """
 
     count: int
@@ -190,6 +193,8 @@ class Cranks:
     eccentricity: float
     cam_bearing_stiffness: float
     carrier_bearing_stiffness: float
+    cam_bearing_clearance: float = 0.0
+    carrier_bearing_clearance: float = 0.0
 
     def __post_init__(self) -> None:
         _check_int("cranks.count", self.count, 2, 6)
@@ -197,6 +202,10 @@ class Cranks:
         _check_pos("cranks.eccentricity", self.eccentricity)
         _check_pos("cranks.cam_bearing_stiffness", self.cam_bearing_stiffness)
         _check_pos("cranks.carrier_bearing_stiffness", self.carrier_bearing_stiffness)
+        for name in ("cam_bearing_clearance", "carrier_bearing_clearance"):
+            v = getattr(self, name)
+            if not np.isfinite(v) or not 0.0 <= v <= 0.2:
+                raise ParameterError(f"cranks.{name}", v, "must be in [0, 0.2] mm")
 
 
 @dataclass(frozen=True)

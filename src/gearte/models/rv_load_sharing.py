@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike
 from gearte.errors import ParameterError
 from gearte.geometry.cycloid import CycloidStage, normal_clearance_unclosed
 from gearte.geometry.rv import RVReducer
-from gearte.solvers.rv_equilibrium import ContactLaw, solve_positions
+from gearte.solvers.rv_equilibrium import CLEARANCE_RESIDUAL, ContactLaw, solve_positions
 
 __all__ = [
     "DofLayout",
@@ -143,7 +143,9 @@ class RVSystem:
     Attributes
     ----------
     theta : (P,) output angles [rad].
-    spring_B : (P, ns, nd) rows; spring_e : (P, ns) offsets [mm]; spring_k : (ns,) [N/mm].
+    spring_B : (P, ns, nd) rows; spring_e : (P, ns) offsets [mm]; spring_k : (ns,) [N/mm];
+    spring_c : (ns,) radial clearance [mm] of isotropic bearings (their x and y rows are
+    consecutive; 0 = linear spring).
     contact_B : (P, nc, nd) rows; contact_gap : (P, nc) clearances [mm];
     contact_group : (nc,) disc index of each contact; contact_pin : (nc,) pin index.
     unit_load : (nd,) generalised force of a unit output torque [1/mm per N·mm].
@@ -161,6 +163,7 @@ class RVSystem:
     unit_load: np.ndarray
     labels: dict
     layout: DofLayout
+    spring_c: np.ndarray | None = None
 
 
 def _u(a: np.ndarray) -> np.ndarray:
@@ -215,12 +218,14 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     rows: list[np.ndarray] = []
     offs: list[np.ndarray] = []
     ks: list[float] = []
+    cs: list[float] = []
     labels: dict[str, slice] = {}
 
-    def add(row, off, k):
+    def add(row, off, k, c=0.0):
         rows.append(row)
         offs.append(off)
         ks.append(k)
+        cs.append(c)
 
     # sun support (2 rows)
     start = len(rows)
@@ -252,7 +257,12 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
             dd = np.broadcast_to(d, (P, 2))
             _point_row(r, lay.crank(i), zero2, dd, 1.0)
             _point_row(r, lay.carrier, crank_pos[:, i], dd, -1.0)
-            add(r, -eps @ d, reducer.cranks.carrier_bearing_stiffness)
+            add(
+                r,
+                -eps @ d,
+                reducer.cranks.carrier_bearing_stiffness,
+                reducer.cranks.carrier_bearing_clearance,
+            )
     labels["carrier_bearing"] = slice(start, len(rows))
 
     # cam bearings: w = u_crank(cam) + eps_cam - u_disc(bore) - eps_bore
@@ -267,7 +277,12 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
                 dd = np.broadcast_to(d, (P, 2))
                 _point_row(r, lay.crank(i), cam_r, dd, 1.0)
                 _point_row(r, lay.disc(j), crank_pos[:, i], dd, -1.0)
-                add(r, (eps_cam - eps_bore) @ d, reducer.cranks.cam_bearing_stiffness)
+                add(
+                    r,
+                    (eps_cam - eps_bore) @ d,
+                    reducer.cranks.cam_bearing_stiffness,
+                    reducer.cranks.cam_bearing_clearance,
+                )
     labels["cam_bearing"] = slice(start, len(rows))
 
     # sun-planet meshes along the working line of action (sun drives, counter-clockwise)
@@ -332,7 +347,20 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
 
     unit = np.zeros(nd)
     unit[lay.output_rotation] = -1.0  # load torque resists the drive
-    return RVSystem(th, spring_B, spring_e, spring_k, cB, cg, group, pin_index, unit, labels, lay)
+    return RVSystem(
+        th,
+        spring_B,
+        spring_e,
+        spring_k,
+        cB,
+        cg,
+        group,
+        pin_index,
+        unit,
+        labels,
+        lay,
+        np.asarray(cs),
+    )
 
 
 # ------------------------------------------------------------------------------------------
@@ -382,6 +410,15 @@ def _postprocess(reducer: RVReducer, system: RVSystem, sol, torque: float) -> Lo
     P = system.theta.size
     w = np.einsum("psi,pi->ps", system.spring_B, sol.q) + system.spring_e
     f = w * system.spring_k[None, :]
+    c = system.spring_c
+    if c is not None and np.any(c > 0):  # bearings with radial clearance: k (|w| - c)+ w/|w|
+        first = np.flatnonzero(c > 0)[::2]
+        wx, wy = w[:, first], w[:, first + 1]
+        n = np.hypot(wx, wy)
+        kf, eps = system.spring_k[first], CLEARANCE_RESIDUAL
+        scale = eps * kf + (1 - eps) * kf * np.maximum(n - c[first], 0.0) / np.where(n > 0, n, 1.0)
+        f[:, first] = scale * wx
+        f[:, first + 1] = scale * wy
     cam = f[:, system.labels["cam_bearing"]].reshape(P, M, N, 2)
     car = f[:, system.labels["carrier_bearing"]].reshape(P, M, 2)
     mesh = f[:, system.labels["mesh"]]

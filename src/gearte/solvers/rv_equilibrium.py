@@ -32,6 +32,10 @@ __all__ = ["ContactLaw", "EquilibriumSolution", "solve_positions", "solve_refere
 
 LAW_LINEAR = 0
 LAW_HU2020 = 1
+#: Stiffness left inside a bearing clearance, relative to the bearing's stiffness. It keeps the
+#: equilibrium unique when parts float in their clearances (at zero load); its force is below
+#: 1e-6 k c (< 1 N for 10 µm at 1e5 N/mm).
+CLEARANCE_RESIDUAL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -102,20 +106,34 @@ def _hu_delta(f, p):
 
 
 @njit(cache=True, nogil=True)
-def _energy(K0, f0, Bc, gc, kc, q):
+def _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q):
     e = 0.5 * q @ (K0 @ q) - f0 @ q
     d = Bc @ q - gc
     for c in range(d.size):
         if d[c] > 0.0:
             e += 0.5 * kc[c] * d[c] * d[c]
+    for m in range(kn.size):
+        wx = Bn[m, 0] @ q + en[m, 0]
+        wy = Bn[m, 1] @ q + en[m, 1]
+        rr = wx * wx + wy * wy
+        e += 0.5 * CLEARANCE_RESIDUAL * kn[m] * rr
+        r = np.sqrt(rr) - cn[m]
+        if r > 0.0:
+            e += 0.5 * (1.0 - CLEARANCE_RESIDUAL) * kn[m] * r * r
     return e
 
 
 @njit(cache=True, nogil=True)
-def _newton(K0, f0, Bc, gc, kc, q, tol, maxit):
-    """Minimise Π for fixed contact stiffness; returns (q, iterations, ok)."""
+def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
+    """Minimise Π for fixed contact stiffness; returns (q, iterations, ok).
+
+    ``Bn, en, kn, cn``: isotropic bearings with radial clearance, energy
+    ``ε k |w|²/2 + (1 − ε) k (|w| − c)₊² / 2`` with ``w = (Bn[m,0]·q + en[m,0], Bn[m,1]·q +
+    en[m,1])`` and ``ε = CLEARANCE_RESIDUAL`` (convex: squared distance to a disc).
+    """
     nd = q.size
     nc = gc.size
+    nm = kn.size
     reg = 1e-13 * np.max(np.abs(np.diag(K0)))
     active = np.zeros(nc, dtype=np.bool_)
     d = Bc @ q - gc
@@ -132,18 +150,51 @@ def _newton(K0, f0, Bc, gc, kc, q, tol, maxit):
                     ba = kc[c] * Bc[c, a]
                     for b in range(nd):
                         H[a, b] += ba * Bc[c, b]
+        for m in range(nm):
+            wx = Bn[m, 0] @ q + en[m, 0]
+            wy = Bn[m, 1] @ q + en[m, 1]
+            rr = np.sqrt(wx * wx + wy * wy)
+            k0m = CLEARANCE_RESIDUAL * kn[m]
+            gx, gy = k0m * wx, k0m * wy
+            hxx, hyy, hxy = k0m, k0m, 0.0
+            if rr > cn[m]:
+                k1m = kn[m] - k0m
+                ux, uy = wx / rr, wy / rr
+                s = 1.0 - cn[m] / rr
+                # w-space gradient k (|w| - c) u and Hessian k [s I + (1 - s) u uᵀ]
+                gx += k1m * (rr - cn[m]) * ux
+                gy += k1m * (rr - cn[m]) * uy
+                hxx += k1m * (s + (1.0 - s) * ux * ux)
+                hyy += k1m * (s + (1.0 - s) * uy * uy)
+                hxy += k1m * (1.0 - s) * ux * uy
+            if True:
+                for a in range(nd):
+                    bx, by = Bn[m, 0, a], Bn[m, 1, a]
+                    grad[a] += gx * bx + gy * by
+                    ta = hxx * bx + hxy * by
+                    tb = hxy * bx + hyy * by
+                    for b in range(nd):
+                        H[a, b] += ta * Bn[m, 0, b] + tb * Bn[m, 1, b]
         for a in range(nd):
             H[a, a] += reg
         dq = -np.linalg.solve(H, grad)
         # backtracking line search on the convex potential
-        e0 = _energy(K0, f0, Bc, gc, kc, q)
+        e0 = _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q)
         step = 1.0
         qn = q + dq
+        decreased = False
+        e1 = e0
         for _ in range(60):
-            if _energy(K0, f0, Bc, gc, kc, qn) <= e0 + 1e-12 * abs(e0):
+            e1 = _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, qn)
+            if e1 <= e0 + 1e-12 * abs(e0):
+                decreased = True
                 break
             step *= 0.5
             qn = q + step * dq
+        if not decreased:
+            # no descent left at round-off level: q is the minimiser to machine precision
+            return q, it + 1, True
+        stalled = e0 - e1 <= 1e-14 * abs(e0)
         q = qn
         d = Bc @ q - gc
         same = True
@@ -152,25 +203,27 @@ def _newton(K0, f0, Bc, gc, kc, q, tol, maxit):
             if a_new != active[c]:
                 same = False
             active[c] = a_new
-        if same and step == 1.0:
-            return q, it + 1, True
-        if np.max(np.abs(step * dq)) < tol:
+        small = np.max(np.abs(step * dq)) < tol
+        if small or (same and step == 1.0 and nm == 0) or (same and stalled and it > 2):
             return q, it + 1, True
     return q, maxit, False
 
 
 @njit(cache=True, nogil=True)
-def _solve_position(K0, f0, Bc, gc, group, ngroups, law, params, k0, q0, tol, maxit):
+def _solve_position(
+    K0, f0, Bn, en, kn, cn, Bc, gc, group, ngroups, law, params, k0, q0, tol, maxit
+):
     """One position: Newton inside, fixed point on the per-disc contact stiffness outside."""
     q = q0.copy()
     k = k0.copy()
     nc = gc.size
     kc = np.empty(nc)
     total = 0
+    qtol = 1e-13 * max(1.0, np.max(np.abs(q0)))
     for _outer in range(200):
         for c in range(nc):
             kc[c] = k[group[c]]
-        q, its, ok = _newton(K0, f0, Bc, gc, kc, q, 1e-14, maxit)
+        q, its, ok = _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, qtol, maxit)
         total += its
         if not ok:
             return q, k, kc * 0.0, total, False
@@ -202,7 +255,9 @@ def _solve_position(K0, f0, Bc, gc, group, ngroups, law, params, k0, q0, tol, ma
 
 
 @njit(cache=True, nogil=True)
-def _solve_all(K0s, f0s, Bcs, gcs, group, ngroups, law, params, k0, q0, tol, maxit):
+def _solve_all(
+    K0s, f0s, Bns, ens, kn, cn, Bcs, gcs, group, ngroups, law, params, k0, q0, tol, maxit
+):
     P = K0s.shape[0]
     nd = q0.size
     nc = gcs.shape[1]
@@ -214,8 +269,9 @@ def _solve_all(K0s, f0s, Bcs, gcs, group, ngroups, law, params, k0, q0, tol, max
     k = k0.copy()
     for p in range(P):
         q, k, f, n, ok = _solve_position(
-            K0s[p], f0s[p], Bcs[p], gcs[p], group, ngroups, law, params, k, q, tol, maxit
-        )
+            K0s[p], f0s[p], Bns[p], ens[p], kn, cn, Bcs[p], gcs[p], group, ngroups, law, params,
+            k, q, tol, maxit,
+        )  # fmt: skip
         if not ok:
             its[p] = -1
             return Q, F, Ks, its
@@ -224,6 +280,22 @@ def _solve_all(K0s, f0s, Bcs, gcs, group, ngroups, law, params, k0, q0, tol, max
         Ks[p] = k
         its[p] = n
     return Q, F, Ks, its
+
+
+def _split_springs(system):
+    """Linear rows and clearance pairs of a system (pairs: consecutive x, y rows with c > 0)."""
+    c = getattr(system, "spring_c", None)
+    ns = system.spring_k.size
+    c = np.zeros(ns) if c is None else np.asarray(c, dtype=float)
+    lin = c == 0.0
+    first = np.flatnonzero(~lin)[::2]
+    Bn = np.ascontiguousarray(
+        np.stack([system.spring_B[:, first], system.spring_B[:, first + 1]], 2)
+    )
+    en = np.ascontiguousarray(
+        np.stack([system.spring_e[:, first], system.spring_e[:, first + 1]], 2)
+    )
+    return lin, Bn, en, system.spring_k[first].copy(), c[first].copy()
 
 
 def _linear_parts(spring_B, spring_e, spring_k, load):
@@ -269,7 +341,10 @@ def solve_positions(
     P = system.theta.size
     torque = np.broadcast_to(np.asarray(torque, dtype=float), (P,))
     load = torque[:, None] * system.unit_load[None, :]
-    K0, f0 = _linear_parts(system.spring_B, system.spring_e, system.spring_k, load)
+    lin, Bn, en, kn, cn = _split_springs(system)
+    K0, f0 = _linear_parts(
+        system.spring_B[:, lin], system.spring_e[:, lin], system.spring_k[lin], load
+    )
     ngroups = int(system.contact_group.max()) + 1
     nd = K0.shape[1]
     q0 = np.zeros(nd) if q0 is None else np.asarray(q0, dtype=float)
@@ -283,7 +358,7 @@ def solve_positions(
             g[n] = saved[n].py_func
         try:
             out = fn(
-                K0, f0, np.ascontiguousarray(system.contact_B),
+                K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
                 np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
                 ngroups, law.code, law.params(), k0, q0, tol, maxit,
             )  # fmt: skip
@@ -291,7 +366,7 @@ def solve_positions(
             g.update(saved)
     else:
         out = fn(
-            K0, f0, np.ascontiguousarray(system.contact_B),
+            K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
             np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
             ngroups, law.code, law.params(), k0, q0, tol, maxit,
         )  # fmt: skip
@@ -308,16 +383,18 @@ def solve_positions(
 def solve_reference(system, torque: float, law: ContactLaw, p: int = 0, k=None):
     """Independent check at one position with ``scipy.optimize.fsolve`` on the equilibrium.
 
-    Uses the *given* per-disc contact stiffness ``k`` (fixed), smooth-free residual
-    ``K0 q − f0 + Σ k max(Bq − g, 0) B``. Returns ``q``.
+    Uses the *given* per-disc contact stiffness ``k`` (fixed), residual
+    ``K0 q − f0 + Σ k max(Bq − g, 0) B + Σ_bearings k (|w| − c)₊ ŵ·B``. Returns ``q``.
     """
     from scipy.optimize import fsolve
 
     load = torque * system.unit_load[None, :]
+    lin, Bn, en, kn, cn = _split_springs(system)
     K0, f0 = _linear_parts(
-        system.spring_B[p : p + 1], system.spring_e[p : p + 1], system.spring_k, load
+        system.spring_B[p : p + 1, lin], system.spring_e[p : p + 1, lin], system.spring_k[lin], load
     )
     K0, f0 = K0[0], f0[0]
+    Bn, en = Bn[p], en[p]
     Bc, gc = system.contact_B[p], system.contact_gap[p]
     ngroups = int(system.contact_group.max()) + 1
     k = np.full(ngroups, law.stiffness) if k is None else np.asarray(k)
@@ -326,6 +403,12 @@ def solve_reference(system, torque: float, law: ContactLaw, p: int = 0, k=None):
 
     def res(q):
         d = Bc @ q - gc
-        return (K0 @ q - f0 + Bc.T @ (kc * np.maximum(d, 0.0))) / scale
+        r = K0 @ q - f0 + Bc.T @ (kc * np.maximum(d, 0.0))
+        w = np.einsum("mxi,i->mx", Bn, q) + en
+        n = np.linalg.norm(w, axis=1)
+        eps = CLEARANCE_RESIDUAL
+        gain = eps * kn + (1 - eps) * kn * np.maximum(n - cn, 0.0) / np.where(n > 0, n, 1.0)
+        f = gain[:, None] * w
+        return (r + np.einsum("mxi,mx->i", Bn, f)) / scale
 
     return fsolve(res, np.zeros(K0.shape[0]), xtol=1e-13, full_output=False)

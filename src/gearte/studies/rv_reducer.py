@@ -72,6 +72,7 @@ class Bearing(StrictModel):
     reference_load_N: float | None = Field(
         default=None, gt=0, le=1e7, description="load of the secant stiffness [N]"
     )
+    radial_clearance_um: float = Field(default=0.0, ge=0, le=200, description="[um]")
 
     @model_validator(mode="after")
     def _one_way(self):
@@ -275,6 +276,8 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         c.eccentricity_mm,
         c.cam_bearing.stiffness(),
         c.carrier_bearing.stiffness(),
+        um_to_mm(c.cam_bearing.radial_clearance_um),
+        um_to_mm(c.carrier_bearing.radial_clearance_um),
     )
     d = sec.discs
     discs = Discs(
