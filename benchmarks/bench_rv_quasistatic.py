@@ -27,7 +27,9 @@ def baseline(system, torque, law):
     """fsolve per position, cold start, outer fixed point on the per-disc stiffness."""
     P = system.theta.size
     load = torque * system.unit_load[None, :]
-    K0s, f0s = _linear_parts(system.spring_B, system.spring_e, system.spring_k, load)
+    K0s, f0s = _linear_parts(
+        system.spring_B, system.spring_e, system.spring_k, load
+    )  # no clearance
     group = system.contact_group
     ng = int(group.max()) + 1
     params = law.params()

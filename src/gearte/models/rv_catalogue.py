@@ -117,14 +117,21 @@ def torsion_test(
     )
 
 
-def backlash(reducer: RVReducer, *, theta: float = 0.0, law: ContactLaw | None = None) -> float:
-    """Backlash θ(0⁺) − θ(0⁻) [rad] at output angle ``theta`` (0 when preloaded)."""
+def backlash(
+    reducer: RVReducer, *, theta: ArrayLike = 0.0, law: ContactLaw | None = None
+) -> float:
+    """Backlash θ(0⁺) − θ(0⁻) [rad]; the smallest over the output angles ``theta`` [rad].
+
+    0 (to the elastic deflection at ±1e-4 T_r) when the reducer is preloaded.
+    """
     law = contact_law(reducer) if law is None else law
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
     eps = 1e-4 * reducer.rated_torque
-    return float(
-        _follow(reducer, theta, np.array([eps]), law)[0]
-        - _follow(reducer, theta, np.array([-eps]), law)[0]
-    )
+    system = assemble(reducer, th)
+    out = system.layout.output_rotation
+    pos = -solve_positions(system, eps, law).q[:, out]
+    neg = -solve_positions(system, -eps, law).q[:, out]
+    return float(np.min(pos - neg))
 
 
 @dataclass(frozen=True)
