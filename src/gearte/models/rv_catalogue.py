@@ -117,9 +117,7 @@ def torsion_test(
     )
 
 
-def backlash(
-    reducer: RVReducer, *, theta: ArrayLike = 0.0, law: ContactLaw | None = None
-) -> float:
+def backlash(reducer: RVReducer, *, theta: ArrayLike = 0.0, law: ContactLaw | None = None) -> float:
     """Backlash θ(0⁺) − θ(0⁻) [rad]; the smallest over the output angles ``theta`` [rad].
 
     0 (to the elastic deflection at ±1e-4 T_r) when the reducer is preloaded.
