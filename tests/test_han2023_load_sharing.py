@@ -218,3 +218,30 @@ def test_han2023_bearing_clearance_absorbs_error_preload(reducers):
     loose = load_sharing(_with_clearance(red, 0.04), small, th).peak_pin_load
     assert tight > 1000.0  # 15-38 µm cam errors against zero-clearance needle bearings
     assert loose < 0.02 * tight
+
+
+def test_han2023_error_te_has_crank_frequency(reducers):
+    """Errors that turn with the cranks repeat z_p times per output revolution (the crank's turns
+    relative to the carrier); a carrier-bore error turns with the carrier and adds almost no TE."""
+    from gearte.geometry.rv import ManufacturingErrors
+    from gearte.models.rv_load_sharing import transmission_error
+
+    red = reducers[0]
+    zero = ManufacturingErrors.none(3, 2)
+    parts = ("planet", "disc_bore", "cam", "carrier_bore")
+    pp = {}
+    for name in parts:
+        kw = {n: getattr(zero, n) for n in parts}
+        kw[name] = getattr(red.errors, name)
+        te = transmission_error(
+            red.with_errors(ManufacturingErrors(**kw)),
+            red.rated_torque,
+            output_positions(720),
+            mesh_samples=0,
+        )
+        g = te.geometric - te.geometric.mean()
+        pp[name] = np.ptp(g)
+        if name != "carrier_bore":
+            spec = np.abs(np.fft.rfft(g))
+            assert int(np.argmax(spec)) == red.pins.count
+    assert pp["carrier_bore"] < 0.05 * pp["cam"]
