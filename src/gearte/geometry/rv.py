@@ -433,6 +433,8 @@ class RVReducer:
         Measured errors (default none).
     rated_torque : float
         Rated output torque [N·mm] (catalogue value; used for sweeps and the virtual test).
+    planets : int, optional
+        Number of planets of the first stage; must equal ``cranks.count`` (default: equal).
 
     Raises
     ------
