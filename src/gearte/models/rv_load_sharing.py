@@ -19,15 +19,23 @@ acts on the carrier against the drive direction. The carrier's rotation deviatio
 ``theta_c`` is then the loaded output angle error, the total transmission error (TE).
 
 Every connection is a scalar "spring row": ``w = B · q + e`` (deflection, ``e`` from
-manufacturing errors), energy ``k w² / 2``. Isotropic bearings are two rows (x and y). A pin
-contact is a unilateral row: approach ``delta = B · q - g`` with ``g`` the initial normal
-clearance, force ``k max(delta, 0)``.
+manufacturing errors), energy ``k w² / 2``. Isotropic bearings are two rows (x and y); with a
+radial clearance ``c`` their energy is ``k (|w| − c)₊² / 2`` (a convex dead band). A pin contact
+is a unilateral row: approach ``delta = B · q - g`` with ``g`` the initial normal clearance
+(:func:`gearte.geometry.cycloid.normal_clearance_unclosed` of the modified profile, minus the
+pin-radius error, plus the pin-centre error projected on the normal), force ``k max(delta, 0)``
+with the load-dependent stiffness of Hu 2020 section 4 (:func:`contact_law`).
 
 Pin-contact geometry (derived, not taken from a paper's figure): for disc ``j`` with eccentric
 direction ``c_j`` the pitch point is ``P_j = a z_p c_j``; the contact normal of pin ``k`` passes
 through ``P_j`` and the pin centre, ``n = (p_k - P_j)/|p_k - P_j|`` with ``|p_k - P_j| = r_p S``,
-``S = sqrt(1 + K1² - 2 K1 cos phi)`` — hence the lever ``l = r_c sin(phi)/S`` of Hu 2020 eq 41
+``S = sqrt(1 + K1² - 2 K1 cos phi)`` — hence the lever ``l = r_c sin(phi)/S`` of Hu 2020 eq 36
 and the classical load law ``F ∝ sin(phi)/S`` for a rigid rotation of the disc.
+
+References
+----------
+Han L., Xu W., Wang Y., Zhang Y. (2023). JERR 25(8). doi:10.9734/JERR/2023/v25i8970
+Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
 """
 
 from __future__ import annotations
@@ -423,10 +431,10 @@ def _postprocess(reducer: RVReducer, system: RVSystem, sol, torque: float) -> Lo
     car = f[:, system.labels["carrier_bearing"]].reshape(P, M, 2)
     mesh = f[:, system.labels["mesh"]]
     pin = sol.contact_force.reshape(P, N, zp)
-    lever = system.contact_B[:, :, :]  # rows hold n and the moment arm about the disc centre
     lay = system.layout
+    # the rotation column of a contact row is the arm of its normal about the disc centre
     arm = np.stack(
-        [lever[:, j * zp : (j + 1) * zp, lay.disc(j) + 2] for j in range(N)], axis=1
+        [system.contact_B[:, j * zp : (j + 1) * zp, lay.disc(j) + 2] for j in range(N)], axis=1
     )  # (P, N, zp)
     disc_torque = -np.sum(pin * arm, axis=-1)
     return LoadSharing(
