@@ -169,10 +169,27 @@ class ReducerSection(StrictModel):
 
     @model_validator(mode="after")
     def _build(self):
-        try:
-            build_reducer(self)
-        except ParameterError as exc:
-            raise ValueError(str(exc)) from None
+        problems = []
+        if self.first_stage.planets != self.cranks.count:
+            problems.append(
+                f"first_stage.planets = {self.first_stage.planets}: must equal cranks.count = "
+                f"{self.cranks.count} (each planet drives one crank)"
+            )
+        for k, e in enumerate(self.errors):
+            entry = ErrorEntry(e.part, e.crank, e.disc, um_to_mm(e.value_um), 0.0)
+            try:
+                ManufacturingErrors.from_entries(
+                    [entry], self.cranks.count, self.discs.count, field_name="errors"
+                )
+            except ParameterError as exc:
+                problems.append(str(exc).replace("errors[0]", f"errors[{k}]"))
+        if not problems:
+            try:
+                build_reducer(self)
+            except ParameterError as exc:
+                problems.append(str(exc))
+        if problems:
+            raise ValueError("; ".join(problems))
         return self
 
 
