@@ -11,7 +11,7 @@ which terminates when the active set repeats — the solution is then exact to r
 
 The contact stiffness is load dependent (Hu et al. 2020 section 4): for each disc
 ``k_g = F_max,g / δ(F_max,g)`` with ``δ`` the contact law of
-:func:`gearte.models.rv_load_sharing.hu2020_contact_deformation`. This outer fixed point is a
+:func:`gearte.models.cycloid_contact.max_normal_deformation`. This outer fixed point is a
 contraction (the secant stiffness varies with ``ln F``) and is iterated to a relative change
 below ``tol``. Positions are solved in sequence, each warm-started from the previous one.
 
