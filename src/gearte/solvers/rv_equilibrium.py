@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from gearte.errors import ConvergenceError
+from gearte.errors import ConvergenceError, ParameterError
 
 __all__ = ["ContactLaw", "EquilibriumSolution", "solve_positions", "solve_reference"]
 
@@ -73,7 +73,7 @@ class ContactLaw:
             return LAW_LINEAR
         if self.kind == "hu2020":
             return LAW_HU2020
-        raise ValueError(f"contact law {self.kind!r}: must be 'hu2020' or 'linear'")
+        raise ParameterError("contact_law.kind", self.kind, "must be 'hu2020' or 'linear'")
 
 
 @dataclass(frozen=True)
