@@ -21,6 +21,7 @@ algorithm; :func:`solve_reference` is an independent scipy check.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,6 +37,8 @@ LAW_HU2020 = 1
 #: equilibrium unique when parts float in their clearances (at zero load); its force is below
 #: 1e-6 k c (< 1 N for 10 µm at 1e5 N/mm).
 CLEARANCE_RESIDUAL = 1e-6
+
+_TWIN_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -351,8 +354,10 @@ def solve_positions(
     k0 = np.full(ngroups, law.stiffness) if k0 is None else np.asarray(k0, dtype=float)
     fn = _solve_all if compiled else _solve_all.py_func
     if not compiled:
-        # the twin calls the plain-Python versions of the inner kernels too
+        # the twin calls the plain-Python versions of the inner kernels too (swapped in under a
+        # lock for the duration of the call; compiled callers do not look these names up)
         g = _solve_all.py_func.__globals__
+        _TWIN_LOCK.acquire()
         saved = {n: g[n] for n in ("_solve_position", "_newton", "_energy", "_hu_delta")}
         for n in saved:
             g[n] = saved[n].py_func
@@ -364,6 +369,7 @@ def solve_positions(
             )  # fmt: skip
         finally:
             g.update(saved)
+            _TWIN_LOCK.release()
     else:
         out = fn(
             K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),

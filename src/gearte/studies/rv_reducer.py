@@ -29,7 +29,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gearte.errors import ParameterError
+from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.rv import (
     Cranks,
     Discs,
@@ -393,7 +393,7 @@ def _load_sharing(red, red0, sec: LoadSharingSection) -> AnalysisResult:
             "peak_pin_load_cycloid_stage_analysis: one disc alone (centre fixed, rigid "
             "supports, no errors, moment T (1 - 1/i) z_c/(z_p N)) — the cycloid_stage contact law."
         )
-    except Exception as exc:  # pragma: no cover - reported, not fatal
+    except (ParameterError, ConvergenceError) as exc:  # pragma: no cover - reported, not fatal
         notes.append(f"cycloid-stage comparison not available: {exc}")
     return AnalysisResult(
         name="load_sharing",
