@@ -248,7 +248,12 @@ class Rayleigh(Distribution):
 
     @classmethod
     def from_tolerance(
-        cls, tolerance: float, *, divisor: float = 6.0, factor: float = 1.0, field: str = "tolerance"
+        cls,
+        tolerance: float,
+        *,
+        divisor: float = 6.0,
+        factor: float = 1.0,
+        field: str = "tolerance",
     ) -> Rayleigh:
         """Scale tied to a tolerance: ``σx = factor · tolerance / divisor``.
 
@@ -259,7 +264,9 @@ class Rayleigh(Distribution):
         scale = factor * t / divisor
         if not scale > 0:
             raise ParameterError(
-                field, tolerance, f"the Rayleigh scale factor*tolerance/divisor = {scale} must be > 0"
+                field,
+                tolerance,
+                f"the Rayleigh scale factor*tolerance/divisor = {scale} must be > 0",
             )
         return cls(scale, factor * t)
 
@@ -278,8 +285,10 @@ class Rayleigh(Distribution):
 
     @property
     def limits(self) -> tuple[float, float]:
-        hi = self.tolerance if self.tolerance is not None else self.scale * math.sqrt(
-            -2.0 * math.log(0.0027)
+        hi = (
+            self.tolerance
+            if self.tolerance is not None
+            else self.scale * math.sqrt(-2.0 * math.log(0.0027))
         )
         return (0.0, float(hi))
 
