@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from gearte.errors import ParameterError
+from gearte.execution import spawn_generators
 from gearte.tolerance.stackup import FunctionStack, LinearStack
 
 __all__ = [
@@ -282,20 +283,17 @@ def _percentile_from_hist(
 
 
 def _map_chunks(func, tasks: Sequence[Any], *, options: Any, progress: bool, description: str):
-    """Run ``func`` over tasks in order through :mod:`gearte.execution` when available."""
-    try:
-        from gearte.execution import map_chunks
-    except ImportError:  # foundation not merged yet: serial fallback
-        return [func(t) for t in tasks]
-    return map_chunks(func, tasks, options=options, progress=progress, description=description)
+    """Run ``func`` over tasks in order through :func:`gearte.execution.map_chunks`."""
+    from gearte.execution import map_chunks
 
-
-def _spawn(seed: int, n: int) -> list[np.random.Generator]:
-    try:
-        from gearte.execution import spawn_generators
-    except ImportError:
-        return [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(n)]
-    return list(spawn_generators(seed, n))
+    return map_chunks(
+        func,
+        tasks,
+        workers=getattr(options, "workers", None),
+        scheduler=getattr(options, "scheduler", None),
+        progress=progress,
+        description=description,
+    )
 
 
 @dataclass(frozen=True)
@@ -421,7 +419,7 @@ def monte_carlo(
     usl = math.inf if upper_spec is None else float(upper_spec)
 
     n_chunks = math.ceil(n / chunk_size)
-    rngs = _spawn(seed, n_chunks)
+    rngs = spawn_generators(seed, n_chunks)
     tasks = []
     remaining_keep = keep
     for k in range(n_chunks):

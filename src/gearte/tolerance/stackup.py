@@ -170,7 +170,7 @@ class LinearStack(_StackBase):
         return (lo, hi)
 
     def rss(self) -> tuple[float, float]:
-        """Root-sum-square limits: middle of the limits ∓ ``sqrt(Σ (sᵢ·hᵢ)²)`` (``hᵢ`` half-width)."""
+        """Root-sum-square limits: middle of the limits ∓ ``sqrt(Σ (sᵢhᵢ)²)``, ``hᵢ`` half-width."""
         mid = self.constant
         acc = 0.0
         for c in self.contributors:
