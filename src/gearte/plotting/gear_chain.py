@@ -141,7 +141,8 @@ def compensation(result: Any) -> Figure:
     ax2.bar(range(len(end)), end, color=PALETTE[2])
     for x, e in enumerate(end):
         ax2.text(x, e, f"{e:.2f}", ha="center", va="bottom", fontsize=8)
-    ax2.set_xticks(range(len(end)), [c[0].split(" ")[0] for c in cols], fontsize=8)
+    short = {"before": "before", "after shim": "shim", "after motor compensation": "motor comp."}
+    ax2.set_xticks(range(len(end)), [short[c[0]] for c in cols], fontsize=8)
     ax2.set_ylabel("end-effector error [mm]")
     return Figure(
         "Lost motion before and after compensation",
