@@ -47,6 +47,7 @@ KERNEL_CODES: dict[str, int] = {
     "rayleigh_phase": 3,
     "empirical": 4,
     "constant": 5,
+    "rayleigh_phase_polar": 6,
 }
 
 _TWO_PI = 2.0 * math.pi
@@ -309,15 +310,26 @@ class RadialPhase(Distribution):
     This is how an eccentricity ``e`` (or a runout) changes a centre distance: ``Δa = e sin φ``
     with ``φ ~ U[0, 2π)`` (Jiang et al. 2024, §2.1 items 3 and 5).
 
+    Parameters
+    ----------
+    magnitude : Distribution
+        Distribution of ``r ≥ 0`` (e.g. :class:`Rayleigh` with ``σx = F″i/6``).
+    polar : bool
+        Only for a Rayleigh magnitude: make the scalar draw (and the compiled kernel) draw ``r``
+        and ``φ`` separately instead of the equivalent normal (same distribution, ~5× slower).
+
     Notes
     -----
     For any magnitude distribution, ``E[r sin φ] = 0`` and ``Var = E[r²]/2``. For a Rayleigh
-    magnitude, ``r sin φ`` is exactly normal ``N(0, σx²)`` (the two components of an isotropic
-    2-D normal), which is why the paper's variances ``F″²sin²α/9`` come out as they do; gearte
-    still draws the magnitude and the phase separately.
+    magnitude, ``r sin φ`` is *exactly* normal ``N(0, σx²)`` (a Rayleigh radius with a uniform
+    angle is an isotropic 2-D normal; ``r sin φ`` is one of its components), which is why the
+    paper's variances ``F″²sin²α/9`` come out as they do. The scalar draw and the compiled kernel
+    use that identity (one ``standard_normal`` call); the vectorised :meth:`sample` always
+    draws the magnitude and the phase separately, so comparing the two engines checks it.
     """
 
     magnitude: Distribution
+    polar: bool = False
 
     def __post_init__(self) -> None:
         lo, _ = self.magnitude.limits
@@ -328,7 +340,9 @@ class RadialPhase(Distribution):
 
     @property
     def kernel_kind(self) -> str | None:
-        return "rayleigh_phase" if isinstance(self.magnitude, Rayleigh) else None
+        if not isinstance(self.magnitude, Rayleigh):
+            return None
+        return "rayleigh_phase_polar" if self.polar else "rayleigh_phase"
 
     @property
     def mean(self) -> float:
@@ -350,6 +364,8 @@ class RadialPhase(Distribution):
         return r * np.sin(phi)
 
     def draw_one(self, rng: np.random.Generator) -> float:
+        if isinstance(self.magnitude, Rayleigh) and not self.polar:
+            return self.magnitude.scale * rng.standard_normal()
         r = self.magnitude.draw_one(rng)
         return r * math.sin(rng.uniform(0.0, _TWO_PI))
 
