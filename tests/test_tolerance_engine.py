@@ -324,7 +324,7 @@ def test_nonlinear_spur_model_as_function_stack():
     # eqs. 2-13 with eccentricity magnitudes and phases as separate contributors: a nonlinear
     # stack. MC must agree with the linear stack. Sobol: E[e sin φ | e] = 0, so e alone has no
     # first-order effect; E[e sin φ | φ] = σx√(π/2) sin φ, so φ alone explains π/4 of the pair's
-    # share; the rest is interaction (total index of e = the linear variance share)
+    # share; the rest is interaction
     from gearte.models.backlash import spur_normal_backlash
 
     p = spur_pair()
@@ -352,7 +352,7 @@ def test_nonlinear_spur_model_as_function_stack():
     assert s.first_order["e2"] == pytest.approx(0.0, abs=0.03)
     share_e2 = variance_shares(lin)["driven gear eccentricity"]
     assert s.first_order["phi2"] == pytest.approx(math.pi / 4 * share_e2, abs=0.03)
-    assert s.total["e2"] == pytest.approx(
-        variance_shares(lin)["driven gear eccentricity"], abs=0.03
-    )
+    # total indices: ST_φ = E[e²]/2 / σx² · share = share; ST_e = E[sin²φ]·Var(e)/σx² · share
+    assert s.total["phi2"] == pytest.approx(share_e2, abs=0.03)
+    assert s.total["e2"] == pytest.approx((1 - math.pi / 4) * share_e2, abs=0.02)
     assert s.first_order["dfa"] == pytest.approx(variance_shares(lin)["centre distance"], abs=0.03)
