@@ -70,7 +70,34 @@ __all__ = [
     "BevelPair",
     "BacklashSummary",
     "summarise_backlash",
+    "SPUR_SOURCES",
+    "BEVEL_SOURCES",
 ]
+
+#: Names of the sources (contributors) of the two stacks, as in Tables 3 and 7.
+SPUR_SOURCES: tuple[str, ...] = (
+    "driving gear tooth thickness",
+    "driven gear tooth thickness",
+    "centre distance",
+    "driven gear eccentricity",
+    "bearing radial clearance",
+    "driving gear eccentricity",
+    "reducer output runout",
+)
+BEVEL_SOURCES: tuple[str, ...] = (
+    "driving gear tooth thickness",
+    "driven gear tooth thickness",
+    "driving gear eccentricity",
+    "driven gear eccentricity",
+    "driving gear face profile",
+    "driven gear face profile",
+    "housing end face profile",
+    "end cover face profile",
+    "shaft angle",
+    "shaft distance",
+    "driving bearing radial clearance",
+    "driven bearing radial clearance",
+)
 
 
 # ------------------------------------------------------------------------------------------------

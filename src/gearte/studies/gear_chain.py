@@ -259,8 +259,7 @@ class Case(CaseBase):
 def _current_min_um(st: StageSpec, confidence: float) -> tuple[float, float]:
     """Current minimum backlash [µm] of a stage and its minimum limit [µm]."""
     if st.pair is not None:
-        pair = st.pair.build()
-        s = summarise_backlash(pair.backlash_stack(), confidence=confidence)
+        s = summarise_backlash(st.pair.backlash_stack(), confidence=confidence)
         return float(mm_to_um(s.min)), st.pair.min_backlash_limit_um
     assert st.backlash_min_um is not None
     return st.backlash_min_um, st.min_backlash_limit_um
@@ -270,7 +269,7 @@ def _stage_backlash_mm(st: StageSpec, confidence: float):
     """(min, mean, max) backlash [mm], output diameter [mm], α [rad], pair or None."""
     if st.pair is not None:
         pair = st.pair.build()
-        s = summarise_backlash(pair.backlash_stack(), confidence=confidence)
+        s = summarise_backlash(st.pair.backlash_stack(), confidence=confidence)
         return (s.min, s.mean, s.max), pair.output_diameter, pair.pressure_angle, pair
     assert st.backlash_min_um is not None and st.backlash_max_um is not None
     assert st.backlash_mean_um is not None and st.output_diameter_mm is not None

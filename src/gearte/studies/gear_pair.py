@@ -26,6 +26,8 @@ from pydantic import Field, model_validator
 
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.models.backlash import (
+    BEVEL_SOURCES,
+    SPUR_SOURCES,
     BevelGear,
     BevelPair,
     SpurGear,
@@ -45,6 +47,7 @@ __all__ = [
     "BevelGearSpec",
     "BevelPairSpec",
     "PairSpec",
+    "DistributionSpec",
     "PairAnalysisSpec",
     "Case",
     "run",
@@ -103,7 +106,100 @@ class _Clearance(StrictModel):
         return self
 
 
-class SpurPairSpec(_Clearance):
+class DistributionSpec(StrictModel):
+    """Replaces the paper's distribution of one source (values of the source itself, in µm).
+
+    ``normal``: between ``lower_um`` and ``upper_um`` with σ = range/6; ``truncated_normal``: the
+    same, cut at the limits (parts outside scrapped); ``uniform``: on [lower_um, upper_um];
+    ``rayleigh``: scale ``scale_um`` (eccentricities: the magnitude; the phase stays uniform);
+    ``empirical``: ``values_um`` measured on real parts (resampled). For an eccentricity or a
+    runout the distribution is that of the magnitude ``e ≥ 0``.
+    """
+
+    kind: Literal["normal", "truncated_normal", "uniform", "rayleigh", "empirical"]
+    lower_um: float | None = Field(default=None, ge=-100_000, le=100_000)
+    upper_um: float | None = Field(default=None, ge=-100_000, le=100_000)
+    scale_um: float | None = Field(default=None, gt=0, le=100_000)
+    values_um: list[float] | None = Field(default=None, min_length=2, max_length=10_000_000)
+
+    @model_validator(mode="after")
+    def _fields_of_kind(self):
+        if self.kind in ("normal", "truncated_normal", "uniform"):
+            if self.lower_um is None or self.upper_um is None:
+                raise ValueError(f"kind = {self.kind!r} needs lower_um and upper_um")
+            if self.lower_um > self.upper_um or (
+                self.kind != "normal" and self.lower_um == self.upper_um
+            ):
+                raise ValueError(
+                    f"inverted limits: lower_um = {self.lower_um} must be < upper_um = "
+                    f"{self.upper_um}"
+                )
+        if self.kind == "rayleigh" and self.scale_um is None:
+            raise ValueError("kind = 'rayleigh' needs scale_um > 0")
+        if self.kind == "empirical" and self.values_um is None:
+            raise ValueError("kind = 'empirical' needs values_um (at least 2 measurements)")
+        return self
+
+    def build(self):
+        from gearte.tolerance.distributions import (
+            Empirical,
+            Normal,
+            Rayleigh,
+            Truncated,
+            Uniform,
+        )
+
+        mm = 1e-3
+        if self.kind == "normal":
+            return Normal.from_limits(self.lower_um * mm, self.upper_um * mm)  # type: ignore[operator]
+        if self.kind == "truncated_normal":
+            lo, hi = self.lower_um * mm, self.upper_um * mm  # type: ignore[operator]
+            return Truncated(Normal.from_limits(lo, hi), lo, hi)
+        if self.kind == "uniform":
+            return Uniform(self.lower_um * mm, self.upper_um * mm)  # type: ignore[operator]
+        if self.kind == "rayleigh":
+            return Rayleigh(self.scale_um * mm)  # type: ignore[operator]
+        return Empirical([v * mm for v in self.values_um])  # type: ignore[union-attr]
+
+
+class _Distributions(StrictModel):
+    distributions: dict[str, DistributionSpec] = Field(
+        default_factory=dict,
+        description="Per-source distribution replacing the paper's (keys: source names).",
+    )
+
+    def backlash_stack(self):
+        """The pair's normal-backlash stack [mm] with the distribution overrides applied."""
+        from gearte.tolerance.distributions import RadialPhase
+        from gearte.tolerance.stackup import Contributor, LinearStack
+
+        base = self.build().backlash_stack()  # type: ignore[attr-defined]
+        if not self.distributions:
+            return base
+        cs = []
+        for c in base.contributors:
+            spec = self.distributions.get(c.name)
+            if spec is None:
+                cs.append(c)
+                continue
+            d = spec.build()
+            if isinstance(c.distribution, RadialPhase):
+                d = RadialPhase(d)
+            cs.append(Contributor(c.name, d, c.sensitivity, c.group))
+        return LinearStack(cs, base.constant, name=base.name, unit=base.unit)
+
+    @model_validator(mode="after")
+    def _known_sources(self):
+        known = SPUR_SOURCES if getattr(self, "type", "") == "spur" else BEVEL_SOURCES
+        unknown = sorted(set(self.distributions) - set(known))
+        if unknown:
+            raise ValueError(
+                f"distributions: unknown source(s) {unknown}; sources of this pair: {list(known)}"
+            )
+        return self
+
+
+class SpurPairSpec(_Clearance, _Distributions):
     """A spur pair and its mounting (Jiang et al. 2024, Tables 1–2)."""
 
     type: Literal["spur"] = "spur"
@@ -159,7 +255,7 @@ class BevelGearSpec(_ThicknessLimits, _Clearance):
     )
 
 
-class BevelPairSpec(StrictModel):
+class BevelPairSpec(_Distributions):
     """A straight bevel pair and its mounting (Jiang et al. 2024, Tables 5–6)."""
 
     type: Literal["bevel"] = "bevel"
@@ -247,7 +343,7 @@ def analyse_pair(
     from gearte.tolerance.montecarlo import monte_carlo
 
     pair = spec.build()
-    stack = pair.backlash_stack()
+    stack = spec.backlash_stack()
     alpha = pair.pressure_angle
     d_out = pair.output_diameter
     summ = summarise_backlash(
