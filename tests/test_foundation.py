@@ -85,6 +85,7 @@ def test_results_json_and_report_are_written(tmp_path):
     assert data["analyses"]["demo"]["values"]["total_length [mm]"] == pytest.approx(15.0)
     assert data["analyses"]["demo"]["values"]["x [mm]"] == [0.0, 5.0, 10.0]
     assert data["case"]["kind"] == "foundation_test" and "gearte_version" in data
+    assert paths["results"].stat().st_mode & 0o044 == 0o044  # readable by others, like any file
     html = paths["report"].read_text()
     assert "data:image/png;base64," in html and "total_length [mm]" in html
 

@@ -15,6 +15,13 @@ from typing import Any
 __all__ = ["write_outputs", "atomic_write_text"]
 
 
+def _public_mode() -> int:
+    """Mode of a normally created file (0o666 less the umask); ``mkstemp`` makes 0o600."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def atomic_write_text(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` atomically (temporary file in the same folder + rename)."""
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -22,6 +29,7 @@ def atomic_write_text(path: Path, text: str) -> None:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
+        os.chmod(tmp, _public_mode())
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -59,6 +67,7 @@ def write_outputs(
             fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".tmp", dir=out)
             with os.fdopen(fd, "w", encoding="utf-8") as fh:
                 fh.write(text)
+            os.chmod(tmp, _public_mode())
             tmp_files.append((tmp, paths[key]))
         for tmp, final in tmp_files:
             os.replace(tmp, final)
