@@ -212,3 +212,21 @@ def test_case_inverted_backlash_and_verified_range():
                 verified_backlash_max_um=25.0,
             )
         )
+
+
+def test_statistical_joint_lost_motion(paper_route):
+    # not in the paper: independent normal stages (σ = range/2z) instead of the worst-case sum
+    from gearte.tolerance.stackup import z_for_confidence
+
+    v = paper_route["chain"].values
+    z = z_for_confidence(0.9973)
+
+    def lm(um, d):
+        return float(rad_to_arcmin(2 * um * UM / (d * math.cos(ALPHA))))
+
+    s_lo, s_m, s_hi = (lm(j, 275.0) for j in (34, 54, 75))
+    b_lo, b_m, b_hi = (lm(j, 102.1) for j in (72, 90, 108))
+    mean = 1 / 152 * 152 / (3.929 * 1.0) + s_m + b_m
+    sd = math.hypot((s_hi - s_lo) / (2 * z), (b_hi - b_lo) / (2 * z))
+    assert v["joint_lost_motion_statistical_max [arcmin]"] == pytest.approx(mean + z * sd)
+    assert v["joint_lost_motion_statistical_max [arcmin]"] < v["joint_lost_motion_max [arcmin]"]
