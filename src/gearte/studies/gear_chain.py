@@ -279,7 +279,13 @@ def _stage_backlash_mm(st: StageSpec, confidence: float):
     return trio, st.output_diameter_mm, float(deg_to_rad(st.pressure_angle_deg)), None
 
 
-def _lost(trio, d, alpha) -> tuple[float, float, float]:
+def _lost(trio, d, alpha, name: str, warnings: list[str]) -> tuple[float, float, float]:
+    """(min, mean, max) return error [rad]; a negative backlash (interference) loses no motion."""
+    if trio[0] < 0:
+        warnings.append(
+            f"{name}: minimum normal backlash {mm_to_um(trio[0]):.1f} µm < 0 (the flanks "
+            "interfere); its lost motion is counted as 0 there"
+        )
     return tuple(float(return_error(max(j, 0.0), d, alpha)) for j in trio)  # type: ignore[return-value]
 
 
@@ -347,7 +353,7 @@ def run(case: Case, options) -> StudyResult:
             continue
         trio, d, alpha, pair = _stage_backlash_mm(st, conf)
         backlash[st.name] = (trio, d, alpha, pair)
-        lo, mean, mx = _lost(trio, d, alpha)
+        lo, mean, mx = _lost(trio, d, alpha, st.name, warnings)
         stages.append(StageLostMotion(st.name, st.ratio, mx, mean, lo, st.compensate))
         if pair is not None:
             assert st.pair is not None
@@ -465,7 +471,7 @@ def run(case: Case, options) -> StudyResult:
         else:
             used = after
             source = "gearte's backlash shifted by the shim"
-        lo, mean, mx = _lost(used, d, alpha)
+        lo, mean, mx = _lost(used, d, alpha, f"{sh.stage} after shim", warnings)
         k = next(i for i, s in enumerate(stages) if s.name == sh.stage)
         old = stages[k]
         shim_stages = list(stages)
