@@ -70,3 +70,19 @@ def test_bad_distribution_overrides_name_the_field():
         load_case(_spur(**{"reducer output runout": {"kind": "rayleigh", "scale_um": 0.0}}))
     with pytest.raises(CaseFileError, match="values_um"):
         load_case(_spur(**{"centre distance": {"kind": "empirical", "values_um": [1.0]}}))
+
+
+def test_upper_spec_gives_cp_and_out_of_spec():
+    d = _spur()
+    d["analysis"]["max_backlash_limit_um"] = 70.0
+    v = run_case(d, RunOptions(progress=False, samples=400_000))["monte_carlo"].values
+    from scipy.stats import norm
+
+    mu, sd = 53.397, 7.216
+    assert v["cp"] == pytest.approx((70.0 - 15.0) / (6 * sd), rel=0.01)
+    assert v["cpk"] == pytest.approx((70.0 - mu) / (3 * sd), rel=0.01)
+    p = norm.sf((70.0 - mu) / sd)
+    assert v["fraction_above_max_limit"] == pytest.approx(p, abs=4 * (p / 400_000) ** 0.5)
+    d["analysis"]["max_backlash_limit_um"] = 10.0
+    with pytest.raises(CaseFileError, match="max_backlash_limit_um"):
+        run_case(d, RunOptions(progress=False, samples=1000))

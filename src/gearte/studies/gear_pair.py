@@ -24,6 +24,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
+from gearte.errors import ParameterError
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.models.backlash import (
     BEVEL_SOURCES,
@@ -323,11 +324,27 @@ class PairAnalysisSpec(StrictModel):
     sobol_samples: int = Field(
         default=0, ge=0, le=10**7, description="Base samples for Sobol indices (0: skip)."
     )
+    max_backlash_limit_um: float | None = Field(
+        default=None,
+        gt=0,
+        le=100_000,
+        description="Optional upper spec of the normal backlash [µm] (for Cp and out-of-spec).",
+    )
 
 
 class Case(CaseBase):
     pair: PairSpec
     analysis: PairAnalysisSpec = PairAnalysisSpec()
+
+    @model_validator(mode="after")
+    def _spec_limits(self):
+        hi = self.analysis.max_backlash_limit_um
+        if hi is not None and hi <= self.pair.min_backlash_limit_um:
+            raise ValueError(
+                f"analysis.max_backlash_limit_um = {hi} must be above "
+                f"pair.min_backlash_limit_um = {self.pair.min_backlash_limit_um}"
+            )
+        return self
 
 
 def analyse_pair(
@@ -415,6 +432,15 @@ def analyse_pair(
         else (analysis.monte_carlo_samples)
     )
     seed = options.seed if getattr(options, "seed", None) is not None else analysis.seed
+    upper = None
+    if analysis.max_backlash_limit_um is not None:
+        if analysis.max_backlash_limit_um <= float(mm_to_um(pair.min_backlash_limit)):
+            raise ParameterError(
+                "analysis.max_backlash_limit_um",
+                analysis.max_backlash_limit_um,
+                "must be above the pair's min_backlash_limit_um",
+            )
+        upper = float(um_to_mm(analysis.max_backlash_limit_um))
     if n_mc and n_mc >= 2:
         mc = monte_carlo(
             stack,
@@ -422,6 +448,7 @@ def analyse_pair(
             seed=seed,
             chunk_size=analysis.chunk_size,
             lower_spec=pair.min_backlash_limit if pair.min_backlash_limit > 0 else None,
+            upper_spec=upper,
             percentiles=(
                 50 * (1 - analysis.confidence),
                 50.0,
@@ -449,7 +476,10 @@ def analyse_pair(
                     "mc_backlash_high_percentile [um]": float(um(mc.percentiles[qs[2]])),
                     "percentile_levels [%]": qs,
                     "fraction_below_min_limit": mc.below_fraction,
-                    "cpk_vs_min_limit": mc.cpk,
+                    "cpk": mc.cpk,
+                    "fraction_above_max_limit": mc.above_fraction,
+                    "out_of_spec_fraction": mc.out_of_spec_fraction,
+                    "cp": mc.cp,
                     "mean_difference_in_standard_errors": float(mean_err_se),
                     "sd_relative_difference": float(mc.sd / stack.sd - 1.0),
                 },
