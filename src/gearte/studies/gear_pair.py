@@ -450,9 +450,9 @@ def analyse_pair(
             lower_spec=pair.min_backlash_limit if pair.min_backlash_limit > 0 else None,
             upper_spec=upper,
             percentiles=(
-                50 * (1 - analysis.confidence),
+                round(50 * (1 - analysis.confidence), 10),
                 50.0,
-                100 - 50 * (1 - analysis.confidence),
+                round(100 - 50 * (1 - analysis.confidence), 10),
             ),
             progress=getattr(options, "progress", False),
             options=options,
