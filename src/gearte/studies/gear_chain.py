@@ -42,6 +42,7 @@ from gearte.models.lost_motion import (
     analyse_chain,
     compensation_table,
     compensation_table_csv,
+    compensation_table_json,
     return_error,
     shim_backlash_reduction,
     shim_thickness,
@@ -564,6 +565,10 @@ def run(case: Case, options) -> StudyResult:
                     + (" Acts on the chain after the shim." if case.shim is not None else ""),
                 ],
                 data={"chain": res},
+                files={
+                    "compensation.csv": compensation_table_csv(table),
+                    "compensation.json": compensation_table_json(table),
+                },
             )
         )
     return StudyResult(case=case, analyses=analyses, warnings=warnings)
