@@ -400,9 +400,21 @@ def _load_sharing(red, red0, sec: LoadSharingSection) -> AnalysisResult:
         title="Pin load sharing over one output revolution",
         values=values,
         references=["han2023", "hu2020"],
-        notes=notes,
+        notes=notes + ["pin_loads.csv: the load of every pin on every disc at every position."],
         data=data,
+        files={"pin_loads.csv": _pin_csv(ls)},
     )
+
+
+def _pin_csv(ls) -> str:
+    """Pin-load table: one row per output angle and disc, one column per pin [N]."""
+    zp = ls.pin_force.shape[2]
+    lines = ["output_angle [deg],disc," + ",".join(f"pin_{k + 1} [N]" for k in range(zp))]
+    for p, th in enumerate(np.degrees(ls.theta)):
+        for j in range(ls.pin_force.shape[1]):
+            vals = ",".join(f"{v:.3f}" for v in ls.pin_force[p, j])
+            lines.append(f"{th:.4f},{j + 1},{vals}")
+    return "\n".join(lines) + "\n"
 
 
 def _transmission_error(red, sec: TESection) -> AnalysisResult:
@@ -439,7 +451,21 @@ def _transmission_error(red, sec: TESection) -> AnalysisResult:
             "ripple has z_p z_c cycles per revolution and is aliased by uniform sampling.",
         ],
         data={"te": te},
+        files={"transmission_error.csv": _te_csv(te)},
     )
+
+
+def _te_csv(te) -> str:
+    rows = ["output_angle [deg],total_te [arcsec],geometric_te [arcsec],elastic_te [arcsec]"]
+    for th, t, g, e in zip(
+        np.degrees(te.theta),
+        rad_to_arcsec(te.total),
+        rad_to_arcsec(te.geometric),
+        rad_to_arcsec(te.elastic),
+        strict=True,
+    ):
+        rows.append(f"{th:.4f},{t:.6f},{g:.6f},{e:.6f}")
+    return "\n".join(rows) + "\n"
 
 
 def _catalogue(red, sec: CatalogueSection) -> AnalysisResult:
