@@ -246,7 +246,7 @@ class Discs:
             raise ParameterError("discs.poisson_ratio", self.poisson_ratio, "must be in [0, 0.5)")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
 class PinRing:
     """The fixed ring of ``z_p`` pins.
 
@@ -332,7 +332,7 @@ class ErrorEntry:
 _PARTS = ("planet_base_circle", "disc_crank_bore", "cam", "carrier_crank_bore")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
 class ManufacturingErrors:
     """Measured eccentricity errors as arrays of error vectors in the parts' frames [mm].
 
@@ -422,7 +422,7 @@ class ManufacturingErrors:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
 class RVReducer:
     """A whole RV reducer.
 
