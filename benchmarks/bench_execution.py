@@ -1,0 +1,210 @@
+"""Execution layer (issue 7): local 1 worker vs 2 workers vs a Dask LocalCluster of 2 workers.
+
+Two workloads, each run on every backend with the same seed (results must be identical):
+
+1. Tolerance study: 1e7-sample Monte-Carlo of the normal backlash of Jiang et al. (2024)'s spur
+   pair (``examples/jiang2024_spur_pair.toml``) through ``gearte.tolerance.montecarlo`` — the real
+   issue-3 kernel.
+2. Dynamics batch: 200 runs of a torsional dynamics model with random errors. **Stand-in**: the
+   RV dynamics batch of issue 6 is not on main yet, so this uses a representative compiled kernel
+   of its own (:func:`standin_dte_chunk`: a numba ``nogil`` RK4 of a two-mass torsional system
+   with time-varying mesh stiffness and random eccentricity errors, 10⁵ RK4 steps per run,
+   ~10 ms). To use the real batch, change the one line marked ``DYNAMICS_BATCH =`` below.
+
+Printed: wall time per backend, speed-up and parallel efficiency against 1 worker (goal ≥ 0.8 on
+2 cores for the dynamics batch), the plain baseline (a bare Python loop over the same kernel,
+no execution layer) and the layer's overhead ratio, and the LocalCluster's start-up and
+per-study overhead. Each backend is warmed up first (JIT compile / cache load in every worker).
+
+Run: ``PYTHONPATH=src python benchmarks/bench_execution.py [--runs 200] [--samples 1e7]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from gearte.execution import RunningStats, map_chunks, open_executor, seeded_chunks
+from gearte.studies import RunOptions
+
+# ----------------------------------------------------------------------------------------------
+# Stand-in dynamics kernel (replace by issue 6's batch when it lands; see DYNAMICS_BATCH below)
+
+
+@njit(cache=True, nogil=True)
+def _standin_dte(e1, phi1, e2, phi2, k_var, n_steps, dt):  # pragma: no cover - compiled
+    """Peak-to-peak dynamic TE [rad] of a two-mass torsional gear model, RK4, one run.
+
+    Masses J1, J2 [kg·mm²] on base radii r1, r2 [mm]; mesh stiffness k(t) = k0 (1 + k_var
+    sin(ω_m t)) [N/mm], damping c [N·s/mm]; eccentricity errors e·sin(Ω t + φ) [mm] on both
+    gears; constant input speed and load torque. State: mesh deflection δ and its rate.
+    """
+    j1, j2, r1, r2 = 2.0e3, 8.0e3, 20.0, 40.0
+    k0, c = 4.0e5, 6.0
+    m_eq = 1.0 / (r1 * r1 / j1 + r2 * r2 / j2)
+    w1 = 2.0 * np.pi * 25.0
+    w2 = w1 * r1 / r2
+    wm = w1 * 30.0
+    f_load = 50.0
+    d, v = 0.0, 0.0
+    lo, hi = 1e300, -1e300
+    t = 0.0
+    for i in range(n_steps):
+        # RK4 on (δ, δ'); excitation: errors projected on the line of action
+        def acc(tt, dd, vv):
+            k = k0 * (1.0 + k_var * math.sin(wm * tt))
+            ex = e1 * math.sin(w1 * tt + phi1) + e2 * math.sin(w2 * tt + phi2)
+            return (f_load - k * (dd - ex) - c * vv) / m_eq
+
+        a1 = acc(t, d, v)
+        a2 = acc(t + 0.5 * dt, d + 0.5 * dt * v, v + 0.5 * dt * a1)
+        a3 = acc(t + 0.5 * dt, d + 0.5 * dt * (v + 0.5 * dt * a1), v + 0.5 * dt * a2)
+        a4 = acc(t + dt, d + dt * (v + 0.5 * dt * a2), v + dt * a3)
+        d += dt * (v + dt * (a1 + a2 + a3) / 6.0)
+        v += dt * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
+        t += dt
+        if i > n_steps // 5:  # after settling
+            te = d / r2
+            lo = min(lo, te)
+            hi = max(hi, te)
+    return hi - lo
+
+
+def standin_dte_chunk(task: tuple[Any, int]) -> np.ndarray:
+    """One chunk of stand-in dynamics runs: random errors per run → peak-to-peak DTE [rad]."""
+    chunk, n_steps = task
+    rng = chunk.rng()
+    out = np.empty(chunk.size)
+    for k in range(chunk.size):
+        e1, e2 = rng.uniform(0.0, 0.01, 2)  # eccentricities [mm]
+        p1, p2 = rng.uniform(0.0, 2 * np.pi, 2)
+        k_var = rng.uniform(0.05, 0.2)
+        out[k] = _standin_dte(e1, p1, e2, p2, k_var, n_steps, 2.0e-5)
+    return out
+
+
+def standin_dynamics_batch(runs: int, options: RunOptions, *, seed: int = 6) -> RunningStats:
+    """The stand-in batch: ``runs`` realisations in chunks of 4, reduced in chunk order."""
+    tasks = [(c, N_STEPS) for c in seeded_chunks(runs, 4, seed)]
+    return map_chunks(
+        _pp_stats, tasks, options=options, reduce=RunningStats.merge, description="dynamics"
+    )
+
+
+def _pp_stats(task: tuple[Any, int]) -> RunningStats:
+    return RunningStats.of(standin_dte_chunk(task))
+
+
+def plain_dynamics_loop(runs: int, *, seed: int = 6) -> RunningStats:
+    """Baseline: a bare loop over the same kernel and streams, no execution layer."""
+    total = RunningStats()
+    for c in seeded_chunks(runs, 4, seed):
+        total = total.merge(_pp_stats((c, N_STEPS)))
+    return total
+
+
+N_STEPS = 100_000
+
+#: The dynamics batch benchmarked: ``f(runs, options) -> summary``. When issue 6 lands, e.g.
+#: ``lambda runs, o: dte_batch(MODEL, runs, scheduler=o.scheduler, workers=o.workers)``.
+DYNAMICS_BATCH = standin_dynamics_batch  # <- the one line to swap
+
+# ----------------------------------------------------------------------------------------------
+# Tolerance study: the real issue-3 Monte-Carlo
+
+
+def tolerance_study(samples: int, options: RunOptions) -> Any:
+    from gearte.io.case_file import load_case
+    from gearte.tolerance.montecarlo import monte_carlo
+
+    stack = load_case("jiang2024_spur_pair").pair.backlash_stack()
+    # chunks of 250 000 samples: 40 chunks for 1e7, enough to balance 2 workers
+    return monte_carlo(stack, samples, seed=2024, chunk_size=250_000, options=options)
+
+
+def _summary(r: Any) -> tuple[float, ...]:
+    if isinstance(r, RunningStats):
+        return r.as_tuple()
+    return (r.n, r.mean, r.sd, r.min, r.max)
+
+
+def _time(fn, *args) -> tuple[float, Any]:
+    t0 = time.perf_counter()
+    out = fn(*args)
+    return time.perf_counter() - t0, out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--runs", type=int, default=200, help="dynamics runs")
+    ap.add_argument("--samples", type=float, default=1e7, help="tolerance samples")
+    ap.add_argument("--repeat", type=int, default=2, help="best of N timings")
+    a = ap.parse_args()
+    samples = int(a.samples)
+    print(f"cores available: {len(os.sched_getaffinity(0))}; load average {os.getloadavg()[0]:.2f}")
+
+    t_start = time.perf_counter()
+    cluster = open_executor("local-cluster", 2)
+    t_cluster_start = time.perf_counter() - t_start
+    backends = {
+        "local, 1 worker": open_executor("sequential"),
+        "local, 2 workers": open_executor("threads", 2),
+        "LocalCluster, 2 workers": cluster,
+    }
+    workloads = {
+        f"tolerance MC, {samples:.0e} samples": (tolerance_study, samples, min(samples, 500_000)),
+        f"dynamics batch, {a.runs} runs": (DYNAMICS_BATCH, a.runs, 8),
+    }
+    try:
+        for wname, (fn, size, warm) in workloads.items():
+            print(f"\n{wname}")
+            times: dict[str, float] = {}
+            ref = None
+            for bname, ex in backends.items():
+                opts = RunOptions(scheduler=ex, progress=False)
+                fn(warm, opts)  # JIT compile / cache load on every worker
+                best = math.inf
+                for _ in range(a.repeat):
+                    dt, out = _time(fn, size, opts)
+                    best = min(best, dt)
+                s = _summary(out)
+                ref = s if ref is None else ref
+                same = "identical" if s == ref else "DIFFERENT"
+                times[bname] = best
+                n = 1 if "1 worker" in bname else 2
+                speedup = times["local, 1 worker"] / best
+                print(
+                    f"  {bname:25s} {best:7.3f} s   speed-up {speedup:4.2f}   "
+                    f"efficiency {speedup / n:4.2f}   result {same}"
+                )
+            overhead = times["LocalCluster, 2 workers"] - times["local, 2 workers"]
+            print(f"  cluster overhead vs local threads: {overhead:+.3f} s per study")
+            if fn is standin_dynamics_batch:
+                t_plain, out = _time(plain_dynamics_loop, size)
+                ratio = times["local, 1 worker"] / t_plain
+                print(
+                    f"  plain loop (no execution layer) {t_plain:7.3f} s; gearte 1 worker / plain "
+                    f"= {ratio:4.2f}; gearte 2 workers / plain = "
+                    f"{times['local, 2 workers'] / t_plain:4.2f}   result "
+                    f"{'identical' if _summary(out) == ref else 'DIFFERENT'}"
+                )
+        print(f"\nLocalCluster start-up (2 worker processes): {t_cluster_start:.2f} s")
+    finally:
+        for ex in backends.values():
+            ex.close()
+
+
+if __name__ == "__main__":
+    # Run as the importable module ``bench_execution`` so that Dask workers (which import it
+    # from this folder, on their sys.path) unpickle the chunk functions by reference.
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import bench_execution
+
+    bench_execution.main()
