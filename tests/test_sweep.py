@@ -134,7 +134,7 @@ def test_sweep_results_identical_on_every_backend_and_common_random_numbers():
     assert sd[(4, 0.5)] == pytest.approx(4 * sd[(1, 0)], rel=1e-12)
 
 
-def test_outputs_csv_json_and_one_plot_per_result_and_key(tmp_path):
+def test_outputs_csv_json_and_one_plot_per_varying_result(tmp_path):
     r = run_sweep(DEMO, {"demo.length_mm": "1:3:3", "demo.count": "2,3"}, progress=False)
     paths = write_sweep(r, tmp_path / "sw")
     rows = list(csv.DictReader(paths["csv"].open()))
@@ -143,7 +143,10 @@ def test_outputs_csv_json_and_one_plot_per_result_and_key(tmp_path):
     data = json.loads(paths["json"].read_text())
     assert data["vary"] == {"demo.length_mm": [1, 2, 3], "demo.count": [2, 3]}
     assert data["points"][5]["values"]["demo.total_length [mm]"] == pytest.approx(4.5)
-    assert len(paths["plots"]) == len(r.columns) * len(r.keys) == 6
+    # one figure per result that varies (total length; map.a and n are constant), one panel
+    # per varied key
+    assert data["constant_columns"] == ["demo.map.a", "demo.n"]
+    assert [p.name for p in paths["plots"]] == ["demo.total_length_mm.png"]
     assert all(p.stat().st_size > 1000 for p in paths["plots"])
 
 
@@ -161,7 +164,7 @@ def test_cli_sweep_writes_outputs_and_reports_bad_keys(tmp_path):
     assert r.exit_code == 0, r.output
     assert "3 points" in r.output
     assert (out / "sweep.csv").is_file() and (out / "sweep.json").is_file()
-    assert len(list((out / "plots").glob("*.png"))) == 3
+    assert len(list((out / "plots").glob("*.png"))) == 1
     for bad, field in (("demo.colour=1:2:3", "demo.colour"), ("demo.length_mm", "--vary")):
         r = runner.invoke(main, ["sweep", str(case), "--vary", bad, "--out", str(out)])
         assert r.exit_code == 2, r.output

@@ -358,6 +358,9 @@ class SweepResult:
             "backend": self.backend,
             "elapsed [s]": round(self.elapsed_s, 4),
             "columns": self.columns,
+            "constant_columns": [
+                c for c in self.columns if len({repr(v) for v in self.column(c)}) == 1
+            ],
             "points": [
                 {
                     "params": p,
@@ -504,8 +507,9 @@ def _atomic_write_bytes(path: Path, data: bytes) -> None:
 def write_sweep(
     result: SweepResult, out_dir: str | os.PathLike[str], *, plots: bool = True
 ) -> dict[str, Any]:
-    """Write ``sweep.csv``, ``sweep.json`` and (unless ``plots=False``) one PNG per scalar
-    result and varied key under ``plots/``. Figures are rendered before any file is written.
+    """Write ``sweep.csv``, ``sweep.json`` and (unless ``plots=False``) under ``plots/`` one PNG
+    per scalar result that varies over the sweep, with one panel per varied key. Figures are
+    rendered before any file is written.
 
     Returns
     -------
@@ -519,7 +523,7 @@ def write_sweep(
 
         for stem, fig in figures(result):
             buf = io.BytesIO()
-            fig.fig.savefig(buf, format="png", dpi=110)
+            fig.fig.savefig(buf, format="png", dpi=100)
             rendered.append((out / "plots" / f"{stem}.png", buf.getvalue()))
     csv_text, json_text = result.to_csv(), result.to_json()
     paths: dict[str, Any] = {"csv": out / "sweep.csv", "json": out / "sweep.json", "plots": []}

@@ -1,7 +1,9 @@
 """Figures of a parameter sweep: every scalar result against every varied key.
 
-With one varied key each figure is a line; with more, one line per combination of the other keys
-(up to :data:`MAX_LINES`, a scatter beyond). matplotlib is imported lazily (via ``new_figure``).
+One figure per scalar result that changes over the sweep (results constant at every point are
+listed in the table, not drawn), with one panel per varied key. With one varied key a panel is a
+line; with more, one line per combination of the other keys (up to :data:`MAX_LINES`, a scatter
+beyond). matplotlib is imported lazily (via ``new_figure``).
 """
 
 from __future__ import annotations
@@ -12,19 +14,15 @@ from typing import Any
 
 from gearte.plotting import PALETTE, Figure, new_figure
 
-__all__ = ["figures", "figure_for", "plot_stem", "MAX_LINES"]
+__all__ = ["figures", "figure_for", "plot_stem", "varying_columns", "MAX_LINES"]
 
 #: Most lines drawn in one figure before falling back to a scatter of all points.
 MAX_LINES = 8
 
 
-def plot_stem(column: str, key: str) -> str:
-    """File stem of the figure of ``column`` against ``key`` (safe characters only)."""
-
-    def slug(s: str) -> str:
-        return re.sub(r"[^A-Za-z0-9_.-]+", "_", s).strip("_")
-
-    return f"{slug(column)}__vs__{slug(key)}"
+def plot_stem(column: str) -> str:
+    """File stem of the figure of ``column`` (safe characters only)."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", column).strip("_")
 
 
 def _num(v: Any) -> float:
@@ -36,14 +34,23 @@ def _num(v: Any) -> float:
         return math.nan
 
 
-def figure_for(result: Any, column: str, key: str) -> Figure:
-    """``column`` (a scalar result) against the varied ``key``."""
-    fig, ax = new_figure(figsize=(6.0, 3.8))
+def varying_columns(result: Any) -> list[str]:
+    """Scalar results that are not the same at every point."""
+    out = []
+    for col in result.columns:
+        vals = result.column(col)
+        if len({repr(v) for v in vals}) > 1:
+            out.append(col)
+    return out
+
+
+def _panel(ax: Any, result: Any, column: str, key: str) -> str:
     y = [_num(v) for v in result.column(column)]
     xs = result.column(key)
     numeric_x = all(isinstance(x, int | float) and not isinstance(x, bool) for x in xs)
-    x_pos = [float(x) for x in xs] if numeric_x else None
-    if not numeric_x:  # categorical values: positions in order of first appearance
+    if numeric_x:
+        x_pos = [float(x) for x in xs]
+    else:  # categorical values: positions in order of first appearance
         cats = list(dict.fromkeys(map(str, xs)))
         x_pos = [float(cats.index(str(x))) for x in xs]
         ax.set_xticks(range(len(cats)), cats)
@@ -58,31 +65,40 @@ def figure_for(result: Any, column: str, key: str) -> Figure:
                 [x_pos[i] for i in idx],
                 [y[i] for i in idx],
                 marker="o",
+                ms=4,
                 color=PALETTE[n % len(PALETTE)],
                 label=label,
             )
         if others:
-            ax.legend(fontsize="small")
+            ax.legend(fontsize="x-small")
+        how = f"lines: {', '.join(others)}" if others else ""
     else:
         ax.scatter(x_pos, y, s=12, color=PALETTE[0])
-    failed = [i for i, e in enumerate(result.errors) if e]
-    for i in failed:
-        ax.axvline(x_pos[i], color="0.8", lw=0.8, ls=":")
+        how = "all points"
+    for i, e in enumerate(result.errors):
+        if e:
+            ax.axvline(x_pos[i], color="0.8", lw=0.8, ls=":")
     ax.set_xlabel(key)
     ax.set_ylabel(column)
     ax.grid(True, alpha=0.3)
-    caption = f"{column} over the sweep of {key}"
-    if others:
-        caption += f" (lines: {', '.join(others)})" if len(groups) <= MAX_LINES else " (all points)"
+    return how
+
+
+def figure_for(result: Any, column: str) -> Figure:
+    """``column`` (a scalar result) against each varied key, one panel per key."""
+    keys = result.keys
+    fig, axes = new_figure(1, len(keys), figsize=(5.0 * len(keys), 3.6), squeeze=False)
+    hows = [_panel(ax, result, column, key) for ax, key in zip(axes[0], keys, strict=True)]
+    caption = f"{column} over the sweep of {', '.join(keys)}"
+    extra = [h for h in hows if h]
+    if extra:
+        caption += f" ({'; '.join(extra)})"
+    failed = sum(1 for e in result.errors if e)
     if failed:
-        caption += f"; dotted: {len(failed)} point(s) that failed"
-    return Figure(f"{column} vs {key}", caption, fig)
+        caption += f"; dotted: {failed} point(s) that failed"
+    return Figure(f"{column} vs {', '.join(keys)}", caption, fig)
 
 
 def figures(result: Any) -> list[tuple[str, Figure]]:
-    """``[(file stem, Figure), ...]``: every scalar result against every varied key."""
-    return [
-        (plot_stem(col, key), figure_for(result, col, key))
-        for col in result.columns
-        for key in result.keys
-    ]
+    """``[(file stem, Figure), ...]``: every varying scalar result against every varied key."""
+    return [(plot_stem(col), figure_for(result, col)) for col in varying_columns(result)]
