@@ -13,9 +13,11 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import logging
+import math
 import multiprocessing
 import socket
 import threading
+import time
 import uuid
 from collections.abc import Callable
 from typing import Any
@@ -303,6 +305,7 @@ class DaskExecutor(ChunkExecutor):
     ) -> None:
         distributed = _import_distributed()
         self._owned: list[Any] = []
+        self._workers, self._workers_at = 1, -math.inf
         self.retries = int(retries)
         self._token = uuid.uuid4().hex[:8]
         try:
@@ -344,10 +347,15 @@ class DaskExecutor(ChunkExecutor):
 
     @property
     def workers(self) -> int:  # type: ignore[override]
-        try:
-            return max(1, sum(self.client.nthreads().values()))
-        except Exception:  # noqa: BLE001 - a sizing hint only
-            return 1
+        """Worker threads of the cluster now (asked at most once a second: clusters adapt)."""
+        now = time.monotonic()
+        if now - self._workers_at > 1.0:
+            try:
+                self._workers = max(1, sum(self.client.nthreads().values()))
+            except Exception:  # noqa: BLE001 - a sizing hint only
+                self._workers = 1
+            self._workers_at = now
+        return self._workers
 
     def _check_versions(self) -> None:
         import gearte

@@ -102,9 +102,14 @@ def map_chunks(
     results: list[Any] = []
     acc = initial
     try:
-        window = max_in_flight or (4 * max(1, executor.workers) if not keep else None)
-        if executor.name == "sequential":
-            window = 1  # computed at submission: hand each result back before the next
+
+        def window() -> int | None:
+            if executor.name == "sequential":
+                return 1  # computed at submission: hand each result back before the next
+            if max_in_flight is not None:
+                return max_in_flight
+            return None if keep else 4 * max(1, executor.workers)  # follows adaptive clusters
+
         batch = executor.batch()
         buffer: dict[int, Any] = {}
         frontier = 0  # index of the next result to hand back
@@ -114,7 +119,8 @@ def map_chunks(
         with ChunkProgress(total, description, bool(progress)) as bar:
             try:
                 while True:
-                    while not exhausted and (window is None or submitted < frontier + window):
+                    w = window()
+                    while not exhausted and (w is None or submitted < frontier + w):
                         try:
                             task = next(it)
                         except StopIteration:
