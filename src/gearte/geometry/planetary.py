@@ -44,13 +44,13 @@ def willis_speeds(
     Returns
     -------
     dict
-        ``{"sun", "ring", "carrier"}`` absolute speeds [rad/s] and ``"planet_rel"``, the planets'
-        speed relative to the carrier [rad/s] (needs ``z_planet``: see
-        :meth:`PlanetarySet.speeds`).
+        ``{"sun", "ring", "carrier"}`` absolute speeds [rad/s] (planet speeds need ``z_planet``:
+        see :meth:`PlanetarySet.speeds`).
 
     Notes
     -----
-    Willis: ``(w_s - w_c) / (w_r - w_c) = -z_r / z_s``, i.e. ``z_s w_s + z_r w_r = (z_s + z_r) w_c``.
+    Willis: ``(w_s - w_c) / (w_r - w_c) = -z_r / z_s``, i.e.
+    ``z_s w_s + z_r w_r = (z_s + z_r) w_c``.
     With the ring fixed and the sun as input, ``w_c = w_s z_s / (z_s + z_r)`` (1/8 for 12/84).
     """
     for name, m in (("fixed", fixed), ("input", input_member)):
@@ -118,7 +118,9 @@ class PlanetarySet:
         if not (np.isfinite(self.module) and self.module > 0):
             raise ParameterError("module", self.module, "must be > 0 [mm]")
         if not (0.0 < self.pressure_angle < np.pi / 4):
-            raise ParameterError("pressure_angle", self.pressure_angle, "must be in (0, pi/4) [rad]")
+            raise ParameterError(
+                "pressure_angle", self.pressure_angle, "must be in (0, pi/4) [rad]"
+            )
         if int(self.n_planets) != self.n_planets or self.n_planets < 1:
             raise ParameterError("n_planets", self.n_planets, "must be an integer >= 1")
         if sorted((self.fixed, self.input, self.output)) != sorted(MEMBERS):

@@ -34,9 +34,9 @@ gear. Trans. CSAM 44(8), 287-292. doi:10.6041/j.issn.1000-1298.2013.08.049 (Tabl
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Mapping, Sequence
 
 import numpy as np
 from numba import njit
@@ -127,9 +127,7 @@ class TermSet:
         return tuple(a for a in self.angles if a != self.reference_angle)
 
 
-def derive_terms(
-    pset: PlanetarySet, planet_model: str = "reference", n_planet_params: int | None = None
-) -> TermSet:
+def derive_terms(pset: PlanetarySet, planet_model: str = "reference") -> TermSet:
     """Equivalent mesh-error terms of all eccentricities, derived from kinematics.
 
     Parameters
@@ -141,8 +139,6 @@ def derive_terms(
         state, planet 1 studied"). ``"mean"``: the output follows the mean of the N planets'
         constraints (ideal load sharing): each term gets gain 1/N and sun/ring/carrier terms of
         the planets are summed with their position angles eta_i.
-    n_planet_params : int, optional
-        Unused placeholder for symmetry with the case schema (planets are indexed 1..N).
 
     Returns
     -------
@@ -194,15 +190,9 @@ def derive_terms(
             ErrorTerm("A_s/external" + suffix, "A_s", g, q_c, a - eta, "gamma_s", 1, "external"),
             ErrorTerm("E_r/internal" + suffix, "E_r", g, q_rc, -a - eta, "beta_r", 1, "internal"),
             ErrorTerm("A_r/internal" + suffix, "A_r", g, q_c, -a - eta, "gamma_r", 1, "internal"),
-            ErrorTerm(
-                "A_c/external" + suffix, "A_c", -g, q_c, a - eta, "gamma_c", 1, "external"
-            ),
-            ErrorTerm(
-                "A_c/internal" + suffix, "A_c", -g, q_c, -a - eta, "gamma_c", 1, "internal"
-            ),
-            ErrorTerm(
-                f"A_{p}/external", f"A_{p}", -g, Fraction(0), a, f"gamma_{p}", 1, "external"
-            ),
+            ErrorTerm("A_c/external" + suffix, "A_c", -g, q_c, a - eta, "gamma_c", 1, "external"),
+            ErrorTerm("A_c/internal" + suffix, "A_c", -g, q_c, -a - eta, "gamma_c", 1, "internal"),
+            ErrorTerm(f"A_{p}/external", f"A_{p}", -g, Fraction(0), a, f"gamma_{p}", 1, "external"),
             ErrorTerm(
                 f"A_{p}/internal", f"A_{p}", -g, Fraction(0), -a, f"gamma_{p}", 1, "internal"
             ),
@@ -536,9 +526,7 @@ def exact_extremes(
     if np.any(nh < 1):
         raise ParameterError("harmonics", harmonics, "must be integers >= 1")
     M = _grid_points(nh)
-    return _extremes_batch(
-        c, np.ascontiguousarray(Z.real), np.ascontiguousarray(Z.imag), nh, M
-    )
+    return _extremes_batch(c, np.ascontiguousarray(Z.real), np.ascontiguousarray(Z.imag), nh, M)
 
 
 def exact_extremes_numpy(
