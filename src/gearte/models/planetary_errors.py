@@ -337,6 +337,8 @@ def group_phasors(
     arr = _term_arrays(terms)
     m = np.asarray(magnitudes, dtype=float)
     th = np.asarray(angles, dtype=float)
+    if th.shape[-1] == 0:  # no angle keys at all
+        th = np.zeros(th.shape[:-1] + (1,))
     lead = np.broadcast_shapes(m.shape[:-1], th.shape[:-1])
     amp = arr["gain"] * m[..., arr["mag_idx"]]
     ang = np.where(arr["ang_idx"] >= 0, th[..., np.maximum(arr["ang_idx"], 0)], 0.0)

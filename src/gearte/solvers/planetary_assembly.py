@@ -216,7 +216,8 @@ def optimal_assembly(
     reference_value : float
         Value of the reference angle [rad] (0: angles are relative to the datum).
     starts : int
-        Quasi-random (scrambled Sobol) start points evaluated in one compiled batch.
+        Quasi-random (scrambled Sobol) start points evaluated in one compiled batch (rounded up
+        to a power of 2).
     polish : int
         Number of best starts refined by Nelder–Mead (xatol 1e-10 rad).
     seed : int
@@ -253,7 +254,8 @@ def optimal_assembly(
     if not free:
         return _plan(terms, mags, dict(zip(terms.angles, base, strict=True)), ())
     d = len(free)
-    sob = qmc.Sobol(d, scramble=True, seed=seed).random(starts) * 2 * np.pi
+    m = int(np.ceil(np.log2(max(starts, 2))))  # Sobol balance needs a power of 2
+    sob = qmc.Sobol(d, scramble=True, seed=seed).random_base2(m) * 2 * np.pi
     vals = amp(sob)
     cand = [sob[i] for i in np.argsort(vals)[:polish]]
     for st in extra_starts or []:
