@@ -320,3 +320,34 @@ def test_negative_magnitude_is_an_error():
         coupled_te(terms, mags, {})
     with pytest.raises(ParameterError, match="missing"):
         coupled_te(terms, {"E_s": 0.01}, {})
+
+
+def test_derived_terms_vs_eq9_term_by_term(eq9):
+    """Derived terms equal eq 9's bracket term by term except the documented discrepancies:
+    e2 (frequency 7/24 not 11/24, and phase + pi), e6 (phase + pi), e7 (frequency 7/24)."""
+    eq_terms, _, _ = eq9
+    derived = derive_terms(wang_set())
+    by_name = {t.name.split("/planet")[0]: t for t in derived.terms}
+    pairs = {  # eq 9 term -> (derived term, expected frequency, extra phase)
+        "e1": ("E_s/external", Fraction(7, 8), 0.0),
+        "e2": ("E_p1/external", Fraction(7, 24), np.pi),
+        "e3": ("A_s/external", Fraction(1, 8), 0.0),
+        "e4": ("A_p1/external", Fraction(0), 0.0),
+        "e5": ("A_c/external", Fraction(1, 8), 0.0),
+        "e6": ("E_r/internal", Fraction(1, 8), np.pi),
+        "e7": ("E_p1/internal", Fraction(7, 24), 0.0),
+        "e8": ("A_p1/internal", Fraction(0), 0.0),
+        "e9": ("A_c/internal", Fraction(1, 8), 0.0),
+    }
+    rng = np.random.default_rng(3)
+    t = rng.uniform(0, 100, 7)  # input angle w_s t [rad]
+    th = rng.uniform(0, 2 * np.pi)  # any common angle value
+    for e in eq_terms.terms:
+        key = e.name.split()[0]
+        dname, q, extra = pairs[key]
+        d = by_name[dname]
+        # both written as +-sin(q t + phase + k theta); derived has k = +1 with the signed q
+        dv = d.gain * np.sin(float(d.frequency) * t + d.phase + d.angle_coeff * th)
+        ev = np.sin(float(q) * t + e.phase + extra + e.angle_coeff * th)  # eq 9 with the fix
+        assert abs(d.frequency) == q
+        assert np.allclose(dv, ev, atol=1e-12), key
