@@ -351,3 +351,24 @@ def test_derived_terms_vs_eq9_term_by_term(eq9):
         ev = np.sin(float(q) * t + e.phase + extra + e.angle_coeff * th)  # eq 9 with the fix
         assert abs(d.frequency) == q
         assert np.allclose(dv, ev, atol=1e-12), key
+
+
+def test_exact_kernel_near_ties_and_degenerate_inputs():
+    """Peaks of (nearly) equal height are where pruning could pick the wrong one: compare with
+    the twin that refines every discrete extremum. Also a pure constant and one harmonic."""
+    rng = np.random.default_rng(11)
+    n = 200
+    Z = np.zeros((n, 3), dtype=complex)
+    Z[:, 0] = np.exp(1j * rng.uniform(0, 2 * np.pi, n))  # harmonic 3: three equal peaks
+    Z[:, 1] = 10.0 ** rng.uniform(-12, -3, n) * np.exp(1j * rng.uniform(0, 2 * np.pi, n))
+    Z[:, 2] = 10.0 ** rng.uniform(-12, -3, n) * np.exp(1j * rng.uniform(0, 2 * np.pi, n))
+    c = rng.normal(size=n) * 0.1
+    harm = (3, 7, 21)
+    fx, fn = exact_extremes(c, Z, harm)
+    tx, tn = exact_extremes_numpy(c, Z, harm)
+    assert np.allclose(fx, tx, rtol=0, atol=1e-13) and np.allclose(fn, tn, rtol=0, atol=1e-13)
+    fx, fn = exact_extremes(np.array([0.3]), np.zeros((1, 3), dtype=complex), harm)
+    assert fx[0] == pytest.approx(0.3, abs=1e-15) and fn[0] == pytest.approx(0.3, abs=1e-15)
+    fx, fn = exact_extremes(np.array([0.0]), np.array([[0, 0, 2.0 - 1.0j]]), harm)
+    assert fx[0] == pytest.approx(np.sqrt(5), rel=1e-14)
+    assert fn[0] == pytest.approx(-np.sqrt(5), rel=1e-14)

@@ -386,28 +386,57 @@ def _f_d1_d2(u, c, zr, zi, nh):
 
 
 @njit(cache=True, nogil=True)
-def _refine(u0, du, lo, hi, sgn, c, zr, zi, nh, stol):
-    """Local maximum of sgn*f in [lo, hi], Newton on f' from u0 + du (du: parabolic guess).
+def _f_d123(u, c, zr, zi, nh):
+    """f and its first three derivatives at u.
 
-    Stops when the Newton step is below ``stol`` and returns the second-order Taylor value at
-    the stepped point, whose error is below Σ|Z| n³ stol³ / 6; the caller sets stol so that this
-    is 1e-13 Σ|Z| (1e-13 relative to the largest possible |f|). Falls back to golden-section
-    search if Newton leaves [lo, hi] or meets f'' of the wrong sign.
+    One sine/cosine of u; e^{i n_g u} for the sorted harmonics by complex multiplication
+    (w^{n_g} = w^{n_{g-1}} w^{n_g - n_{g-1}}, binary powering), relative error ~ 1e-15.
     """
-    u = u0 + du
-    for _ in range(30):
-        f, d1, d2 = _f_d1_d2(u, c, zr, zi, nh)
-        d1 *= sgn
-        d2 *= sgn
-        if d2 >= 0.0:
-            break
-        step = -d1 / d2
-        if abs(step) <= stol:
-            return sgn * f + d1 * step + 0.5 * d2 * step * step
-        u = u + step
-        if u < lo or u > hi:
-            break
-    # golden-section search for the local maximum of sgn*f on [lo, hi]
+    cu = math.cos(u)
+    su = math.sin(u)
+    pr = 1.0  # running power w^{n_{g-1}}
+    pi_ = 0.0
+    last = 0
+    f = c
+    d1 = 0.0
+    d2 = 0.0
+    d3 = 0.0
+    for g in range(nh.shape[0]):
+        n = nh[g]
+        k = n - last
+        last = n
+        # w^k by binary powering
+        br = cu
+        bi = su
+        qr = 1.0
+        qi = 0.0
+        while k > 0:
+            if k & 1:
+                t = qr * br - qi * bi
+                qi = qr * bi + qi * br
+                qr = t
+            k >>= 1
+            if k:
+                t = br * br - bi * bi
+                bi = 2.0 * br * bi
+                br = t
+        t = pr * qr - pi_ * qi
+        pi_ = pr * qi + pi_ * qr
+        pr = t
+        co = pr
+        s_ = pi_
+        v = zr[g] * s_ + zi[g] * co
+        w = n * (zr[g] * co - zi[g] * s_)
+        f += v
+        d1 += w
+        d2 -= n * n * v
+        d3 -= n * n * w
+    return f, d1, d2, d3
+
+
+@njit(cache=True, nogil=True)
+def _golden(u0, lo, hi, sgn, c, zr, zi, nh):
+    """Golden-section search for a local maximum of sgn*f on [lo, hi] (fallback, rarely used)."""
     gr = 0.6180339887498949
     a = lo
     b = hi
@@ -436,39 +465,104 @@ def _refine(u0, du, lo, hi, sgn, c, zr, zi, nh, stol):
 
 
 @njit(cache=True, nogil=True)
-def _parabolic(buf, j, sgn, h):
+def _refine(u0, du, lo, hi, sgn, c, zr, zi, nh, stol):
+    """Local maximum of sgn*f in [lo, hi], Halley iteration on f' from u0 + du.
+
+    ``du`` is the parabolic-interpolation guess from the grid. Stops when the step is below
+    ``stol`` and returns the third-order Taylor value at the stepped point, whose error is below
+    Σ|Z| n⁴ stol⁴ / 24; the caller sets stol so that this is 1e-13 Σ|Z| (1e-13 relative to the
+    largest possible |f|). Falls back to golden-section search if the iteration leaves
+    [lo, hi] or meets f'' of the wrong sign.
+    """
+    u = u0 + du
+    for _ in range(30):
+        f, d1, d2, d3 = _f_d123(u, c, zr, zi, nh)
+        d1 *= sgn
+        d2 *= sgn
+        d3 *= sgn
+        if d2 >= 0.0:
+            break
+        den = 2.0 * d2 * d2 - d1 * d3
+        step = -2.0 * d1 * d2 / den if den > 0.0 else -d1 / d2  # Halley, else Newton
+        if abs(step) <= stol:
+            return sgn * f + step * (d1 + step * (0.5 * d2 + step * d3 / 6.0))
+        u = u + step
+        if u < lo or u > hi:
+            break
+    return _golden(u0, lo, hi, sgn, c, zr, zi, nh)
+
+
+@njit(cache=True, nogil=True)
+def _nb(buf, j, sgn):
+    """sgn * (previous, this, next node value), periodic; no integer modulo (slow)."""
     M = buf.shape[0]
-    v = sgn * buf[j]
-    vp = sgn * buf[(j - 1 + M) % M]
-    vn = sgn * buf[(j + 1) % M]
+    jp = j - 1 if j > 0 else M - 1
+    jn = j + 1 if j < M - 1 else 0
+    return sgn * buf[jp], sgn * buf[j], sgn * buf[jn]
+
+
+@njit(cache=True, nogil=True)
+def _parabolic(buf, j, sgn, h):
+    """Offset of the vertex of the parabola through the nodes j-1, j, j+1 [rad]."""
+    vp, v, vn = _nb(buf, j, sgn)
     den = vp - 2.0 * v + vn
     return 0.5 * h * (vp - vn) / den if den < 0.0 else 0.0
 
 
 @njit(cache=True, nogil=True)
-def _best_extremum(buf, j0, second, sgn, h, bound, c, zr, zi, nh, stol):
-    """Global max of sgn*f: refine the best discrete local maximum j0; if the second-best local
-    maximum (node value ``second``) lies within ``bound`` of the refined value, refine every
-    local maximum within that bound (rare)."""
+def _refine_node(buf, j, sgn, h, c, zr, zi, nh, stol):
+    return _refine(
+        j * h, _parabolic(buf, j, sgn, h), (j - 1) * h, (j + 1) * h, sgn, c, zr, zi, nh, stol
+    )
+
+
+@njit(cache=True, nogil=True)
+def _best_extremum(buf, j0, sgn, h, bound, c, zr, zi, nh, stol):
+    """Global max of sgn*f over the period.
+
+    The best node j0 is refined first (value B). A true maximum elsewhere can exceed its nearest
+    node by at most ``bound``, so only nodes above B - bound can lead to a higher one: the run of
+    such nodes around j0 is searched for further discrete peaks, and the remaining nodes are
+    scanned (almost always all below: a predictable branch); every peak found is refined too.
+    """
     M = buf.shape[0]
-    du = _parabolic(buf, j0, sgn, h)
-    best = _refine(j0 * h, du, (j0 - 1) * h, (j0 + 1) * h, sgn, c, zr, zi, nh, stol)
-    if second <= best - bound:
-        return sgn * best
+    best = _refine_node(buf, j0, sgn, h, c, zr, zi, nh, stol)
     thr = best - bound
-    for j in range(M):
-        v = sgn * buf[j]
-        if v <= thr or j == j0:
-            continue
-        vp = sgn * buf[(j - 1 + M) % M]
-        vn = sgn * buf[(j + 1) % M]
-        if v < vp or v < vn:
-            continue
-        du = _parabolic(buf, j, sgn, h)
-        r = _refine(j * h, du, (j - 1) * h, (j + 1) * h, sgn, c, zr, zi, nh, stol)
-        if r > best:
-            best = r
-            thr = best - bound
+    # the run of nodes above thr around j0: offsets -lo < k < hi
+    lo = 1
+    j = j0 - 1 if j0 > 0 else M - 1
+    while lo < M and sgn * buf[j] > thr:
+        lo += 1
+        j = j - 1 if j > 0 else M - 1
+    hi = 1
+    j = j0 + 1 if j0 < M - 1 else 0
+    while hi < M - lo + 1 and sgn * buf[j] > thr:
+        hi += 1
+        j = j + 1 if j < M - 1 else 0
+    j = j0 - lo + 1
+    if j < 0:
+        j += M
+    for _k in range(lo + hi - 1):  # inside the run: any other discrete peak
+        if j != j0:
+            vp, v, vn = _nb(buf, j, sgn)
+            if v >= vp and v >= vn:
+                r = _refine_node(buf, j, sgn, h, c, zr, zi, nh, stol)
+                if r > best:
+                    best = r
+        j = j + 1 if j < M - 1 else 0
+    above = 0
+    for k in range(M):  # branchless count of nodes above thr (vectorised)
+        above += sgn * buf[k] > thr
+    if above <= lo + hi - 1:  # all of them in the run: nothing outside can win
+        return sgn * best
+    for _k in range(M - lo - hi + 1):  # outside the run: j continues after its right end
+        if sgn * buf[j] > thr:
+            vp, v, vn = _nb(buf, j, sgn)
+            if v >= vp and v >= vn:
+                r = _refine_node(buf, j, sgn, h, c, zr, zi, nh, stol)
+                if r > best:
+                    best = r
+        j = j + 1 if j < M - 1 else 0
     return sgn * best
 
 
@@ -484,47 +578,33 @@ def _extremes_one(c, zr, zi, nh, stab, ctab, buf, h, curv):
         b = zi[g]
         for j in range(M):
             buf[j] += a * stab[g, j] + b * ctab[g, j]
-    # one pass: best and second-best discrete local maxima of f and of -f
-    m1 = -1e300
-    m2 = -1e300
-    n1 = -1e300
-    n2 = -1e300
+    fmax = buf[0]
+    fmin = buf[0]
     jmax = 0
     jmin = 0
-    vp = buf[M - 1]
-    v = buf[0]
-    for j in range(M):
-        vn = buf[j + 1] if j < M - 1 else buf[0]
-        if v >= vp and v >= vn:
-            if v > m1:
-                m2 = m1
-                m1 = v
-                jmax = j
-            elif v > m2:
-                m2 = v
-        if v <= vp and v <= vn:
-            if -v > n1:
-                n2 = n1
-                n1 = -v
-                jmin = j
-            elif -v > n2:
-                n2 = -v
-        vp = v
-        v = vn
+    for j in range(1, M):
+        v = buf[j]
+        if v > fmax:
+            fmax = v
+            jmax = j
+        elif v < fmin:
+            fmin = v
+            jmin = j
     # the most a true extremum can exceed its nearest node (f' = 0 there): h²/8 max|f''|
     bound = 0.0
     s1 = 0.0
-    s3 = 0.0
+    s4 = 0.0
     for g in range(G):
         a = math.sqrt(zr[g] * zr[g] + zi[g] * zi[g])
-        bound += a * nh[g] * nh[g]
+        n2 = nh[g] * nh[g]
+        bound += a * n2
         s1 += a
-        s3 += a * nh[g] * nh[g] * nh[g]
+        s4 += a * n2 * n2
     bound *= curv
-    # Taylor-stop step: Σ|Z| n³ stol³ / 6 <= 1e-13 Σ|Z|, and never above 1e-4 rad
-    stol = min(1e-4, (6e-13 * s1 / s3) ** (1.0 / 3.0)) if s3 > 0.0 else 1e-4
-    best_max = _best_extremum(buf, jmax, m2, 1.0, h, bound, c, zr, zi, nh, stol)
-    best_min = _best_extremum(buf, jmin, n2, -1.0, h, bound, c, zr, zi, nh, stol)
+    # Taylor-stop step: Σ|Z| n⁴ stol⁴ / 24 <= 1e-13 Σ|Z|, and never above 1e-3 rad
+    stol = min(1e-3, (2.4e-12 * s1 / s4) ** 0.25) if s4 > 0.0 else 1e-3
+    best_max = _best_extremum(buf, jmax, 1.0, h, bound, c, zr, zi, nh, stol)
+    best_min = _best_extremum(buf, jmin, -1.0, h, bound, c, zr, zi, nh, stol)
     return best_max, best_min
 
 
