@@ -113,3 +113,21 @@ def test_bad_case_values_are_named(path, value, field):
     fields = [f for f, _ in err.value.errors]
     assert fields[0] == field
     assert str(value) in str(err.value) or path[-1] in str(err.value)
+
+
+def test_mean_planet_model_case_runs():
+    """planet_model = 'mean': per-planet keys, sun/ring/carrier terms average out."""
+    data = copy.deepcopy(raw("wang2013_2kh_derived"))
+    data["errors"]["planet_model"] = "mean"
+    data["errors"]["magnitudes_um"].pop("E_p")
+    data["errors"]["magnitudes_um"].update({"E_p1": 16.0, "E_p2": 10.0, "E_p3": 4.0})
+    data["analyses"]["monte_carlo"]["samples"] = 2000
+    data["analyses"]["monte_carlo"]["scenarios"] = ["random_assembly"]
+    data["analyses"]["coupled_te"]["assembly"] = "given"
+    data["analyses"]["assembly"] = {"starts": 256, "polish": 1}
+    r = run_case(load_case_dict(data), RunOptions(progress=False))
+    g = r["coupled_te"]["group_amplitude [um]"]
+    # only the planets' 7/24 group and their pin errors survive (sun/ring/carrier cancel)
+    assert set(g) == {"1/8", "7/24", "7/8"}
+    assert g["1/8"] < 1e-12 and g["7/8"] < 1e-12
+    assert r["mc_random_assembly"]["samples"] == 2000

@@ -11,6 +11,8 @@ import numpy as np
 
 from gearte.plotting import PALETTE, Figure, new_figure
 
+_OPT = "optimal_assembly_te [arcsec]"
+
 __all__ = ["figures", "phasor_figure", "te_period_figure", "mc_histograms_figure"]
 
 
@@ -68,13 +70,27 @@ def te_period_figure(result: Any) -> Figure | None:
     ax.axhline(-amp, color=PALETTE[1], ls="--", lw=1)
     s = a["coupled_te_amplitude_sum [arcsec]"]
     ax.axhline(s, color=PALETTE[2], ls=":", lw=1, label=f"Σ group amplitudes {s:.1f}″")
+    if "assembly" in result:
+        from gearte.models.planetary_errors import coupled_te
+
+        d = result["assembly"].data
+        opt = coupled_te(d["terms"], d["mags"], d["optimal"].angles)
+        yo = opt.signal(u) * abs(opt.scale) * 648000.0 / np.pi
+        ax.plot(
+            u / (2 * np.pi) * per,
+            yo,
+            color=PALETTE[3],
+            lw=1.0,
+            label=f"optimal assembly (amplitude {result['assembly'][_OPT]:.1f}″)",
+        )
     ax.set_xlabel("input revolutions")
     ax.set_ylabel("output TE [arcsec]")
     ax.legend(fontsize=8)
     return Figure(
         "Coupled transmission error over one common period",
-        "Output TE over the common period of all terms; dashed: the exact amplitude "
-        "max|Σe|; dotted: the sum of group amplitudes (Wang's lambda = 1 rule).",
+        "Output TE over the common period of all terms at the coupled-TE assembly; dashed: its "
+        "exact amplitude max|Σe|; dotted: the sum of group amplitudes (Wang's lambda = 1 "
+        "rule); purple: the globally optimal assembly.",
         fig,
     )
 

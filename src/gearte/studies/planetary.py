@@ -379,7 +379,8 @@ def run(case: Case, options) -> StudyResult:
     # ---- coupled TE at the chosen assembly
     if case.analyses.coupled_te is not None:
         which = case.analyses.coupled_te.assembly
-        at = {"given": angs, "paper_rule": paper.angles}.get(which)
+        given = {a: angs.get(a, 0.0) for a in terms.angles}
+        at = {"given": given, "paper_rule": paper.angles}.get(which)
         if which == "optimal":
             assert optimal is not None
             at = optimal.angles
