@@ -656,10 +656,15 @@ def exact_extremes(
 
     Notes
     -----
-    Dense stage on ``M = 8 n_max`` nodes; every node that is a discrete local extremum within the
-    bound ``h²/8 Σ|Z_g| n_g²`` of the best node (the most a true extremum can exceed its nearest
-    node, since f' = 0 there) is refined by safeguarded Newton iteration on f' to |Δu| < 1e-13
-    (golden-section fallback). Compiled with numba; :func:`exact_extremes_numpy` is the plain twin.
+    Dense stage on ``M = 8 n_max`` nodes (h = 2 pi / M). The best node is refined by Halley
+    iteration on f' (parabolic start; stop when the step is below a tolerance chosen so that the
+    third-order Taylor value is within 1e-13 Σ|Z| of f there). A true maximum can exceed its
+    nearest node by at most ``h²/8 Σ|Z_g| n_g²`` (f' = 0 there), so every other discrete peak
+    whose node lies within that bound of the refined value is refined too (golden-section
+    fallback if an iteration leaves its bracket). This is exact (to ~1e-13 relative) provided two
+    local maxima of f are never closer than two nodes (a quarter period of the highest harmonic);
+    measured against a 2^15-point grid refined from every local extremum: < 1e-13 relative.
+    Compiled with numba; :func:`exact_extremes_numpy` is the plain twin.
     """
     nh = np.ascontiguousarray(np.asarray(harmonics, dtype=np.int64))
     c = np.ascontiguousarray(np.atleast_1d(np.asarray(c, dtype=float)))
