@@ -372,3 +372,22 @@ def test_exact_kernel_near_ties_and_degenerate_inputs():
     fx, fn = exact_extremes(np.array([0.0]), np.array([[0, 0, 2.0 - 1.0j]]), harm)
     assert fx[0] == pytest.approx(np.sqrt(5), rel=1e-14)
     assert fn[0] == pytest.approx(-np.sqrt(5), rel=1e-14)
+
+
+@pytest.mark.parametrize("a1, a2", [(21.0, 12.0), (13.0, 10.94), (5.0, 4.99)])
+def test_wang2013_conclusion4_compensation_interval(a1, a2):
+    """Wang §1(2) / conclusion (4): two same-frequency terms (A1 > A2) compensate (B2 < A1)
+    exactly when the phase difference lies in (arccos(-A2/2A1), 2pi - arccos(-A2/2A1)); the
+    best is ±pi with B2 = A1 - A2."""
+    edge = np.arccos(-a2 / (2 * a1))
+    for dphi, expect in [(edge, a1), (np.pi, a1 - a2), (0.0, a1 + a2)]:
+        terms = terms_from_table(
+            [
+                {"magnitude": "a", "frequency": "1/8", "phase": dphi, "angle": None},
+                {"magnitude": "b", "frequency": "1/8", "phase": 0.0, "angle": None},
+            ],
+            scale=1.0,
+        )
+        assert coupled_te(terms, {"a": a1, "b": a2}, {}).amplitude == pytest.approx(
+            expect, rel=1e-12
+        )
