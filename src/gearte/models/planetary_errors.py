@@ -365,7 +365,8 @@ def group_phasors(
 
 # --------------------------------------------------------------------------- exact extremes
 def _grid_points(harmonics: Sequence[int]) -> int:
-    """Grid size of the dense stage: 8 points per period of the highest harmonic (>= 16)."""
+    """Grid size of the dense stage: 8 points per period of the highest harmonic (>= 16; always
+    a multiple of 4, which :func:`_argmax_argmin` relies on)."""
     return max(16, 8 * int(max(harmonics)) if len(harmonics) else 16)
 
 
@@ -567,6 +568,63 @@ def _best_extremum(buf, j0, sgn, h, bound, c, zr, zi, nh, stol):
 
 
 @njit(cache=True, nogil=True)
+def _argmax_argmin(buf):
+    """Indices of the largest and smallest node; four independent lanes with selects (no
+    data-dependent branches), ~2x faster than the plain loop. len(buf) is a multiple of 4."""
+    M = buf.shape[0]
+    a0 = a1 = a2 = a3 = -np.inf
+    b0 = b1 = b2 = b3 = np.inf
+    i0 = i1 = i2 = i3 = 0
+    k0 = k1 = k2 = k3 = 0
+    for j in range(0, M, 4):
+        v = buf[j]
+        t = v > a0
+        a0 = v if t else a0
+        i0 = j if t else i0
+        t = v < b0
+        b0 = v if t else b0
+        k0 = j if t else k0
+        v = buf[j + 1]
+        t = v > a1
+        a1 = v if t else a1
+        i1 = j + 1 if t else i1
+        t = v < b1
+        b1 = v if t else b1
+        k1 = j + 1 if t else k1
+        v = buf[j + 2]
+        t = v > a2
+        a2 = v if t else a2
+        i2 = j + 2 if t else i2
+        t = v < b2
+        b2 = v if t else b2
+        k2 = j + 2 if t else k2
+        v = buf[j + 3]
+        t = v > a3
+        a3 = v if t else a3
+        i3 = j + 3 if t else i3
+        t = v < b3
+        b3 = v if t else b3
+        k3 = j + 3 if t else k3
+    if a1 > a0:
+        a0 = a1
+        i0 = i1
+    if a3 > a2:
+        a2 = a3
+        i2 = i3
+    if a2 > a0:
+        i0 = i2
+    if b1 < b0:
+        b0 = b1
+        k0 = k1
+    if b3 < b2:
+        b2 = b3
+        k2 = k3
+    if b2 < b0:
+        k0 = k2
+    return i0, k0
+
+
+@njit(cache=True, nogil=True)
 def _extremes_one(c, zr, zi, nh, stab, ctab, buf, h, curv):
     """max f and min f over one period, exact (dense grid, pruning bound, Newton refinement)."""
     M = buf.shape[0]
@@ -578,18 +636,7 @@ def _extremes_one(c, zr, zi, nh, stab, ctab, buf, h, curv):
         b = zi[g]
         for j in range(M):
             buf[j] += a * stab[g, j] + b * ctab[g, j]
-    fmax = buf[0]
-    fmin = buf[0]
-    jmax = 0
-    jmin = 0
-    for j in range(1, M):
-        v = buf[j]
-        if v > fmax:
-            fmax = v
-            jmax = j
-        elif v < fmin:
-            fmin = v
-            jmin = j
+    jmax, jmin = _argmax_argmin(buf)
     # the most a true extremum can exceed its nearest node (f' = 0 there): h²/8 max|f''|
     bound = 0.0
     s1 = 0.0
