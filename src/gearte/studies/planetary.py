@@ -313,6 +313,19 @@ def run(case: Case, options) -> StudyResult:
     q0, harm, group = frequency_basis(terms)
     analyses: list[AnalysisResult] = []
     warnings: list[str] = []
+    if case.errors.source == "derived" and case.errors.planet_model == "reference":
+        unused = sorted(
+            k
+            for k in list(case.errors.magnitudes_um) + list(case.errors.angles_deg)
+            if k.rstrip("0123456789") in ("E_p", "A_p", "beta_p", "gamma_p")
+            and k[-1].isdigit()
+            and k.rstrip("0123456789") + "1" != k
+        )
+        if unused:
+            warnings.append(
+                f"planet_model = 'reference' uses planet 1 only; values of {unused} are unused "
+                "(set planet_model = 'mean' to use every planet)"
+            )
 
     # ---- the terms, one row each
     rows = []
