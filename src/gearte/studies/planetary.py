@@ -310,7 +310,7 @@ def run(case: Case, options) -> StudyResult:
 
     terms, mags, angs = build_terms(case)
     pset = case.gearset.build()
-    q0, harm, group = frequency_basis(terms)
+    q0, harm, _ = frequency_basis(terms)
     analyses: list[AnalysisResult] = []
     warnings: list[str] = []
     if case.errors.source == "derived" and case.errors.planet_model == "reference":
