@@ -1,0 +1,226 @@
+"""2K-H planetary gear set: geometry, assembly conditions and Willis kinematics.
+
+A 2K-H set has a sun ``s`` (external), ``N`` identical planets ``p`` (external) on a carrier ``c``
+and a ring ``r`` (internal). One of sun, ring, carrier is fixed, one is the input, the third the
+output. Units: mm, rad, rad/s (angles of planets in rad, measured counter-clockwise from the
+first planet, which sits on the x axis at t = 0).
+
+References
+----------
+Wang C., Chen X., Li Y., Chen H. (2013). Coupling compensation of transmission error for planetary
+gear. Trans. CSAM 44(8), 287-292. doi:10.6041/j.issn.1000-1298.2013.08.049 (Table 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Literal
+
+import numpy as np
+
+from gearte.errors import ParameterError
+
+__all__ = ["MEMBERS", "PlanetarySet", "willis_speeds"]
+
+Member = Literal["sun", "ring", "carrier"]
+MEMBERS: tuple[str, ...] = ("sun", "ring", "carrier")
+
+
+def willis_speeds(
+    z_sun: int, z_ring: int, fixed: str, input_member: str, input_speed: float = 1.0
+) -> dict[str, float]:
+    """Absolute angular speeds of sun, ring, carrier and planet from the Willis equation.
+
+    Parameters
+    ----------
+    z_sun, z_ring : int
+        Tooth numbers of sun and ring [-].
+    fixed, input_member : {"sun", "ring", "carrier"}
+        The fixed member (speed 0) and the driven-from-outside member.
+    input_speed : float
+        Angular speed of the input member [rad/s].
+
+    Returns
+    -------
+    dict
+        ``{"sun", "ring", "carrier"}`` absolute speeds [rad/s] (planet speeds need ``z_planet``:
+        see :meth:`PlanetarySet.speeds`).
+
+    Notes
+    -----
+    Willis: ``(w_s - w_c) / (w_r - w_c) = -z_r / z_s``, i.e.
+    ``z_s w_s + z_r w_r = (z_s + z_r) w_c``.
+    With the ring fixed and the sun as input, ``w_c = w_s z_s / (z_s + z_r)`` (1/8 for 12/84).
+    """
+    for name, m in (("fixed", fixed), ("input", input_member)):
+        if m not in MEMBERS:
+            raise ParameterError(name, m, f"must be one of {MEMBERS}")
+    if fixed == input_member:
+        raise ParameterError("input", input_member, "input and fixed member must differ")
+    zs, zr = Fraction(z_sun), Fraction(z_ring)
+    # speeds as exact fractions of the input speed
+    w: dict[str, Fraction] = {fixed: Fraction(0), input_member: Fraction(1)}
+    (other,) = [m for m in MEMBERS if m not in (fixed, input_member)]
+    # z_s w_s + z_r w_r - (z_s + z_r) w_c = 0, solve for the unknown member
+    coef = {"sun": zs, "ring": zr, "carrier": -(zs + zr)}
+    w[other] = -(coef[fixed] * w[fixed] + coef[input_member] * w[input_member]) / coef[other]
+    return {k: float(v) * input_speed for k, v in w.items()}
+
+
+@dataclass(frozen=True)
+class PlanetarySet:
+    """A 2K-H planetary gear set with involute gears.
+
+    Parameters
+    ----------
+    z_sun, z_planet, z_ring : int
+        Tooth numbers [-] (Wang 2013 Table 1: 12, 36, 84).
+    module : float
+        Normal module m [mm].
+    pressure_angle : float
+        Working pressure angle of both meshes alpha [rad] (standard gears: alpha_w = alpha = 20°).
+    n_planets : int
+        Number of planets N [-].
+    planet_angles : tuple of float, optional
+        Position angles eta_i of the planets [rad], the first 0; default equal spacing 2 pi i / N.
+    fixed, input, output : {"sun", "ring", "carrier"}
+        Which member is held, driven and taken off (Wang 2013: ring, sun, carrier).
+    standard : bool
+        Standard (unshifted) gears: then ``z_r = z_s + 2 z_p`` must hold (concentricity).
+
+    Raises
+    ------
+    ParameterError
+        Teeth < 3, module or pressure angle out of range, ``z_r != z_s + 2 z_p`` for standard
+        gears, planets that cannot be assembled (``(z_s + z_r) eta_i / 2 pi`` not an integer),
+        neighbouring planets whose tip circles overlap, or members not a permutation.
+    """
+
+    z_sun: int
+    z_planet: int
+    z_ring: int
+    module: float
+    pressure_angle: float
+    n_planets: int = 3
+    planet_angles: tuple[float, ...] | None = None
+    fixed: str = "ring"
+    input: str = "sun"
+    output: str = "carrier"
+    standard: bool = True
+    _eta: tuple[float, ...] = field(init=False, repr=False, compare=False, default=())
+
+    def __post_init__(self) -> None:
+        for name in ("z_sun", "z_planet", "z_ring"):
+            z = getattr(self, name)
+            if int(z) != z or z < 3:
+                raise ParameterError(name, z, "must be an integer >= 3")
+        if not (np.isfinite(self.module) and self.module > 0):
+            raise ParameterError("module", self.module, "must be > 0 [mm]")
+        if not (0.0 < self.pressure_angle < np.pi / 4):
+            raise ParameterError(
+                "pressure_angle", self.pressure_angle, "must be in (0, pi/4) [rad]"
+            )
+        if int(self.n_planets) != self.n_planets or self.n_planets < 1:
+            raise ParameterError("n_planets", self.n_planets, "must be an integer >= 1")
+        if sorted((self.fixed, self.input, self.output)) != sorted(MEMBERS):
+            raise ParameterError(
+                "fixed/input/output",
+                (self.fixed, self.input, self.output),
+                f"must be a permutation of {MEMBERS}",
+            )
+        if self.standard and self.z_ring != self.z_sun + 2 * self.z_planet:
+            raise ParameterError(
+                "z_ring",
+                self.z_ring,
+                f"standard gears need z_r = z_s + 2 z_p = {self.z_sun + 2 * self.z_planet}",
+            )
+        if self.z_ring <= self.z_sun + self.z_planet:
+            raise ParameterError("z_ring", self.z_ring, "must exceed z_s + z_p")
+        n = int(self.n_planets)
+        if self.planet_angles is None:
+            eta = tuple(2.0 * np.pi * i / n for i in range(n))
+        else:
+            eta = tuple(float(x) for x in self.planet_angles)
+            if len(eta) != n:
+                raise ParameterError(
+                    "planet_angles", self.planet_angles, f"needs n_planets = {n} angles"
+                )
+            if eta[0] != 0.0:
+                raise ParameterError("planet_angles", self.planet_angles, "first angle must be 0")
+        zsum = self.z_sun + self.z_ring
+        for i, e in enumerate(eta):
+            k = zsum * e / (2.0 * np.pi)
+            if abs(k - round(k)) > 1e-6:
+                raise ParameterError(
+                    f"planet_angles[{i}]" if self.planet_angles is not None else "n_planets",
+                    e if self.planet_angles is not None else n,
+                    f"planet cannot be assembled: (z_s + z_r) * eta / 2pi = {k:.4g} is not an "
+                    f"integer (z_s + z_r = {zsum})",
+                )
+        # neighbouring planets must not overlap (tip circle m (z_p + 2) for standard addendum)
+        if n > 1:
+            srt = np.sort(np.mod(np.asarray(eta), 2 * np.pi))
+            gaps = np.diff(np.concatenate([srt, [srt[0] + 2 * np.pi]]))
+            chord = 2.0 * self.centre_distance * np.sin(gaps.min() / 2.0)
+            tip = self.module * (self.z_planet + 2)
+            if chord <= tip:
+                raise ParameterError(
+                    "n_planets",
+                    n,
+                    f"neighbouring planets overlap: centre chord {chord:.4g} mm <= planet tip "
+                    f"diameter {tip:.4g} mm",
+                )
+        object.__setattr__(self, "_eta", eta)
+
+    # ------------------------------------------------------------------ geometry
+    @property
+    def eta(self) -> np.ndarray:
+        """Planet position angles eta_i [rad]."""
+        return np.asarray(self._eta)
+
+    def base_radius(self, member: str) -> float:
+        """Base-circle radius r_b = m z cos(alpha) / 2 of ``sun``, ``planet`` or ``ring`` [mm]."""
+        z = {"sun": self.z_sun, "planet": self.z_planet, "ring": self.z_ring}[member]
+        return 0.5 * self.module * z * np.cos(self.pressure_angle)
+
+    @property
+    def centre_distance(self) -> float:
+        """Sun–planet centre distance a = m (z_s + z_p) / 2 [mm]."""
+        return 0.5 * self.module * (self.z_sun + self.z_planet)
+
+    # ---------------------------------------------------------------- kinematics
+    def speed_ratios(self) -> dict[str, Fraction]:
+        """Exact speeds as fractions of the input speed: sun, ring, carrier, planet (absolute)
+        and ``planet_rel`` (planet relative to the carrier), by the Willis equation."""
+        zs, zp, zr = Fraction(self.z_sun), Fraction(self.z_planet), Fraction(self.z_ring)
+        w: dict[str, Fraction] = {self.fixed: Fraction(0), self.input: Fraction(1)}
+        coef = {"sun": zs, "ring": zr, "carrier": -(zs + zr)}
+        o = self.output
+        w[o] = -(coef[self.fixed] * w[self.fixed] + coef[self.input] * w[self.input]) / coef[o]
+        # planet relative to carrier: sun-planet external mesh (w_p - w_c) = -(z_s/z_p)(w_s - w_c)
+        w["planet_rel"] = -(zs / zp) * (w["sun"] - w["carrier"])
+        w["planet"] = w["planet_rel"] + w["carrier"]
+        return w
+
+    def speeds(self, input_speed: float = 1.0) -> dict[str, float]:
+        """Absolute speeds [rad/s] (and ``planet_rel``) for an input speed [rad/s]."""
+        return {k: float(v) * input_speed for k, v in self.speed_ratios().items()}
+
+    @property
+    def ratio(self) -> float:
+        """Transmission ratio i = w_input / w_output [-] (8 for Wang 2013)."""
+        r = self.speed_ratios()
+        return float(Fraction(1) / r[self.output])
+
+    def output_scale(self) -> float:
+        """Output rotation error per unit of (e_w + e_n) [rad/mm].
+
+        From the linearised contact conditions along the two lines of action,
+        ``r_bs dθ_s + r_br dθ_r + e_w + e_n = (r_bs + r_br) dθ_c``; the input and the fixed member
+        have dθ = 0, so the output error is ``(e_w + e_n)`` times ``1/(r_bs + r_br)`` (carrier),
+        ``-1/r_br`` (ring) or ``-1/r_bs`` (sun). For the carrier output this is Wang 2013's
+        ``1/(r_bs i_sc)`` (eq. 9).
+        """
+        rbs, rbr = self.base_radius("sun"), self.base_radius("ring")
+        return {"carrier": 1.0 / (rbs + rbr), "ring": -1.0 / rbr, "sun": -1.0 / rbs}[self.output]

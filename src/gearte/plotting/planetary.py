@@ -1,0 +1,129 @@
+"""Figures of the ``planetary`` study: group phasors, TE over the common period, MC histograms.
+
+matplotlib is imported lazily through :func:`gearte.plotting.new_figure`; nothing calls show().
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from gearte.plotting import PALETTE, Figure, new_figure
+
+_OPT = "optimal_assembly_te [arcsec]"
+
+__all__ = ["figures", "phasor_figure", "te_period_figure", "mc_histograms_figure"]
+
+
+def phasor_figure(result: Any) -> Figure | None:
+    """Group phasors (one arrow per same-frequency group) at the coupled-TE assembly."""
+    if "coupled_te" not in result:
+        return None
+    te = result["coupled_te"].data["te"]
+    fig, ax = new_figure(figsize=(5.5, 5.0))
+    scale = 1e3  # mm -> µm
+    lim = 1e-9
+    for k, (f, z) in enumerate(zip(te.frequencies, te.phasors, strict=True)):
+        z = z * scale
+        ax.annotate(
+            "",
+            xy=(z.real, z.imag),
+            xytext=(0, 0),
+            arrowprops={"arrowstyle": "->", "color": PALETTE[k % len(PALETTE)], "lw": 2},
+        )
+        ax.plot([], [], color=PALETTE[k % len(PALETTE)], label=f"q = {f} (|Z| = {abs(z):.2f} µm)")
+        lim = max(lim, abs(z))
+    if te.constant:
+        c = te.constant * scale
+        ax.plot([0], [c], "ks", label=f"constant {c:.2f} µm")
+        lim = max(lim, abs(c))
+    ax.set_xlim(-1.1 * lim, 1.1 * lim)
+    ax.set_ylim(-1.1 * lim, 1.1 * lim)
+    ax.set_aspect("equal")
+    ax.axhline(0, color="0.8", lw=0.8)
+    ax.axvline(0, color="0.8", lw=0.8)
+    ax.set_xlabel("Re Z [µm]")
+    ax.set_ylabel("Im Z [µm]")
+    ax.legend(fontsize=8, loc="upper left")
+    return Figure(
+        "Same-frequency groups (phasors)",
+        "Each arrow is the exact phasor sum of the mesh-error terms of one frequency (multiple q "
+        "of the input speed) at the assembly of the coupled-TE analysis.",
+        fig,
+    )
+
+
+def te_period_figure(result: Any) -> Figure | None:
+    """Σe(t) converted to output TE over one common period."""
+    if "coupled_te" not in result:
+        return None
+    a = result["coupled_te"]
+    te = a.data["te"]
+    u = a.data["u"]
+    per = float(1 / te.q0)  # input revolutions per common period
+    y = te.signal(u) * abs(te.scale) * 648000.0 / np.pi
+    fig, ax = new_figure()
+    ax.plot(u / (2 * np.pi) * per, y, color=PALETTE[0], lw=1.2, label="Σ e(t) (coupled)")
+    amp = a["coupled_te_amplitude [arcsec]"]
+    ax.axhline(amp, color=PALETTE[1], ls="--", lw=1, label=f"± amplitude {amp:.1f}″")
+    ax.axhline(-amp, color=PALETTE[1], ls="--", lw=1)
+    s = a["coupled_te_amplitude_sum [arcsec]"]
+    ax.axhline(s, color=PALETTE[2], ls=":", lw=1, label=f"Σ group amplitudes {s:.1f}″")
+    if "assembly" in result:
+        from gearte.models.planetary_errors import coupled_te
+
+        d = result["assembly"].data
+        opt = coupled_te(d["terms"], d["mags"], d["optimal"].angles)
+        yo = opt.signal(u) * abs(opt.scale) * 648000.0 / np.pi
+        ax.plot(
+            u / (2 * np.pi) * per,
+            yo,
+            color=PALETTE[3],
+            lw=1.0,
+            label=f"optimal assembly (amplitude {result['assembly'][_OPT]:.1f}″)",
+        )
+    ax.set_xlabel("input revolutions")
+    ax.set_ylabel("output TE [arcsec]")
+    ax.legend(fontsize=8)
+    return Figure(
+        "Coupled transmission error over one common period",
+        "Output TE over the common period of all terms at the coupled-TE assembly; dashed: its "
+        "exact amplitude max|Σe|; dotted: the sum of group amplitudes (Wang's lambda = 1 "
+        "rule); purple: the globally optimal assembly.",
+        fig,
+    )
+
+
+def mc_histograms_figure(result: Any) -> Figure | None:
+    """Histogram of the coupled TE per Monte-Carlo scenario."""
+    mcs = [a for a in result.analyses if a.name.startswith("mc_")]
+    if not mcs:
+        return None
+    fig, ax = new_figure(figsize=(7.5, 4.5))
+    for k, a in enumerate(mcs):
+        e = np.asarray(a.data["edges [arcsec]"])
+        h = np.asarray(a.data["hist"], dtype=float)
+        w = np.diff(e)
+        dens = h / max(h.sum(), 1) / w
+        ax.stairs(
+            dens,
+            e,
+            color=PALETTE[k % len(PALETTE)],
+            lw=1.4,
+            label=f"{a.name[3:]}: mean {a['mc_mean [arcsec]']:.0f}″, sd {a['mc_sd [arcsec]']:.0f}″",
+        )
+    ax.set_xlabel("coupled TE amplitude [arcsec]")
+    ax.set_ylabel("probability density [1/arcsec]")
+    ax.legend(fontsize=7)
+    return Figure(
+        "Monte-Carlo of assembly strategies",
+        "Distribution of the exact coupled TE per scenario (Wang 2013 Figs 2-5).",
+        fig,
+    )
+
+
+def figures(result: Any) -> list[Figure]:
+    """All figures of a ``planetary`` result."""
+    out = [phasor_figure(result), te_period_figure(result), mc_histograms_figure(result)]
+    return [f for f in out if f is not None]
