@@ -198,6 +198,20 @@ def test_worker_lost_mid_study_is_retried_and_result_is_bit_identical(reference,
     assert stats.extra == reference.extra
 
 
+def test_local_process_that_dies_is_replaced_and_its_chunks_rerun(reference, tmp_path):
+    from execution_tasks import crash_once
+    from gearte.execution import PoolExecutor
+
+    marker = tmp_path / "crashed"
+    tasks = [(str(marker), c) for c in seeded_chunks(SAMPLES, CHUNK, SEED)]
+    with PoolExecutor("processes", 2) as ex:
+        stats = map_chunks(crash_once, tasks, scheduler=ex, reduce=RunningStats.merge)
+        assert ex.failures == 1
+    assert marker.exists()
+    assert stats.extra["chunks"] == SAMPLES // CHUNK
+    assert stats.as_tuple() == reference.as_tuple()
+
+
 def test_client_passed_in_stays_open_and_internal_ones_are_closed(client):
     r = check_backend(client, samples=20_000, chunk_size=5_000)
     assert r["identical"] and r["backend"] == "dask"

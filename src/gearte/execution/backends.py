@@ -124,23 +124,46 @@ class SequentialExecutor(ChunkExecutor):
 
 
 class _PoolBatch(Batch):
-    def __init__(self, pool: cf.Executor) -> None:
+    def __init__(self, executor: PoolExecutor) -> None:
         super().__init__()
-        self._pool = pool
+        self._ex = executor
+        self._jobs: dict[Any, tuple[Callable[[Any], Any], Any, int]] = {}
 
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
-        self.pending[self._pool.submit(func, task)] = index
+        fut = self._ex._pool.submit(func, task)
+        self.pending[fut] = index
+        self._jobs[fut] = (func, task, self._ex._generation)
 
     def next_done(self) -> list[tuple[int, Any]]:
+        from concurrent.futures.process import BrokenProcessPool
+
         done, _ = cf.wait(list(self.pending), return_when=cf.FIRST_COMPLETED)
-        out = [(self.pending[f], f.result()) for f in done]
+        out: list[tuple[int, Any]] = []
+        broken: int | None = None
         for f in done:
-            del self.pending[f]
+            try:
+                result = f.result()
+            except BrokenProcessPool:
+                broken = self._jobs[f][2]
+                continue
+            out.append((self.pending.pop(f), result))
+            del self._jobs[f]
+        if broken is not None:
+            # A worker process died (killed, out of memory, crashed): every chunk still pending
+            # in that pool is lost with it. Start a new pool and submit them again (same tasks,
+            # same seeds, so the same results).
+            self._ex._restart(broken)
+            lost = list(self.pending)
+            for f in lost:
+                func, task, _ = self._jobs.pop(f)
+                index = self.pending.pop(f)
+                self.submit(func, task, index, "")
         return out
 
     def cancel(self) -> None:
         for f in self.pending:
             f.cancel()
+        self._jobs.clear()
         super().cancel()
 
 
@@ -149,26 +172,51 @@ class PoolExecutor(ChunkExecutor):
 
     Threads suit gearte's kernels (numba ``nogil`` functions and numpy calls release the GIL):
     nothing is pickled. Processes suit pure-Python chunk functions; ``func`` and the tasks must
-    then be picklable (module-level functions) and each process imports gearte once.
+    then be picklable (module-level functions) and each process imports gearte once. When a
+    process dies, the pool is replaced and its chunks run again, up to
+    :attr:`allowed_failures` times.
     """
+
+    #: Pool replacements after dead worker processes before giving up with SchedulerError.
+    allowed_failures = 3
 
     def __init__(self, kind: str = "threads", workers: int | None = None) -> None:
         nw = default_workers() if workers is None else int(workers)
         if nw < 1:
             raise ParameterError("workers", workers, "must be ≥ 1")
+        if kind not in ("threads", "processes"):  # pragma: no cover - guarded by open_executor
+            raise ParameterError("scheduler", kind, f"must be one of {LOCAL_SCHEDULERS}")
         self.name = kind
         self.workers = nw
-        if kind == "threads":
-            self._pool: cf.Executor = cf.ThreadPoolExecutor(nw, thread_name_prefix="gearte")
-        elif kind == "processes":
-            methods = multiprocessing.get_all_start_methods()
-            ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-            self._pool = cf.ProcessPoolExecutor(nw, mp_context=ctx)
-        else:  # pragma: no cover - guarded by open_executor
-            raise ParameterError("scheduler", kind, f"must be one of {LOCAL_SCHEDULERS}")
+        self.failures = 0
+        self._generation = 0
+        self._lock = threading.Lock()
+        self._pool = self._new_pool()
+
+    def _new_pool(self) -> cf.Executor:
+        if self.name == "threads":
+            return cf.ThreadPoolExecutor(self.workers, thread_name_prefix="gearte")
+        methods = multiprocessing.get_all_start_methods()
+        ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+        return cf.ProcessPoolExecutor(self.workers, mp_context=ctx)
+
+    def _restart(self, generation: int) -> None:
+        """Replace the broken pool of ``generation`` (once, whichever batch notices first)."""
+        with self._lock:
+            if generation != self._generation:
+                return
+            self.failures += 1
+            if self.failures > self.allowed_failures:
+                raise SchedulerError(
+                    f"local worker processes died {self.failures} times; a chunk likely runs out "
+                    "of memory or crashes the interpreter — try a smaller chunk size"
+                )
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = self._new_pool()
+            self._generation += 1
 
     def batch(self) -> Batch:
-        return _PoolBatch(self._pool)
+        return _PoolBatch(self)
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)
