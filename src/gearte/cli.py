@@ -127,7 +127,8 @@ def main() -> None:
     "--scheduler",
     default=None,
     metavar="ADDRESS",
-    help="Run sampled work on a Dask cluster, e.g. tcp://host:8786.",
+    help="Run sampled work on a Dask cluster, e.g. tcp://host:8786 (or a local backend: "
+    "threads, processes, local-cluster). See docs/cluster.md.",
 )
 @click.option("--no-report", is_flag=True, help="Write results.json only.")
 @click.option("--no-progress", is_flag=True, help="Hide progress bars.")
@@ -206,7 +207,8 @@ def run(
     "--scheduler",
     default=None,
     metavar="ADDRESS",
-    help="Run the points on a Dask cluster, e.g. tcp://host:8786.",
+    help="Run the points on a Dask cluster, e.g. tcp://host:8786 (or a local backend: "
+    "threads, processes, local-cluster).",
 )
 @click.option("--no-plots", is_flag=True, help="Write the table only.")
 @click.option("--no-progress", is_flag=True, help="Hide the progress bar.")
