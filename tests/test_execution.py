@@ -17,6 +17,8 @@ import time
 from functools import partial
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from gearte.errors import ParameterError, SchedulerError
 from gearte.execution import (
@@ -278,3 +280,32 @@ def test_cli_prints_an_unreachable_scheduler_without_traceback(tmp_path):
     assert r.exit_code == 2, r.output
     assert "scheduler" in r.output and f"127.0.0.1:{port}" in r.output
     assert "Traceback" not in r.output
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    durations=st.lists(st.integers(0, 3), min_size=0, max_size=25),
+    workers=st.integers(1, 3),
+    window=st.one_of(st.none(), st.integers(1, 5)),
+)
+def test_results_are_handed_back_in_task_order_whatever_the_timing(durations, workers, window):
+    def task(i: int) -> float:
+        time.sleep(0.001 * durations[i])
+        return 0.1 * i + 1e-17 * i * i  # order-sensitive floating-point sum
+
+    order: list[int] = []
+    total = map_chunks(
+        task,
+        range(len(durations)),
+        workers=workers,
+        max_in_flight=window,
+        reduce=lambda a, b: a + b,
+        initial=0.0,
+        on_result=lambda i, r: order.append(i),
+        progress=False,
+    )
+    expected = 0.0
+    for i in range(len(durations)):
+        expected += 0.1 * i + 1e-17 * i * i
+    assert order == list(range(len(durations)))
+    assert total == expected

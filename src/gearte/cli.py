@@ -80,8 +80,8 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
 
 @contextlib.contextmanager
 def _executor(scheduler: str | None, workers: int | None) -> Iterator[Any]:
-    """The Dask executor of ``--scheduler`` (connected once, before any work; closed after), or
-    ``None`` for the local default."""
+    """The executor of ``--scheduler`` (a Dask cluster is connected once, before any work, and
+    released after), or ``None`` for the local default."""
     if scheduler is None:
         yield None
         return
