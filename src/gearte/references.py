@@ -9,8 +9,9 @@ __all__ = ["REFERENCES", "cite"]
 
 REFERENCES: dict[str, str] = {
     "hu2020": (
-        "Hu Y., Li G., Zhu W., Cui J. (2020). An Elastic Transmission Error Compensation Method for "
-        "Rotary Vector Speed Reducers Based on Error Sensitivity Analysis. Applied Sciences 10(2), 481. "
+        "Hu Y., Li G., Zhu W., Cui J. (2020). An Elastic Transmission Error Compensation Method "
+        "for Rotary Vector Speed Reducers Based on Error Sensitivity Analysis. Applied Sciences "
+        "10(2), 481. "
         "doi:10.3390/app10020481"
     ),
     "jiang2024": (

@@ -1,1 +1,1 @@
-"""Pure geometry of gears and cycloid discs (profiles, clearances, equivalent gears). Units: mm, rad."""
+"""Pure geometry of gears and cycloid discs (profiles, clearances, equivalents); mm, rad."""

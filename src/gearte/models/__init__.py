@@ -1,1 +1,1 @@
-"""Pure physics models, one module per phenomenon: functions of arrays, units mm, N, N·mm, MPa, rad."""
+"""Pure physics models, one module per phenomenon, as functions of arrays."""

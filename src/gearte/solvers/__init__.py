@@ -1,1 +1,1 @@
-"""Solvers kept separate from the models: contact fixed points, nonlinear equilibria, ODE integrators."""
+"""Solvers, separate from the models: contact fixed points, equilibria, ODEs."""

@@ -1,0 +1,3 @@
+from gearte.cli import main
+
+main()

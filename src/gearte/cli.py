@@ -1,0 +1,203 @@
+"""Command-line interface: a thin layer over the Python API.
+
+Only click is imported at start-up; everything else is imported inside the command that needs it,
+so ``gearte --help`` answers fast.
+
+Exit codes: 0 ok · 1 the analysis failed (non-convergence, divergence) · 2 bad input ·
+3 internal error (a bug: please report it, ``--debug`` shows the traceback).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Callable
+from typing import Any
+
+import click
+
+EXIT_FAILED = 1
+EXIT_BAD_INPUT = 2
+EXIT_INTERNAL = 3
+
+
+def _error(title: str, message: str) -> None:
+    """Print an error without a traceback (rich when available on a terminal)."""
+    if sys.stderr.isatty():
+        from rich.console import Console
+        from rich.panel import Panel
+
+        Console(stderr=True).print(Panel(message, title=title, border_style="red", expand=False))
+    else:
+        click.echo(f"error ({title}): {message}", err=True)
+
+
+def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
+    """Run ``fn`` turning gearte's errors into clean messages and exit codes."""
+    from gearte.errors import (
+        CaseFileError,
+        ConvergenceError,
+        DivergenceError,
+        GearteError,
+        ParameterError,
+        SchedulerError,
+    )
+
+    try:
+        return fn()
+    except CaseFileError as exc:
+        _error("invalid case", str(exc))
+        sys.exit(EXIT_BAD_INPUT)
+    except ParameterError as exc:
+        _error("invalid parameter", str(exc))
+        sys.exit(EXIT_BAD_INPUT)
+    except FileNotFoundError as exc:
+        _error("not found", str(exc).strip("'\""))
+        sys.exit(EXIT_BAD_INPUT)
+    except SchedulerError as exc:
+        _error("scheduler", str(exc))
+        sys.exit(EXIT_BAD_INPUT)
+    except (ConvergenceError, DivergenceError) as exc:
+        _error("analysis failed", str(exc))
+        sys.exit(EXIT_FAILED)
+    except GearteError as exc:
+        _error("error", str(exc))
+        sys.exit(EXIT_FAILED)
+    except Exception as exc:  # noqa: BLE001 - last line of defence of the CLI
+        if debug or os.environ.get("GEARTE_DEBUG"):
+            raise
+        _error(
+            "internal error",
+            f"{type(exc).__name__}: {exc}\nThis is a bug in gearte; rerun with --debug for the "
+            "traceback and report it.",
+        )
+        sys.exit(EXIT_INTERNAL)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="gearte", message="gearte %(version)s")
+def main() -> None:
+    """gearte — accuracy of precision robot-joint reducers (RV, cycloid, planetary, gear chains).
+
+    A case file (TOML) describes one drive and the analyses to run; `gearte cases` lists the
+    bundled ones. Units inside: mm, N, N·mm, MPa, rad; every result name carries its unit.
+    """
+
+
+@main.command()
+@click.argument("case")
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False),
+    default=None,
+    help="Output folder (default: out/<case name>).",
+)
+@click.option("--seed", type=int, default=None, help="Override the case's random seed.")
+@click.option(
+    "--samples",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Override Monte-Carlo sample counts.",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Local worker threads (default: all cores).",
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Run sampled work on a Dask cluster, e.g. tcp://host:8786.",
+)
+@click.option("--no-report", is_flag=True, help="Write results.json only.")
+@click.option("--no-progress", is_flag=True, help="Hide progress bars.")
+@click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
+def run(
+    case: str,
+    out_dir: str | None,
+    seed: int | None,
+    samples: int | None,
+    workers: int | None,
+    scheduler: str | None,
+    no_report: bool,
+    no_progress: bool,
+    debug: bool,
+) -> None:
+    """Run CASE (a .toml file or a bundled case name) and write results.json and report.html."""
+
+    def _run() -> None:
+        from gearte.io.case_file import load_case
+        from gearte.report.outputs import write_outputs
+        from gearte.studies import RunOptions, run_case
+
+        c = load_case(case)
+        opts = RunOptions(
+            progress=not no_progress,
+            seed=seed,
+            samples=samples,
+            scheduler=scheduler,
+            workers=workers,
+        )
+        result = run_case(c, opts)
+        target = out_dir or os.path.join("out", result.name)
+        paths = write_outputs(result, target, report=not no_report)
+        for w in result.warnings:
+            click.echo(f"warning: {w}", err=True)
+        click.echo(f"{result.name}: {len(result.analyses)} analyses in {result.elapsed_s:.2f} s")
+        for p in paths.values():
+            click.echo(f"  wrote {p}")
+
+    _guarded(_run, debug)
+
+
+@main.command()
+@click.argument("cases", nargs=-1, required=True)
+def validate(cases: tuple[str, ...]) -> None:
+    """Check case files without running them; print every problem, one per line."""
+    from gearte.errors import CaseFileError
+
+    def _validate() -> None:
+        from gearte.io.case_file import load_case
+
+        bad = 0
+        for c in cases:
+            try:
+                case = load_case(c)
+            except CaseFileError as exc:
+                bad += 1
+                click.echo(str(exc), err=True)
+                continue
+            click.echo(f"{c}: ok ({case.case.kind})")
+        if bad:
+            sys.exit(EXIT_BAD_INPUT)
+
+    _guarded(_validate, False)
+
+
+@main.command("cases")
+@click.option("--kinds", is_flag=True, help="List the study kinds instead.")
+def cases_cmd(kinds: bool) -> None:
+    """List the bundled example cases (run one with `gearte run NAME`)."""
+    if kinds:
+        from gearte.studies import available_kinds
+
+        for k in available_kinds():
+            click.echo(k)
+        return
+    import tomllib
+
+    from gearte.cases import list_cases
+
+    for name, path in list_cases().items():
+        try:
+            meta = tomllib.loads(path.read_text(encoding="utf-8")).get("case", {})
+        except (OSError, tomllib.TOMLDecodeError):
+            meta = {}
+        click.echo(f"{name:40s} {meta.get('kind', '?'):16s} {meta.get('title', '')}")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,46 @@
+"""Plotting: one module per study kind with ``figures(result) -> list[Figure]``.
+
+matplotlib is imported only inside functions, and figures are made without pyplot (no global
+state, no GUI backend): ``fig, ax = new_figure()``. Nothing here calls ``show()``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["Figure", "new_figure", "figures_for", "PALETTE"]
+
+#: Colours used consistently across gearte's plots (colour-blind safe, Okabe–Ito).
+PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000"]
+
+
+@dataclass
+class Figure:
+    """A figure of a report: its title, a caption saying what to read from it, the figure."""
+
+    title: str
+    caption: str
+    fig: Any  # matplotlib.figure.Figure
+
+
+def new_figure(
+    nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] = (7.0, 4.0), **subplot_kw: Any
+) -> tuple[Any, Any]:
+    """A matplotlib Figure (Agg canvas, no pyplot) and its axes."""
+    from matplotlib.figure import Figure as MplFigure
+
+    fig = MplFigure(figsize=figsize, layout="constrained")
+    axes = fig.subplots(nrows, ncols, **subplot_kw)
+    return fig, axes
+
+
+def figures_for(result: Any) -> list[Figure]:
+    """All figures of a study result, from the plotting module its kind names (``FIGURES``)."""
+    from gearte.studies import get_kind
+
+    module_name = getattr(get_kind(result.kind), "FIGURES", None)
+    if not module_name:
+        return []
+    return list(importlib.import_module(module_name).figures(result))

@@ -1,0 +1,69 @@
+"""Write a study's outputs atomically: ``results.json`` and ``report.html``.
+
+Everything is computed and rendered in memory first; files are then written to temporary names in
+the output folder and moved into place with ``os.replace``, so a failed run never leaves a
+half-written report.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+__all__ = ["write_outputs", "atomic_write_text"]
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` atomically (temporary file in the same folder + rename)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def write_outputs(
+    result: Any, out_dir: str | os.PathLike[str], *, report: bool = True
+) -> dict[str, Path]:
+    """Write ``results.json`` (and ``report.html`` unless ``report=False``) into ``out_dir``.
+
+    Returns
+    -------
+    dict
+        ``{"results": path, "report": path}`` of the files written.
+    """
+    out = Path(out_dir)
+    json_text = result.to_json()
+    html_text = None
+    if report:
+        from gearte.report.html import render_report
+
+        html_text = render_report(result)
+    paths = {"results": out / "results.json"}
+    if html_text is not None:
+        paths["report"] = out / "report.html"
+    # Both documents exist in memory: only now touch the disk.
+    tmp_files: list[tuple[str, Path]] = []
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        for key, text in (("results", json_text), ("report", html_text)):
+            if text is None:
+                continue
+            fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".tmp", dir=out)
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            tmp_files.append((tmp, paths[key]))
+        for tmp, final in tmp_files:
+            os.replace(tmp, final)
+    finally:
+        for tmp, _ in tmp_files:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    return paths

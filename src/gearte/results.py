@@ -1,0 +1,138 @@
+"""Result objects of gearte's studies and their JSON form.
+
+Names of values carry their unit in brackets (``"max_contact_force [N]"``); dimensionless names
+have none (``"K1"``). Arrays become lists in JSON; non-finite numbers become ``null``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = ["AnalysisResult", "StudyResult", "to_jsonable"]
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert numpy scalars/arrays, tuples and nested mappings to plain JSON types."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.bool_ | bool):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.floating | float):
+        f = float(obj)
+        return f if math.isfinite(f) else None
+    if isinstance(obj, complex | np.complexfloating):
+        return {"re": to_jsonable(obj.real), "im": to_jsonable(obj.imag)}
+    if obj is None or isinstance(obj, str | int):
+        return obj
+    if hasattr(obj, "model_dump"):
+        return to_jsonable(obj.model_dump(mode="json"))
+    return str(obj)
+
+
+@dataclass
+class AnalysisResult:
+    """One analysis of a study.
+
+    Attributes
+    ----------
+    name : str
+        Machine name, key in ``results.json`` (``"tooth_contact"``).
+    title : str
+        Human title for the report.
+    values : dict
+        Named results; names carry units (``"max_contact_force [N]"``). Scalars, arrays, lists
+        and mappings.
+    references : list of str
+        Keys of :data:`gearte.references.REFERENCES` this analysis used.
+    notes : list of str
+        Assumptions and remarks shown in the report and JSON.
+    data : dict
+        Extra objects for plotting; not serialised.
+    """
+
+    name: str
+    title: str
+    values: dict[str, Any] = field(default_factory=dict)
+    references: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    data: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    def __getitem__(self, key: str) -> Any:
+        return self.values[key]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "title": self.title,
+            "values": to_jsonable(self.values),
+            "notes": list(self.notes),
+            "references": list(self.references),
+        }
+
+
+@dataclass
+class StudyResult:
+    """All analyses of one case run.
+
+    ``result["tooth_contact"]["pins_in_mesh"]`` reads a value.
+    """
+
+    case: Any
+    analyses: list[AnalysisResult] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    elapsed_s: float = 0.0
+
+    def __getitem__(self, name: str) -> AnalysisResult:
+        for a in self.analyses:
+            if a.name == name:
+                return a
+        raise KeyError(f"no analysis {name!r}; have {[a.name for a in self.analyses]}")
+
+    def __contains__(self, name: object) -> bool:
+        return any(a.name == name for a in self.analyses)
+
+    @property
+    def kind(self) -> str:
+        return str(self.case.case.kind)
+
+    @property
+    def name(self) -> str:
+        return str(self.case.case.name or self.kind)
+
+    @property
+    def references(self) -> list[str]:
+        keys: list[str] = list(self.case.case.references)
+        for a in self.analyses:
+            keys += [k for k in a.references if k not in keys]
+        return keys
+
+    def to_dict(self) -> dict[str, Any]:
+        from gearte import __version__
+        from gearte.references import REFERENCES
+
+        return {
+            "gearte_version": __version__,
+            "case": {
+                "name": self.name,
+                "kind": self.kind,
+                "title": self.case.case.title,
+                "input": to_jsonable(self.case.model_dump(mode="json")),
+            },
+            "references": {k: REFERENCES.get(k, k) for k in self.references},
+            "warnings": list(self.warnings),
+            "elapsed [s]": round(self.elapsed_s, 4),
+            "analyses": {a.name: a.to_dict() for a in self.analyses},
+        }
+
+    def to_json(self, indent: int | None = 1) -> str:
+        return json.dumps(self.to_dict(), indent=indent, ensure_ascii=False, allow_nan=False)

@@ -1,0 +1,83 @@
+"""Study kinds: one module per kind of drive/analysis, the kind name is the module name.
+
+A kind module defines ``KIND``, ``REFERENCES``, ``FIGURES`` (module path of its plotting),
+``class Case(CaseBase)`` and ``run(case, options) -> StudyResult`` (see docs/architecture.md).
+Kinds are discovered without importing them, so adding a module is all it takes.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import pkgutil
+import time
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
+
+__all__ = ["RunOptions", "available_kinds", "get_kind", "register_kind", "run_case"]
+
+_EXTRA_KINDS: dict[str, str] = {}
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """Options of a run that are not part of the drive's description.
+
+    Attributes
+    ----------
+    progress : bool
+        Show progress bars for chunked work (only on a terminal).
+    seed : int, optional
+        Overrides the case's random seed.
+    samples : int, optional
+        Overrides Monte-Carlo sample counts.
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address (``tcp://host:8786``) or client; ``None`` runs locally.
+    workers : int, optional
+        Local worker threads; default: the machine's cores.
+    """
+
+    progress: bool = True
+    seed: int | None = None
+    samples: int | None = None
+    scheduler: Any = None
+    workers: int | None = None
+
+
+def available_kinds() -> list[str]:
+    """Names of all study kinds (module names in this package plus registered ones)."""
+    names = {m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")}
+    return sorted(names | set(_EXTRA_KINDS))
+
+
+def register_kind(kind: str, module: str) -> None:
+    """Register a study kind implemented outside gearte (plugins, tests)."""
+    _EXTRA_KINDS[kind] = module
+
+
+def get_kind(kind: str) -> ModuleType:
+    """Import the module of a study kind."""
+    if kind in _EXTRA_KINDS:
+        return importlib.import_module(_EXTRA_KINDS[kind])
+    if kind not in available_kinds():
+        raise KeyError(f"unknown study kind {kind!r}; known: {available_kinds()}")
+    return importlib.import_module(f"{__name__}.{kind}")
+
+
+def run_case(case: Any, options: RunOptions | None = None) -> Any:
+    """Run a case: a validated ``Case``, a path to a TOML file, a bundled name or a dict.
+
+    Returns
+    -------
+    gearte.results.StudyResult
+    """
+    if isinstance(case, str | os.PathLike | dict):
+        from gearte.io.case_file import load_case
+
+        case = load_case(case)
+    module = get_kind(case.case.kind)
+    t0 = time.perf_counter()
+    result = module.run(case, options or RunOptions())
+    result.elapsed_s = time.perf_counter() - t0
+    return result
