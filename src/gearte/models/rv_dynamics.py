@@ -18,7 +18,8 @@ How it is built (see docs/validation/li2023.md for the derivation and every assu
   cycloid–pin pair and its line of action) is evaluated on the nominal configuration at time t: the
   cycloid–pin direction rotates with the crank (the paper writes a fixed direction).
 * Excitations: involute mesh stiffness (rectangular wave of the contact ratio, Fourier series,
-  eq 11), cycloid–pin stiffness from the loaded contact (:mod:`gearte.models.cycloid_loaded_contact`,
+  eq 11), cycloid–pin stiffness from the loaded contact
+  (:mod:`gearte.models.cycloid_loaded_contact`,
   Fourier series, eq 13), the eccentricity/assembly errors of Table 3 on explicitly chosen
   cranks/discs, bearing clearances, constant load torque on the output, speed-controlled motor
   behind the input torsional stiffness.
@@ -96,6 +97,8 @@ class RVDynamicsParameters:
     Stiffnesses [N/m] and torsional stiffnesses [N·m/rad] (Table 2). Not in the paper, assumed:
     ``involute_single_pair_stiffness_N_per_m`` (ISO 6336 c' ≈ 14 N/(mm·µm) × 10 mm face width),
     ``damping_ratio`` ζ of the lowest elastic mode.
+    ``cycloid_stiffness``: "fourier" (time-varying k_cr from the loaded contact, eq 13) or "mean"
+    (its mean only, as paper 004 §4.1 does).
     Operating point: ``input_speed_rpm``, ``output_torque_Nm`` (450 N·m, split equally over the
     discs for the contact analysis).
     """
@@ -129,6 +132,7 @@ class RVDynamicsParameters:
     cycloid_harmonics: int = 8
     contact_positions: int = 48
     damping_ratio: float = 0.03
+    cycloid_stiffness: str = "fourier"
     input_speed_rpm: float = 1500.0
     output_torque_Nm: float = 450.0  # noqa: N815
     crank_phase_deg: float = 0.0
@@ -147,10 +151,14 @@ class RVDynamicsParameters:
             if int(getattr(self, name)) < lo:
                 raise ParameterError(name, getattr(self, name), f"must be an integer ≥ {lo}")
         for name, val in self.__dict__.items():
-            if name in ints or name in ("pair", "crank_phase_deg"):
+            if name in ints or name in ("pair", "crank_phase_deg", "cycloid_stiffness"):
                 continue
             if not (np.isfinite(val) and val > 0):
                 raise ParameterError(name, val, "must be finite and > 0")
+        if self.cycloid_stiffness not in ("fourier", "mean"):
+            raise ParameterError(
+                "cycloid_stiffness", self.cycloid_stiffness, "must be 'fourier' or 'mean'"
+            )
         if not self.damping_ratio < 1.0:
             raise ParameterError("damping_ratio", self.damping_ratio, "must be in (0, 1)")
         if self.cycloid_harmonics >= self.contact_positions // 2:
@@ -487,7 +495,13 @@ def rv_rhs(t, y, args, dydt):
         # planet–crank shaft: bending (translation) and torsion
         k = pf[13]
         fx, fy = _bearing(
-            q[ip] - q[ih], q[ip + 1] - q[ih + 1], v[ip] - v[ih], v[ip + 1] - v[ih + 1], k, br * k, 0.0
+            q[ip] - q[ih],
+            q[ip + 1] - q[ih + 1],
+            v[ip] - v[ih],
+            v[ip + 1] - v[ih + 1],
+            k,
+            br * k,
+            0.0,
         )
         f[ip] += fx
         f[ip + 1] += fy
@@ -621,13 +635,17 @@ class RVDynamicModel:
         self.errors = errors if errors is not None else RVErrors(crank_count=m, disc_count=n)
         if (self.errors.crank_count, self.errors.disc_count) != (m, n):
             raise ParameterError(
-                "errors", (self.errors.crank_count, self.errors.disc_count), f"must be for ({m}, {n})"
+                "errors",
+                (self.errors.crank_count, self.errors.disc_count),
+                f"must be for ({m}, {n})",
             )
         self.n_bodies = 2 * m + n + 2
         self.n_dof = 3 * self.n_bodies
         t_disc = p.output_torque_Nm * 1e3 / n
         self.contact = contact or mesh_period_contact(p.pair, t_disc, p.contact_positions)
         k_cr_mean, a_cr, b_cr = fourier_fit(self.contact.mesh_stiffness, p.cycloid_harmonics)
+        if p.cycloid_stiffness == "mean":  # paper 004 §4.1 feeds the mean into the model
+            a_cr, b_cr = np.zeros_like(a_cr), np.zeros_like(b_cr)
         self.cycloid_fourier = (k_cr_mean, a_cr, b_cr)  # N/mm
         self.beta_cr = self.contact.pressure_angle_mean
         sr = float(np.sum(self.contact.contact.radial_force_signed))
@@ -773,16 +791,39 @@ class RVDynamicModel:
         i_s, i_o = 0, self.n_bodies - 1
         k = p.sun_support_stiffness_N_per_m * N_PER_M_TO_N_PER_MM
         gx, gy = point_rows(i_s, (0, 0), None, None, (0, 0))
-        out.append(dict(name="sun support", kind="bearing", k=k, g=(gx, gy), cl=0.0,
-                        e=-polar(*e.sun_assembly)))
+        out.append(
+            dict(
+                name="sun support",
+                kind="bearing",
+                k=k,
+                g=(gx, gy),
+                cl=0.0,
+                e=-polar(*e.sun_assembly),
+            )
+        )
         g = np.zeros(nd)
         g[2] = 1.0
-        out.append(dict(name="input shaft", kind="line", k=p.input_torsional_stiffness_Nm_per_rad
-                        * NM_PER_RAD_TO_NMM_PER_RAD, g=g, e=0.0))
+        out.append(
+            dict(
+                name="input shaft",
+                kind="line",
+                k=p.input_torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD,
+                g=g,
+                e=0.0,
+            )
+        )
         k = p.output_support_stiffness_N_per_m * N_PER_M_TO_N_PER_MM
         gx, gy = point_rows(i_o, (0, 0), None, None, (0, 0))
-        out.append(dict(name="output support", kind="bearing", k=k, g=(gx, gy),
-                        cl=e.output_bearing_clearance_mm, e=-polar(*e.output_assembly)))
+        out.append(
+            dict(
+                name="output support",
+                kind="bearing",
+                k=k,
+                g=(gx, gy),
+                cl=e.output_bearing_clearance_mm,
+                e=-polar(*e.output_assembly),
+            )
+        )
         sun_off = polar(e.sun_eccentricity[0], th_s + e.sun_eccentricity[1])
         for i in range(m):
             ip, ih = 1 + i, 1 + m + i
@@ -797,23 +838,48 @@ class RVDynamicModel:
             g = row([(0, (nvec[0], nvec[1], arm_a)), (ip, (-nvec[0], -nvec[1], -arm_b))])
             phase = p.sun_teeth * (th_s - th_o) + p.sun_teeth * 2 * np.pi * i / m
             pl_off = polar(e.planet_eccentricity[i, 0], th_h + e.planet_eccentricity[i, 1])
-            out.append(dict(name=f"sun-planet{i + 1} mesh", kind="line",
-                            k=series(self.involute_fourier, phase), g=g,
-                            e=float(nvec @ (sun_off - pl_off))))
+            out.append(
+                dict(
+                    name=f"sun-planet{i + 1} mesh",
+                    kind="line",
+                    k=series(self.involute_fourier, phase),
+                    g=g,
+                    e=float(nvec @ (sun_off - pl_off)),
+                )
+            )
             gx, gy = point_rows(ip, ch, ih, ch, ch)
-            out.append(dict(name=f"crank{i + 1} bending", kind="bearing",
-                            k=p.crank_bending_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
-                            g=(gx, gy), cl=0.0, e=np.zeros(2)))
+            out.append(
+                dict(
+                    name=f"crank{i + 1} bending",
+                    kind="bearing",
+                    k=p.crank_bending_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
+                    g=(gx, gy),
+                    cl=0.0,
+                    e=np.zeros(2),
+                )
+            )
             g = np.zeros(nd)
             g[3 * ip + 2], g[3 * ih + 2] = 1.0, -1.0
-            out.append(dict(name=f"crank{i + 1} torsion", kind="line",
-                            k=p.crank_torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD,
-                            g=g, e=0.0))
+            out.append(
+                dict(
+                    name=f"crank{i + 1} torsion",
+                    kind="line",
+                    k=p.crank_torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD,
+                    g=g,
+                    e=0.0,
+                )
+            )
             gx, gy = point_rows(ih, ch, i_o, (0, 0), ch)
-            out.append(dict(name=f"crank{i + 1} support", kind="bearing",
-                            k=p.crank_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
-                            g=(gx, gy), cl=e.crank_bearing_clearance_mm,
-                            e=-polar(e.carrier_hole[i, 0], psi + e.carrier_hole[i, 1])))
+            out.append(
+                dict(
+                    name=f"crank{i + 1} support",
+                    kind="bearing",
+                    k=p.crank_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
+                    g=(gx, gy),
+                    cl=e.crank_bearing_clearance_mm,
+                    e=-polar(e.carrier_hole[i, 0], psi + e.carrier_hole[i, 1]),
+                )
+            )
         for j in range(n):
             ic = 1 + 2 * m + j
             chi = th_h + np.pi * j
@@ -828,18 +894,31 @@ class RVDynamicModel:
                 gx, gy = point_rows(ih, ch, ic, cc, c)
                 cam = polar(e.cam[i, j, 0], chi + e.cam[i, j, 1])
                 hole = polar(e.disc_hole[i, j, 0], psi + e.disc_hole[i, j, 1])
-                out.append(dict(name=f"crank{i + 1}-disc{j + 1} bearing", kind="bearing",
-                                k=p.turning_arm_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
-                                g=(gx, gy), cl=e.turning_arm_clearance_mm, e=cam - hole))
+                out.append(
+                    dict(
+                        name=f"crank{i + 1}-disc{j + 1} bearing",
+                        kind="bearing",
+                        k=p.turning_arm_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
+                        g=(gx, gy),
+                        cl=e.turning_arm_clearance_mm,
+                        e=cam - hole,
+                    )
+                )
             b = self.beta_cr
             dvec = self.sgn_radial * np.sin(b) * ehat + np.cos(b) * eperp
             nvec = -dvec
             pp = p.pair.pin_count * cc
             r = pp - cc
             g = row([(ic, (nvec[0], nvec[1], r[0] * nvec[1] - r[1] * nvec[0]))])
-            out.append(dict(name=f"disc{j + 1}-pins", kind="line",
-                            k=series(self.cycloid_fourier, p.pair.pin_count * chi), g=g,
-                            e=float(e.pin_composite[j, 0] * np.sin(th_o + e.pin_composite[j, 1]))))
+            out.append(
+                dict(
+                    name=f"disc{j + 1}-pins",
+                    kind="line",
+                    k=series(self.cycloid_fourier, p.pair.pin_count * chi),
+                    g=g,
+                    e=float(e.pin_composite[j, 0] * np.sin(th_o + e.pin_composite[j, 1])),
+                )
+            )
         return out
 
     def stiffness_matrix(
@@ -916,7 +995,7 @@ class RVDynamicModel:
         K = self.stiffness_matrix(t, mesh="time")
         q = np.zeros(self.n_dof)
         scale = np.max(np.abs(self.external_force(t)))
-        for it in range(100):
+        for it in range(100):  # noqa: B007 - reported on failure
             r = self.elastic_force(t, q) + self.external_force(t)
             if np.max(np.abs(r)) <= tol * scale:
                 return q
@@ -991,15 +1070,17 @@ class RVDynamicModel:
         A[nd:, nd:] = -minv[:, None] * (self._beta_r * K)
         return np.linalg.eigvals(A)
 
-    def resonance_warnings(self, margin: float = 0.1) -> list[str]:
-        """Warnings when a mesh frequency (or its 2nd harmonic) lies within ±margin of a mode."""
+    def resonance_warnings(
+        self, margin: float = 0.1, harmonics: tuple[int, ...] = (1,)
+    ) -> list[str]:
+        """Warnings when a mesh frequency × ``harmonics`` lies within ±margin of a mode."""
         freqs = self.modal().frequencies
         freqs = freqs[freqs > 0]
         msgs = []
         for name, fm in self.params.frequencies().items():
             if "mesh" not in name:
                 continue
-            for h in (1, 2):
+            for h in harmonics:
                 near = freqs[np.abs(freqs - h * fm) <= margin * h * fm]
                 for fn in near:
                     msgs.append(
@@ -1010,8 +1091,16 @@ class RVDynamicModel:
         return msgs
 
     def with_errors(self, errors: RVErrors) -> RVDynamicModel:
-        """Same model (same contact analysis) with other errors."""
-        return RVDynamicModel(self.params, errors, contact=self.contact)
+        """Same model (same contact analysis, same damping) with other errors."""
+        new = object.__new__(RVDynamicModel)
+        new.__dict__.update(self.__dict__)
+        if (errors.crank_count, errors.disc_count) != (
+            self.params.crank_count,
+            self.params.disc_count,
+        ):
+            raise ParameterError("errors", (errors.crank_count, errors.disc_count), "wrong counts")
+        new.errors = errors
+        return new
 
     def with_params(self, **changes) -> RVDynamicModel:
         """Model with some parameters changed (contact recomputed when the pair/load changes)."""

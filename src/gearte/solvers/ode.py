@@ -213,8 +213,9 @@ def kernels(rhs, output, key: str):
     )
 
     @njit(cache=True, nogil=True)
-    def dopri5(y0, t0, t_end, h0, h_max, rtol, atol, args, t_settle, rec_dt, rec_idx, rec,
-               max_steps):
+    def dopri5(
+        y0, t0, t_end, h0, h_max, rtol, atol, args, t_settle, rec_dt, rec_idx, rec, max_steps
+    ):
         k = _key  # noqa: F841
         n = y0.size
         y = y0.copy()
@@ -260,9 +261,7 @@ def kernels(rhs, output, key: str):
                 )
             rhs(t + h, tmp, args, k6)
             for i in range(n):
-                yn[i] = y[i] + h * (
-                    b1 * k1[i] + b3 * k3[i] + b4 * k4[i] + b5 * k5[i] + b6 * k6[i]
-                )
+                yn[i] = y[i] + h * (b1 * k1[i] + b3 * k3[i] + b4 * k4[i] + b5 * k5[i] + b6 * k6[i])
             rhs(t + h, yn, args, k7)
             counters[2] += 6
             err = 0.0
@@ -317,6 +316,22 @@ def kernels(rhs, output, key: str):
         return y, stats, nrec, counters, -1
 
     return rk4, dopri5
+
+
+_LIMITS: dict[int, tuple[Any, float]] = {}
+
+
+def _cached_limit(system: ODESystem) -> float:
+    """RK4 stability limit of a system, computed once per eigenvalue array."""
+    ev = system.stability_eigenvalues
+    hit = _LIMITS.get(id(ev))
+    if hit is not None and hit[0] is ev:
+        return hit[1]
+    lim = rk4_stability_limit(ev)
+    if len(_LIMITS) > 64:
+        _LIMITS.clear()
+    _LIMITS[id(ev)] = (ev, lim)
+    return lim
 
 
 def _finish_stats(stats: np.ndarray) -> dict[str, float]:
@@ -389,7 +404,7 @@ def integrate(
         if dt is None or not dt > 0:
             raise ParameterError("dt", dt, "RK4 needs a step > 0 s")
         if system.stability_eigenvalues is not None:
-            lim = rk4_stability_limit(system.stability_eigenvalues)
+            lim = _cached_limit(system)
             if dt > lim:
                 raise ParameterError(
                     "dt",
@@ -424,7 +439,18 @@ def integrate(
         atol_arr = np.broadcast_to(np.asarray(atol, dtype=float), y0.shape).copy()
         _, dp = kernels(system.rhs, system.output, system.key)
         y, stats, nrec, counters, status = dp(
-            y0, t0, t1, h0, t1 - t0, rtol, atol_arr, a, t0 + t_settle, rec_dt, idx, rec,
+            y0,
+            t0,
+            t1,
+            h0,
+            t1 - t0,
+            rtol,
+            atol_arr,
+            a,
+            t0 + t_settle,
+            rec_dt,
+            idx,
+            rec,
             max_steps,
         )
         if status == 1:
