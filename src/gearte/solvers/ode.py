@@ -11,18 +11,23 @@ never stores trajectories. Non-finite states are detected in the loop and raised
 :class:`gearte.errors.DivergenceError`; a fixed RK4 step above the stability limit of the
 linearised system is refused with the limit in the message.
 
-Caching: the kernels are closures over the system's ``rhs``/``output`` compiled with
-``cache=True``. numba keys a cached closure by its byte code and the pickled closure variables;
-the system's ``key`` (a hash of the source file defining the rhs) is one of them, so editing the
-model invalidates the cached kernels instead of silently reusing a stale inlined rhs.
+Caching: the kernels are copies of module-level templates whose globals bind the system's
+``rhs``/``output``, compiled with ``cache=True`` under a name that carries a hash of the source
+files of ``rhs`` and ``output``: editing the model gives a new cache entry instead of silently
+reusing a kernel with a stale inlined rhs (numba itself only checks the kernel's own file). No
+closures: numba keys cached closures by their pickled cells, which change every process.
 """
 
 from __future__ import annotations
 
+import hashlib
+import inspect
 import time
+import types
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -127,195 +132,229 @@ def rk4_stability_limit(eigenvalues: np.ndarray) -> float:
     return float(np.min(limits))
 
 
-@lru_cache(maxsize=16)
-def kernels(rhs, output, key: str):
-    """Compiled (RK4, DOPRI5) kernels specialised on ``rhs``/``output`` (cached on disk)."""
-    _key = key  # closure variable: part of numba's cache index (see module docstring)
+# Placeholders of the templates' free names; each specialised kernel rebinds them (_specialise).
+rhs: Any = None
+output: Any = None
 
-    @njit(cache=True, nogil=True)
-    def _stats_update(stats, o):
-        stats[0] += 1.0
-        if o < stats[1]:
-            stats[1] = o
-        if o > stats[2]:
-            stats[2] = o
-        stats[3] += o
-        stats[4] += o * o
 
-    @njit(cache=True, nogil=True)
-    def rk4(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, rec):
-        k = _key  # noqa: F841 - keeps the key in the closure
-        n = y0.size
-        y = y0.copy()
-        k1 = np.empty(n)
-        k2 = np.empty(n)
-        k3 = np.empty(n)
-        k4 = np.empty(n)
-        tmp = np.empty(n)
-        stats = np.zeros(_STATS)
-        stats[1] = np.inf
-        stats[2] = -np.inf
-        nrec = 0
-        h2 = 0.5 * dt
-        h6 = dt / 6.0
-        if settle_steps == 0:
-            o = output(t0, y, args)
+@njit(cache=True, nogil=True)
+def _stats_update(stats, o):
+    stats[0] += 1.0
+    if o < stats[1]:
+        stats[1] = o
+    if o > stats[2]:
+        stats[2] = o
+    stats[3] += o
+    stats[4] += o * o
+
+
+def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, rec):
+    n = y0.size
+    y = y0.copy()
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    tmp = np.empty(n)
+    stats = np.zeros(_STATS)
+    stats[1] = np.inf
+    stats[2] = -np.inf
+    nrec = 0
+    h2 = 0.5 * dt
+    h6 = dt / 6.0
+    if settle_steps == 0:
+        o = output(t0, y, args)
+        _stats_update(stats, o)
+        if rec_every > 0 and rec.shape[0] > 0:
+            rec[0, 0] = o
+            for c in range(rec_idx.size):
+                rec[0, 1 + c] = y[rec_idx[c]]
+            nrec = 1
+    for s in range(n_steps):
+        t = t0 + s * dt
+        rhs(t, y, args, k1)
+        for i in range(n):
+            tmp[i] = y[i] + h2 * k1[i]
+        rhs(t + h2, tmp, args, k2)
+        for i in range(n):
+            tmp[i] = y[i] + h2 * k2[i]
+        rhs(t + h2, tmp, args, k3)
+        for i in range(n):
+            tmp[i] = y[i] + dt * k3[i]
+        rhs(t + dt, tmp, args, k4)
+        acc = 0.0
+        for i in range(n):
+            y[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            acc += y[i]
+        if not np.isfinite(acc):
+            return y, stats, nrec, s + 1
+        if s + 1 >= settle_steps:
+            o = output(t + dt, y, args)
             _stats_update(stats, o)
-            if rec_every > 0 and rec.shape[0] > 0:
-                rec[0, 0] = o
-                for c in range(rec_idx.size):
-                    rec[0, 1 + c] = y[rec_idx[c]]
-                nrec = 1
-        for s in range(n_steps):
-            t = t0 + s * dt
-            rhs(t, y, args, k1)
-            for i in range(n):
-                tmp[i] = y[i] + h2 * k1[i]
-            rhs(t + h2, tmp, args, k2)
-            for i in range(n):
-                tmp[i] = y[i] + h2 * k2[i]
-            rhs(t + h2, tmp, args, k3)
-            for i in range(n):
-                tmp[i] = y[i] + dt * k3[i]
-            rhs(t + dt, tmp, args, k4)
+            if rec_every > 0 and (s + 1 - settle_steps) % rec_every == 0:
+                if nrec < rec.shape[0]:
+                    rec[nrec, 0] = o
+                    for c in range(rec_idx.size):
+                        rec[nrec, 1 + c] = y[rec_idx[c]]
+                    nrec += 1
+    return y, stats, nrec, -1
+
+
+# Dormand–Prince 5(4) tableau
+c2, c3, c4, c5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
+a21 = 1 / 5
+a31, a32 = 3 / 40, 9 / 40
+a41, a42, a43 = 44 / 45, -56 / 15, 32 / 9
+a51, a52, a53, a54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
+a61, a62, a63, a64, a65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
+b1, b3, b4, b5, b6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
+e1, e3, e4, e5, e6, e7 = (
+    71 / 57600,
+    -71 / 16695,
+    71 / 1920,
+    -17253 / 339200,
+    22 / 525,
+    -1 / 40,
+)
+
+
+def _dopri5_template(
+    y0, t0, t_end, h0, h_max, rtol, atol, args, t_settle, rec_dt, rec_idx, rec, max_steps
+):
+    n = y0.size
+    y = y0.copy()
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    yn = np.empty(n)
+    tmp = np.empty(n)
+    stats = np.zeros(_STATS)
+    stats[1] = np.inf
+    stats[2] = -np.inf
+    counters = np.zeros(3)  # accepted, rejected, rhs evaluations
+    t = t0
+    h = h0
+    rhs(t, y, args, k1)
+    counters[2] += 1
+    next_rec = t_settle
+    nrec = 0
+    while t < t_end:
+        if counters[0] + counters[1] >= max_steps:
+            return y, stats, nrec, counters, -2
+        if t + h > t_end:
+            h = t_end - t
+        for i in range(n):
+            tmp[i] = y[i] + h * a21 * k1[i]
+        rhs(t + c2 * h, tmp, args, k2)
+        for i in range(n):
+            tmp[i] = y[i] + h * (a31 * k1[i] + a32 * k2[i])
+        rhs(t + c3 * h, tmp, args, k3)
+        for i in range(n):
+            tmp[i] = y[i] + h * (a41 * k1[i] + a42 * k2[i] + a43 * k3[i])
+        rhs(t + c4 * h, tmp, args, k4)
+        for i in range(n):
+            tmp[i] = y[i] + h * (a51 * k1[i] + a52 * k2[i] + a53 * k3[i] + a54 * k4[i])
+        rhs(t + c5 * h, tmp, args, k5)
+        for i in range(n):
+            tmp[i] = y[i] + h * (
+                a61 * k1[i] + a62 * k2[i] + a63 * k3[i] + a64 * k4[i] + a65 * k5[i]
+            )
+        rhs(t + h, tmp, args, k6)
+        for i in range(n):
+            yn[i] = y[i] + h * (b1 * k1[i] + b3 * k3[i] + b4 * k4[i] + b5 * k5[i] + b6 * k6[i])
+        rhs(t + h, yn, args, k7)
+        counters[2] += 6
+        err = 0.0
+        for i in range(n):
+            ei = h * (e1 * k1[i] + e3 * k3[i] + e4 * k4[i] + e5 * k5[i] + e6 * k6[i] + e7 * k7[i])
+            sc = atol[i] + rtol * max(abs(y[i]), abs(yn[i]))
+            err += (ei / sc) ** 2
+        err = np.sqrt(err / n)
+        if not np.isfinite(err):
+            if h < 1e-14:
+                return y, stats, nrec, counters, 1
+            h *= 0.1
+            counters[1] += 1
+            continue
+        if err <= 1.0:
+            t_new = t + h
+            # record on the uniform grid by cubic Hermite interpolation of the step
+            while next_rec <= t_new + 1e-15 and t_new > t:
+                th = (next_rec - t) / h
+                h00 = 2 * th**3 - 3 * th**2 + 1
+                h10 = th**3 - 2 * th**2 + th
+                h01 = -2 * th**3 + 3 * th**2
+                h11 = th**3 - th**2
+                for i in range(n):
+                    tmp[i] = h00 * y[i] + h10 * h * k1[i] + h01 * yn[i] + h11 * h * k7[i]
+                o = output(next_rec, tmp, args)
+                _stats_update(stats, o)
+                if nrec < rec.shape[0]:
+                    rec[nrec, 0] = o
+                    for c in range(rec_idx.size):
+                        rec[nrec, 1 + c] = tmp[rec_idx[c]]
+                    nrec += 1
+                next_rec += rec_dt
+            t = t_new
             acc = 0.0
             for i in range(n):
-                y[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+                y[i] = yn[i]
+                k1[i] = k7[i]
                 acc += y[i]
             if not np.isfinite(acc):
-                return y, stats, nrec, s + 1
-            if s + 1 >= settle_steps:
-                o = output(t + dt, y, args)
-                _stats_update(stats, o)
-                if rec_every > 0 and (s + 1 - settle_steps) % rec_every == 0:
-                    if nrec < rec.shape[0]:
-                        rec[nrec, 0] = o
-                        for c in range(rec_idx.size):
-                            rec[nrec, 1 + c] = y[rec_idx[c]]
-                        nrec += 1
-        return y, stats, nrec, -1
+                return y, stats, nrec, counters, 1
+            counters[0] += 1
+            fac = 0.9 * err ** (-0.2) if err > 0 else 5.0
+            h = h * min(5.0, max(0.2, fac))
+        else:
+            counters[1] += 1
+            h = h * max(0.2, 0.9 * err ** (-0.2))
+        if h > h_max:
+            h = h_max
+    return y, stats, nrec, counters, -1
 
-    # Dormand–Prince 5(4) tableau
-    c2, c3, c4, c5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
-    a21 = 1 / 5
-    a31, a32 = 3 / 40, 9 / 40
-    a41, a42, a43 = 44 / 45, -56 / 15, 32 / 9
-    a51, a52, a53, a54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
-    a61, a62, a63, a64, a65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
-    b1, b3, b4, b5, b6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
-    e1, e3, e4, e5, e6, e7 = (
-        71 / 57600,
-        -71 / 16695,
-        71 / 1920,
-        -17253 / 339200,
-        22 / 525,
-        -1 / 40,
+
+def _specialise(template, rhs, output, key: str, name: str):
+    """A copy of ``template`` whose globals bind ``rhs``/``output``, compiled with cache=True.
+
+    numba files a cached function under its module and ``__qualname__`` and checks the source
+    file's time stamp; the qualname carries ``key`` (a hash of the files defining rhs and output),
+    so a changed model gets a new cache entry instead of a stale kernel with the old rhs inlined.
+    """
+    g = dict(template.__globals__)
+    g["rhs"] = rhs
+    g["output"] = output
+    fn = types.FunctionType(template.__code__, g, f"{name}_{key}", template.__defaults__, None)
+    fn.__qualname__ = f"{name}_{key}"
+    fn.__module__ = template.__module__
+    return njit(cache=True, nogil=True)(fn)
+
+
+def _source_key(*funcs) -> str:
+    h = hashlib.sha256()
+    for f in funcs:
+        py = getattr(f, "py_func", f)
+        h.update(py.__module__.encode())
+        h.update(py.__qualname__.encode())
+        h.update(Path(inspect.getsourcefile(py)).read_bytes())
+    return h.hexdigest()[:16]
+
+
+@lru_cache(maxsize=16)
+def kernels(rhs, output, key: str = ""):
+    """Compiled (RK4, DOPRI5) kernels specialised on ``rhs``/``output`` (cached on disk).
+
+    The cache key combines ``key`` with a hash of the source files of ``rhs`` and ``output``.
+    """
+    k = hashlib.sha256((key + _source_key(rhs, output)).encode()).hexdigest()[:16]
+    return (
+        _specialise(_rk4_template, rhs, output, k, "rk4"),
+        _specialise(_dopri5_template, rhs, output, k, "dopri5"),
     )
-
-    @njit(cache=True, nogil=True)
-    def dopri5(
-        y0, t0, t_end, h0, h_max, rtol, atol, args, t_settle, rec_dt, rec_idx, rec, max_steps
-    ):
-        k = _key  # noqa: F841
-        n = y0.size
-        y = y0.copy()
-        k1 = np.empty(n)
-        k2 = np.empty(n)
-        k3 = np.empty(n)
-        k4 = np.empty(n)
-        k5 = np.empty(n)
-        k6 = np.empty(n)
-        k7 = np.empty(n)
-        yn = np.empty(n)
-        tmp = np.empty(n)
-        stats = np.zeros(_STATS)
-        stats[1] = np.inf
-        stats[2] = -np.inf
-        counters = np.zeros(3)  # accepted, rejected, rhs evaluations
-        t = t0
-        h = h0
-        rhs(t, y, args, k1)
-        counters[2] += 1
-        next_rec = t_settle
-        nrec = 0
-        while t < t_end:
-            if counters[0] + counters[1] >= max_steps:
-                return y, stats, nrec, counters, -2
-            if t + h > t_end:
-                h = t_end - t
-            for i in range(n):
-                tmp[i] = y[i] + h * a21 * k1[i]
-            rhs(t + c2 * h, tmp, args, k2)
-            for i in range(n):
-                tmp[i] = y[i] + h * (a31 * k1[i] + a32 * k2[i])
-            rhs(t + c3 * h, tmp, args, k3)
-            for i in range(n):
-                tmp[i] = y[i] + h * (a41 * k1[i] + a42 * k2[i] + a43 * k3[i])
-            rhs(t + c4 * h, tmp, args, k4)
-            for i in range(n):
-                tmp[i] = y[i] + h * (a51 * k1[i] + a52 * k2[i] + a53 * k3[i] + a54 * k4[i])
-            rhs(t + c5 * h, tmp, args, k5)
-            for i in range(n):
-                tmp[i] = y[i] + h * (
-                    a61 * k1[i] + a62 * k2[i] + a63 * k3[i] + a64 * k4[i] + a65 * k5[i]
-                )
-            rhs(t + h, tmp, args, k6)
-            for i in range(n):
-                yn[i] = y[i] + h * (b1 * k1[i] + b3 * k3[i] + b4 * k4[i] + b5 * k5[i] + b6 * k6[i])
-            rhs(t + h, yn, args, k7)
-            counters[2] += 6
-            err = 0.0
-            for i in range(n):
-                ei = h * (
-                    e1 * k1[i] + e3 * k3[i] + e4 * k4[i] + e5 * k5[i] + e6 * k6[i] + e7 * k7[i]
-                )
-                sc = atol[i] + rtol * max(abs(y[i]), abs(yn[i]))
-                err += (ei / sc) ** 2
-            err = np.sqrt(err / n)
-            if not np.isfinite(err):
-                if h < 1e-14:
-                    return y, stats, nrec, counters, 1
-                h *= 0.1
-                counters[1] += 1
-                continue
-            if err <= 1.0:
-                t_new = t + h
-                # record on the uniform grid by cubic Hermite interpolation of the step
-                while next_rec <= t_new + 1e-15 and t_new > t:
-                    th = (next_rec - t) / h
-                    h00 = 2 * th**3 - 3 * th**2 + 1
-                    h10 = th**3 - 2 * th**2 + th
-                    h01 = -2 * th**3 + 3 * th**2
-                    h11 = th**3 - th**2
-                    for i in range(n):
-                        tmp[i] = h00 * y[i] + h10 * h * k1[i] + h01 * yn[i] + h11 * h * k7[i]
-                    o = output(next_rec, tmp, args)
-                    _stats_update(stats, o)
-                    if nrec < rec.shape[0]:
-                        rec[nrec, 0] = o
-                        for c in range(rec_idx.size):
-                            rec[nrec, 1 + c] = tmp[rec_idx[c]]
-                        nrec += 1
-                    next_rec += rec_dt
-                t = t_new
-                acc = 0.0
-                for i in range(n):
-                    y[i] = yn[i]
-                    k1[i] = k7[i]
-                    acc += y[i]
-                if not np.isfinite(acc):
-                    return y, stats, nrec, counters, 1
-                counters[0] += 1
-                fac = 0.9 * err ** (-0.2) if err > 0 else 5.0
-                h = h * min(5.0, max(0.2, fac))
-            else:
-                counters[1] += 1
-                h = h * max(0.2, 0.9 * err ** (-0.2))
-            if h > h_max:
-                h = h_max
-        return y, stats, nrec, counters, -1
-
-    return rk4, dopri5
 
 
 _LIMITS: dict[int, tuple[Any, float]] = {}
@@ -413,7 +452,9 @@ def integrate(
                     f"|λ| = {np.max(np.abs(system.stability_eigenvalues)):.4g} 1/s); use dt ≤ "
                     f"{lim:.4g} s",
                 )
-        n_steps = int(round((t1 - t0) / dt))
+        # end exactly at t1: the step is shortened (never lengthened) to fit the span
+        n_steps = max(1, int(np.ceil((t1 - t0) / dt - 1e-9)))
+        dt = (t1 - t0) / n_steps
         settle_steps = int(round(t_settle / dt))
         if record_dt is None:
             rec_every, n_rec = 0, 0
