@@ -391,10 +391,8 @@ def _bearing(dx, dy, vx, vy, k, c, cl):
 
 
 @njit(cache=True, nogil=True)
-def _fourier(mean, coef, phase):
-    """mean + Σ_l a_l cos(l s) + b_l sin(l s) by the angle-addition recurrence (one sin/cos)."""
-    c1 = np.cos(phase)
-    s1 = np.sin(phase)
+def _fourier2(mean, coef, c1, s1):
+    """mean + Σ_l a_l cos(l s) + b_l sin(l s) given cos s and sin s (angle-addition recurrence)."""
     c = c1
     s = s1
     val = mean
@@ -410,9 +408,11 @@ def rv_rhs(t, y, args, dydt):
 
     y = [q (6M+3N+6), q̇]; q per body (x [mm], y [mm], θ [rad]) in the order sun, planets 1..M,
     cranks 1..M, discs 1..N, output. ``args`` = (pf, inv_mass, fsp, fcr, err_g, err_m, err_mn,
-    err_n) from :meth:`RVDynamicModel.kernel_args`.
+    err_n, geo_m, geo_n) from :meth:`RVDynamicModel.kernel_args`; errors are given there as
+    body-fixed Cartesian offsets (E cos β, E sin β) and rotated here with the body, so the only
+    trigonometric calls per evaluation are the five nominal angles.
     """
-    pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n = args
+    pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n, geo_m, geo_n = args
     nm = int(pf[30])
     nn = int(pf[31])
     nd = 3 * (2 * nm + nn + 2)
@@ -426,54 +426,71 @@ def rv_rhs(t, y, args, dydt):
     th_o = w_o * t
     th_s = pf[1] * th_o
     th_h = pf[3] + pf[2] * th_o
+    co = np.cos(th_o)
+    so = np.sin(th_o)
+    cs = np.cos(th_s)
+    ss = np.sin(th_s)
+    chh = np.cos(th_h)
+    shh = np.sin(th_h)
+    ph_s = pf[8] * (th_s - th_o)
+    cps0 = np.cos(ph_s)
+    sps0 = np.sin(ph_s)
+    ph_c = pf[9] * th_h
+    cpc0 = np.cos(ph_c)
+    spc0 = np.sin(ph_c)
     a_h = pf[4]
     ecc = pf[5]
     r_bs = pf[6]
-    alpha = pf[7]
+    ca = np.cos(pf[7])
+    sa = np.sin(pf[7])
     br = pf[21]
     i_out = nd - 3
     # sun support (ground seat offset = sun assembly error) and input shaft torsion
     k = pf[10]
-    ox = err_g[1, 0] * np.cos(err_g[1, 1])
-    oy = err_g[1, 0] * np.sin(err_g[1, 1])
-    fx, fy = _bearing(q[0] - ox, q[1] - oy, v[0], v[1], k, br * k, 0.0)
+    fx, fy = _bearing(q[0] - err_g[1, 0], q[1] - err_g[1, 1], v[0], v[1], k, br * k, 0.0)
     f[0] += fx
     f[1] += fy
     k = pf[11]
     f[2] += -k * q[2] - br * k * v[2]
-    # involute mesh stiffness (eq 11), same phase for every planet when z_s M-periodic
-    ks_m = pf[12]
     # output support
     k = pf[18]
-    ox = err_g[2, 0] * np.cos(err_g[2, 1])
-    oy = err_g[2, 0] * np.sin(err_g[2, 1])
-    fx, fy = _bearing(q[i_out] - ox, q[i_out + 1] - oy, v[i_out], v[i_out + 1], k, br * k, pf[28])
+    fx, fy = _bearing(
+        q[i_out] - err_g[2, 0],
+        q[i_out + 1] - err_g[2, 1],
+        v[i_out],
+        v[i_out + 1],
+        k,
+        br * k,
+        pf[28],
+    )
     f[i_out] += fx
     f[i_out + 1] += fy
     # sun eccentricity offset (rotates with the sun)
-    sex = err_g[0, 0] * np.cos(th_s + err_g[0, 1])
-    sey = err_g[0, 0] * np.sin(th_s + err_g[0, 1])
-    two_pi = 2.0 * np.pi
+    sex = err_g[0, 0] * cs - err_g[0, 1] * ss
+    sey = err_g[0, 0] * ss + err_g[0, 1] * cs
+    w2 = w_o * w_o * a_h
     for i in range(nm):
         ip = 3 * (1 + i)
         ih = 3 * (1 + nm + i)
-        psi = th_o + two_pi * i / nm
-        cps = np.cos(psi)
-        sps = np.sin(psi)
+        cps = co * geo_m[i, 0] - so * geo_m[i, 1]  # psi_i = th_o + 2π i / M
+        sps = so * geo_m[i, 0] + co * geo_m[i, 1]
         chx = a_h * cps
         chy = a_h * sps
         # sun–planet mesh i: line of action tangent to the sun base circle at angle psi − alpha
-        ta = psi - alpha
-        tx = np.cos(ta)
-        ty = np.sin(ta)
+        tx = cps * ca + sps * sa
+        ty = sps * ca - cps * sa
         nx = -ty
         ny = tx
         px = r_bs * tx
         py = r_bs * ty
-        s_ph = pf[8] * (th_s - th_o) + pf[8] * two_pi * i / nm
-        ksp = _fourier(ks_m, fsp, s_ph)
-        pex = err_m[i, 0, 0] * np.cos(th_h + err_m[i, 0, 1])
-        pey = err_m[i, 0, 0] * np.sin(th_h + err_m[i, 0, 1])
+        ksp = _fourier2(
+            pf[12],
+            fsp,
+            cps0 * geo_m[i, 2] - sps0 * geo_m[i, 3],
+            sps0 * geo_m[i, 2] + cps0 * geo_m[i, 3],
+        )
+        pex = err_m[i, 0, 0] * chh - err_m[i, 0, 1] * shh
+        pey = err_m[i, 0, 0] * shh + err_m[i, 0, 1] * chh
         ga_t = px * ny - py * nx  # arm of the sun
         gb_t = (px - chx) * ny - (py - chy) * nx  # arm of the planet
         d = (
@@ -513,8 +530,8 @@ def rv_rhs(t, y, args, dydt):
         f[ih + 2] -= tq
         # crank support bearing in the output disc (hole offset rotates with the output)
         k = pf[15]
-        ox = err_m[i, 1, 0] * np.cos(psi + err_m[i, 1, 1])
-        oy = err_m[i, 1, 0] * np.sin(psi + err_m[i, 1, 1])
+        ox = err_m[i, 1, 0] * cps - err_m[i, 1, 1] * sps
+        oy = err_m[i, 1, 0] * sps + err_m[i, 1, 1] * cps
         # output material point at c_H: u_o + θ_o ẑ×c_H
         dx = q[ih] - (q[i_out] - q[i_out + 2] * chy) - ox
         dy = q[ih + 1] - (q[i_out + 1] + q[i_out + 2] * chx) - oy
@@ -527,59 +544,60 @@ def rv_rhs(t, y, args, dydt):
         f[i_out + 1] -= fy
         f[i_out + 2] -= chx * fy - chy * fx
         # centripetal load of the carried planet and crank (nominal circular motion)
-        w2 = w_o * w_o * a_h
         f[ip] += pf[23] * w2 * cps
         f[ip + 1] += pf[23] * w2 * sps
         f[ih] += pf[24] * w2 * cps
         f[ih + 1] += pf[24] * w2 * sps
     # discs
     w_h = pf[2] * w_o
+    sb = np.sin(pf[19])
+    cb = np.cos(pf[19])
     for j in range(nn):
         ic = 3 * (1 + 2 * nm + j)
-        chi = th_h + np.pi * j
-        ex = np.cos(chi)
-        ey = np.sin(chi)
+        ex = chh * geo_n[j, 0] - shh * geo_n[j, 1]  # chi_j = th_h + π j
+        ey = shh * geo_n[j, 0] + chh * geo_n[j, 1]
         ccx = ecc * ex
         ccy = ecc * ey
         for i in range(nm):
             ih = 3 * (1 + nm + i)
-            psi = th_o + two_pi * i / nm
-            chx = a_h * np.cos(psi)
-            chy = a_h * np.sin(psi)
+            cps = co * geo_m[i, 0] - so * geo_m[i, 1]
+            sps = so * geo_m[i, 0] + co * geo_m[i, 1]
+            chx = a_h * cps
+            chy = a_h * sps
             # turning-arm bearing at the cam centre C = c_H + e ê_χ
-            cx = chx + ccx
-            cy = chy + ccy
             k = pf[16]
-            amx = err_mn[i, j, 1, 0] * np.cos(chi + err_mn[i, j, 1, 1])  # cam (with crank)
-            amy = err_mn[i, j, 1, 0] * np.sin(chi + err_mn[i, j, 1, 1])
-            hox = err_mn[i, j, 0, 0] * np.cos(psi + err_mn[i, j, 0, 1])  # hole (with disc)
-            hoy = err_mn[i, j, 0, 0] * np.sin(psi + err_mn[i, j, 0, 1])
-            rax = cx - chx
-            ray = cy - chy
-            rbx = cx - ccx
-            rby = cy - ccy
-            dx = (q[ih] - q[ih + 2] * ray) - (q[ic] - q[ic + 2] * rby) + amx - hox
-            dy = (q[ih + 1] + q[ih + 2] * rax) - (q[ic + 1] + q[ic + 2] * rbx) + amy - hoy
-            vx = (v[ih] - v[ih + 2] * ray) - (v[ic] - v[ic + 2] * rby)
-            vy = (v[ih + 1] + v[ih + 2] * rax) - (v[ic + 1] + v[ic + 2] * rbx)
+            amx = err_mn[i, j, 1, 0] * ex - err_mn[i, j, 1, 1] * ey  # cam (with crank)
+            amy = err_mn[i, j, 1, 0] * ey + err_mn[i, j, 1, 1] * ex
+            hox = err_mn[i, j, 0, 0] * cps - err_mn[i, j, 0, 1] * sps  # hole (with disc)
+            hoy = err_mn[i, j, 0, 0] * sps + err_mn[i, j, 0, 1] * cps
+            # arms: C − c_H = e ê_χ (crank), C − c_c = c_H (disc)
+            dx = (q[ih] - q[ih + 2] * ccy) - (q[ic] - q[ic + 2] * chy) + amx - hox
+            dy = (q[ih + 1] + q[ih + 2] * ccx) - (q[ic + 1] + q[ic + 2] * chx) + amy - hoy
+            vx = (v[ih] - v[ih + 2] * ccy) - (v[ic] - v[ic + 2] * chy)
+            vy = (v[ih + 1] + v[ih + 2] * ccx) - (v[ic + 1] + v[ic + 2] * chx)
             fx, fy = _bearing(dx, dy, vx, vy, k, br * k, pf[27])
             f[ih] += fx
             f[ih + 1] += fy
-            f[ih + 2] += rax * fy - ray * fx
+            f[ih + 2] += ccx * fy - ccy * fx
             f[ic] -= fx
             f[ic + 1] -= fy
-            f[ic + 2] -= rbx * fy - rby * fx
+            f[ic + 2] -= chx * fy - chy * fx
         # equivalent cycloid–pin contact at the pitch point P = z_p e ê_χ (eq 27, rotating)
-        s_ph = pf[9] * chi
-        kcr = _fourier(pf[17], fcr, s_ph)
-        b = pf[19]
+        kcr = _fourier2(
+            pf[17],
+            fcr,
+            cpc0 * geo_n[j, 2] - spc0 * geo_n[j, 3],
+            spc0 * geo_n[j, 2] + cpc0 * geo_n[j, 3],
+        )
         # force on the disc along d = sgn sinβ ê + cosβ ẑ×ê ; approach direction n = −d
-        nx = -(pf[20] * np.sin(b) * ex - np.cos(b) * ey)
-        ny = -(pf[20] * np.sin(b) * ey + np.cos(b) * ex)
-        rx = pf[9] * ccx - ccx
-        ry = pf[9] * ccy - ccy
+        nx = -(pf[20] * sb * ex - cb * ey)
+        ny = -(pf[20] * sb * ey + cb * ex)
+        rx = (pf[9] - 1.0) * ccx
+        ry = (pf[9] - 1.0) * ccy
         g_t = rx * ny - ry * nx
-        ecr = err_n[j, 0] * np.sin(th_o + err_n[j, 1])
+        ecr = (
+            err_n[j, 0] * so + err_n[j, 1] * co
+        )  # E sin(th_o + φ) = E cosφ sin th_o + E sinφ cos th_o
         d = nx * q[ic] + ny * q[ic + 1] + g_t * q[ic + 2] + ecr
         dv = nx * v[ic] + ny * v[ic + 1] + g_t * v[ic + 2]
         fn = -kcr * d - br * kcr * dv
@@ -725,9 +743,23 @@ class RVDynamicModel:
         }
         for key, val in vals.items():
             pf[_P[key]] = val
-        err_g = np.array([e.sun_eccentricity, e.sun_assembly, e.output_assembly], dtype=float)
-        err_m = np.stack([e.planet_eccentricity, e.carrier_hole], axis=1)
-        err_mn = np.stack([e.disc_hole, e.cam], axis=2)
+
+        def cart(a):
+            a = np.asarray(a, dtype=float)
+            return np.stack([a[..., 0] * np.cos(a[..., 1]), a[..., 0] * np.sin(a[..., 1])], -1)
+
+        err_g = cart([e.sun_eccentricity, e.sun_assembly, e.output_assembly])
+        err_m = cart(np.stack([e.planet_eccentricity, e.carrier_hole], axis=1))
+        err_mn = cart(np.stack([e.disc_hole, e.cam], axis=2))
+        pin = np.asarray(e.pin_composite, dtype=float)
+        m, n = p.crank_count, p.disc_count
+        om = 2 * np.pi * np.arange(m) / m
+        on = np.pi * np.arange(n)
+        geo_m = np.stack(
+            [np.cos(om), np.sin(om), np.cos(p.sun_teeth * om), np.sin(p.sun_teeth * om)], 1
+        )
+        zp = p.pair.pin_count
+        geo_n = np.stack([np.cos(on), np.sin(on), np.cos(zp * on), np.sin(zp * on)], 1)
         return (
             pf,
             1.0 / self.mass,
@@ -736,7 +768,9 @@ class RVDynamicModel:
             np.ascontiguousarray(err_g),
             np.ascontiguousarray(err_m),
             np.ascontiguousarray(err_mn),
-            np.ascontiguousarray(e.pin_composite),
+            np.ascontiguousarray(cart(pin)),
+            np.ascontiguousarray(geo_m),
+            np.ascontiguousarray(geo_n),
         )
 
     # --- plain element model (readable twin) ------------------------------------------------
