@@ -185,3 +185,19 @@ def test_bad_parameters():
         RVDynamicsParameters(cycloid_stiffness="spline")
     with pytest.raises(ParameterError, match="disc_hole"):
         RVErrors(disc_hole=np.zeros((2, 2, 2)))
+
+
+def test_paper_stiffness_puts_first_mode_near_cycloid_mesh():
+    """With the paper's printed k_cr = 2.62e8 N/m and β = 3.8° the output's torsional mode
+    falls near the cycloid mesh frequency (322 Hz at 1500 rpm): the model must warn."""
+    m = RVDynamicModel(
+        RVDynamicsParameters(
+            pair=LI2023_PAIR_MODIFIED,
+            cycloid_stiffness="mean",
+            cycloid_mesh_stiffness_N_per_m=2.62e8,
+            cycloid_pressure_angle_deg=3.8,
+        )
+    )
+    assert m.cycloid_fourier[0] == pytest.approx(2.62e5)
+    assert 300.0 < m.modal().frequencies[0] < 360.0
+    assert any("cycloid mesh" in w for w in m.resonance_warnings(0.1))

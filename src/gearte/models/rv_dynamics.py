@@ -98,7 +98,9 @@ class RVDynamicsParameters:
     ``involute_single_pair_stiffness_N_per_m`` (ISO 6336 c' ≈ 14 N/(mm·µm) × 10 mm face width),
     ``damping_ratio`` ζ of the lowest elastic mode.
     ``cycloid_stiffness``: "fourier" (time-varying k_cr from the loaded contact, eq 13) or "mean"
-    (its mean only, as paper 004 §4.1 does).
+    (its mean only, as paper 004 §4.1 does). ``cycloid_mesh_stiffness_N_per_m`` and
+    ``cycloid_pressure_angle_deg`` override the contact analysis' mean k_cr (the ripple is scaled
+    with it) and β, e.g. to feed the paper's printed 2.62e8 N/m and 3.8°.
     Operating point: ``input_speed_rpm``, ``output_torque_Nm`` (450 N·m, split equally over the
     discs for the contact analysis).
     """
@@ -133,6 +135,8 @@ class RVDynamicsParameters:
     contact_positions: int = 48
     damping_ratio: float = 0.03
     cycloid_stiffness: str = "fourier"
+    cycloid_mesh_stiffness_N_per_m: float | None = None  # noqa: N815
+    cycloid_pressure_angle_deg: float | None = None
     input_speed_rpm: float = 1500.0
     output_torque_Nm: float = 450.0  # noqa: N815
     crank_phase_deg: float = 0.0
@@ -152,6 +156,8 @@ class RVDynamicsParameters:
                 raise ParameterError(name, getattr(self, name), f"must be an integer ≥ {lo}")
         for name, val in self.__dict__.items():
             if name in ints or name in ("pair", "crank_phase_deg", "cycloid_stiffness"):
+                continue
+            if val is None and name.startswith("cycloid_"):
                 continue
             if not (np.isfinite(val) and val > 0):
                 raise ParameterError(name, val, "must be finite and > 0")
@@ -664,8 +670,13 @@ class RVDynamicModel:
         k_cr_mean, a_cr, b_cr = fourier_fit(self.contact.mesh_stiffness, p.cycloid_harmonics)
         if p.cycloid_stiffness == "mean":  # paper 004 §4.1 feeds the mean into the model
             a_cr, b_cr = np.zeros_like(a_cr), np.zeros_like(b_cr)
+        if p.cycloid_mesh_stiffness_N_per_m is not None:
+            scale = p.cycloid_mesh_stiffness_N_per_m * N_PER_M_TO_N_PER_MM / k_cr_mean
+            k_cr_mean, a_cr, b_cr = k_cr_mean * scale, a_cr * scale, b_cr * scale
         self.cycloid_fourier = (k_cr_mean, a_cr, b_cr)  # N/mm
         self.beta_cr = self.contact.pressure_angle_mean
+        if p.cycloid_pressure_angle_deg is not None:
+            self.beta_cr = float(np.deg2rad(p.cycloid_pressure_angle_deg))
         sr = float(np.sum(self.contact.contact.radial_force_signed))
         self.sgn_radial = 1.0 if sr >= 0 else -1.0
         alpha = np.deg2rad(p.pressure_angle_deg)

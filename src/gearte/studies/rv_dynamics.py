@@ -85,6 +85,12 @@ class Dynamics(StrictModel):
     cycloid_stiffness: Literal["fourier", "mean"] = Field(
         "fourier", description="time-varying k_cr (Fourier) or its mean (as the paper)"
     )
+    cycloid_mesh_stiffness_N_per_m: float | None = Field(  # noqa: N815
+        None, gt=0, le=1e12, description="override of the mean k_cr (paper prints 2.62e8)"
+    )
+    cycloid_pressure_angle_deg: float | None = Field(
+        None, ge=0, lt=90, description="override of the equivalent pressure angle β"
+    )
     involute_harmonics: int = Field(10, ge=1, le=60)
     cycloid_harmonics: int = Field(8, ge=1, le=30)
 
