@@ -1,0 +1,312 @@
+"""Loaded tooth contact of a cycloid disc on its pins (Hu et al. 2020, section 4, eq 28–47).
+
+Units: mm, N, N·mm, MPa, rad.
+
+Model as read (see docs/validation/hu2020.md for the garbled print)::
+
+    l_i      = r_c sin φ_i / S_i,  r_c = a z_c                                  (36)
+    δ_i      = (l_i / r_c) δ_max        normal approach of pin i                (37)
+    δ_max    = 2 F_max (1−μ²)/(π E b) · (2/3 + ln(16 r |ρ| / c²))                (38)
+    c        = 4.99e-3 · (4 (1−μ²) F_max |ρ| r / (E b (|ρ| + r)))^½              (39, as printed)
+    ρ        = curvature radius at φ0 = arccos K1 (eq 40), r = r_rp + Δr_rp
+    in mesh  ⇔ δ_i > Δ_i (eq 32 clearance), loaded flank sin φ_i > 0
+    F_i      = (δ_i − Δ_i)/δ_max · F_max                                          (41)
+    T_c      = Σ F_i l_i   ⇒   F_max = T_c / Σ (l_i/r_c − Δ_i/δ_max) l_i          (42–44)
+    T_c      = s T,  s = 0.55 in the paper (uneven split between the two discs)
+
+``F_max`` is the force the model assigns to a pin at the point of largest arm (l = r_c): the
+paper's "maximum contact force". The largest force actually carried by a pin at a given mesh
+position, ``max_i F_i``, is at most F_max (equal when a pin sits at φ0).
+
+The 4.99e-3 factor of eq 39 is not the classical Hertz half-width constant; the printed form is
+kept because it is what reproduces Tables 4–5 and 7–8 (δ_max = 0.0116 mm at 1910.3 N).
+
+References
+----------
+Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from gearte.errors import ParameterError
+from gearte.geometry.cycloid import CycloidStage
+from gearte.solvers.contact import solve_load_sharing, solve_load_sharing_plain
+
+__all__ = [
+    "compliance_constants",
+    "half_width",
+    "max_normal_deformation",
+    "pin_approach",
+    "pin_forces",
+    "start_force",
+    "ToothContact",
+    "tooth_contact",
+]
+
+#: The constant of eq 39 as printed.
+HALF_WIDTH_FACTOR = 4.99e-3
+
+
+def compliance_constants(
+    rho: float, r: float, E: float, mu: float, b: float
+) -> tuple[float, float]:
+    """Constants (A [mm/N], B [N]) with δ_max(F) = A F (2/3 + ln(B/F)) (eq 38–39).
+
+    Parameters
+    ----------
+    rho : float
+        Curvature radius of the disc profile at φ0 [mm] (sign ignored).
+    r : float
+        Pin radius [mm].
+    E : float
+        Young's modulus of disc and pins [MPa].
+    mu : float
+        Poisson's ratio [-].
+    b : float
+        Face width of one disc [mm].
+    """
+    for name, v in (("rho", abs(rho)), ("r", r), ("E", E), ("b", b)):
+        if not (math.isfinite(v) and v > 0.0):
+            raise ParameterError(name, v, "must be finite and > 0")
+    if not (0.0 <= mu < 0.5):
+        raise ParameterError("mu", mu, "Poisson's ratio must be in [0, 0.5)")
+    rho = abs(rho)
+    A = 2.0 * (1.0 - mu * mu) / (math.pi * E * b)
+    c2_per_F = HALF_WIDTH_FACTOR**2 * 4.0 * (1.0 - mu * mu) * rho * r / (E * b * (rho + r))
+    B = 16.0 * r * rho / c2_per_F
+    return A, B
+
+
+def half_width(F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float) -> np.ndarray:
+    """Contact 'half-width' c of eq 39 as printed [mm].
+
+    ``c = 4.99e-3 (4 (1−μ²) F |ρ| r / (E b (|ρ| + r)))^½`` with F [N], ρ, r, b [mm], E [MPa].
+    """
+    F = np.asarray(F, dtype=float)
+    rho = abs(rho)
+    return HALF_WIDTH_FACTOR * np.sqrt(4.0 * (1.0 - mu * mu) * F * rho * r / (E * b * (rho + r)))
+
+
+def max_normal_deformation(
+    F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float
+) -> np.ndarray:
+    """Maximum normal deformation δ_max [mm] under the pin force F [N] (eq 38).
+
+    Parameters
+    ----------
+    F : array_like
+        Maximum contact force F_max [N].
+    rho, r, E, mu, b
+        As in :func:`compliance_constants`.
+
+    Examples
+    --------
+    >>> round(float(max_normal_deformation(1910.3, -43.598, 2.978, 2.06e5, 0.3, 11.0)), 4)
+    0.0116
+    """
+    F = np.asarray(F, dtype=float)
+    c = half_width(F, rho, r, E, mu, b)
+    return (
+        2.0
+        * F
+        * (1.0 - mu * mu)
+        / (math.pi * E * b)
+        * (2.0 / 3.0 + np.log(16.0 * r * abs(rho) / c**2))
+    )
+
+
+def pin_approach(lr: ArrayLike, delta_max: ArrayLike) -> np.ndarray:
+    """Normal approach δ_i = (l_i/r_c) δ_max [mm] (eq 37); negative on the unloaded flank."""
+    return np.asarray(lr, dtype=float) * np.asarray(delta_max, dtype=float)[..., None]
+
+
+def pin_forces(
+    approach: ArrayLike, clearance: ArrayLike, delta_max: ArrayLike, F_max: ArrayLike
+) -> np.ndarray:
+    """Contact force per pin F_i = max(δ_i − Δ_i, 0)/δ_max · F_max [N] (eq 41)."""
+    approach = np.asarray(approach, dtype=float)
+    gap = np.maximum(approach - np.asarray(clearance, dtype=float), 0.0)
+    dm = np.asarray(delta_max, dtype=float)[..., None]
+    return gap / dm * np.asarray(F_max, dtype=float)[..., None]
+
+
+def start_force(T_c: float, K1: float, z_c: int, r_p: float) -> float:
+    """The paper's start value F_max⁰ = ½ (F1 + F2) [N] (eq 45–47, sign restored).
+
+    F1 = 4 T_c / (K1 z_c r_p) (eq 30: all z_p/2 pins loaded, no modification) and F2 = T_c / r_p
+    (one pin). Any positive start gives the same solution (the fixed point is unique).
+    """
+    return 0.5 * (4.0 * T_c / (K1 * z_c * r_p) + T_c / r_p)
+
+
+@dataclass(frozen=True)
+class ToothContact:
+    """Loaded tooth contact at one or more mesh positions (arrays over positions × pins).
+
+    Attributes
+    ----------
+    mesh_angle : ndarray (n,)
+        Mesh position: phase of pin 1 [rad].
+    phase : ndarray (n, z_p)
+        Meshing phase φ_i of every pin [rad].
+    clearance : ndarray (n, z_p)
+        Initial clearance Δ_i (eq 32) [mm]; NaN on the unloaded flank (sin φ ≤ 0).
+    approach : ndarray (n, z_p)
+        Normal deformation/approach δ_i = (l_i/r_c) δ_max (eq 37) [mm].
+    force : ndarray (n, z_p)
+        Contact force F_i (eq 41) [N].
+    in_mesh : ndarray (n, z_p) of bool
+        δ_i > Δ_i on the loaded flank.
+    F_max : ndarray (n,)
+        Maximum contact force (eq 44) [N].
+    delta_max : ndarray (n,)
+        Maximum normal deformation (eq 38) [mm].
+    n_eval : ndarray (n,)
+        Residual evaluations of the solver.
+    T_c : float
+        Torque on the disc [N·mm].
+    rho : float
+        Curvature radius at φ0 [mm].
+    """
+
+    mesh_angle: np.ndarray
+    phase: np.ndarray
+    clearance: np.ndarray
+    approach: np.ndarray
+    force: np.ndarray
+    in_mesh: np.ndarray
+    F_max: np.ndarray
+    delta_max: np.ndarray
+    n_eval: np.ndarray
+    T_c: float
+    rho: float
+
+    @property
+    def pins_in_mesh(self) -> np.ndarray:
+        """Number of loaded pins at each position [-]."""
+        return self.in_mesh.sum(axis=-1)
+
+    @property
+    def max_pin_force(self) -> np.ndarray:
+        """Largest force carried by a pin at each position [N] (≤ F_max)."""
+        return self.force.max(axis=-1)
+
+
+def tooth_contact(
+    stage: CycloidStage,
+    torque: float,
+    *,
+    disc_share: float = 0.55,
+    E: float = 2.06e5,
+    mu: float = 0.3,
+    mesh_angle: ArrayLike = 0.0,
+    F_start: float | None = None,
+    rtol: float = 1e-12,
+    max_iter: int = 200,
+    implementation: str = "numba",
+    clearance_model: str = "eq32",
+) -> ToothContact:
+    """Tooth contact analysis of one disc (Hu et al. 2020, section 4).
+
+    Parameters
+    ----------
+    stage : CycloidStage
+        The modified stage (face width ``stage.b`` is one disc's).
+    torque : float
+        Output torque of the stage T [N·mm].
+    disc_share : float
+        Share s of the torque carried by the analysed disc, T_c = s T [-] (paper: 0.55).
+    E : float
+        Young's modulus [MPa].
+    mu : float
+        Poisson's ratio [-].
+    mesh_angle : array_like
+        Mesh position(s) [rad], the phase of pin 1; 0 is the paper's position (pin 1 on the line
+        of centres). One tooth pitch is 2π/z_p.
+    F_start : float, optional
+        Start value of F_max [N]; default the paper's eq 45. The result does not depend on it.
+    rtol : float
+        Relative tolerance on F_max [-].
+    max_iter : int
+        Iteration limit; exceeding it raises :class:`gearte.errors.ConvergenceError`.
+    implementation : {"numba", "plain"}
+        Compiled kernel or the plain per-pin Python twin.
+    clearance_model : {"eq32", "envelope"}
+        Initial clearances from eq 32 (the paper, first order in the modifications) or from the
+        exact envelope construction (:func:`gearte.geometry.cycloid.envelope_clearance`), both
+        closed at φ0.
+
+    Returns
+    -------
+    ToothContact
+        Per-position and per-pin results.
+    """
+    if not (math.isfinite(torque) and torque > 0.0):
+        raise ParameterError("torque", torque, "must be finite and > 0 [N·mm]")
+    if not (0.0 < disc_share <= 1.0):
+        raise ParameterError("disc_share", disc_share, "must be in (0, 1]")
+    if implementation not in ("numba", "plain"):
+        raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
+    if clearance_model not in ("eq32", "envelope"):
+        raise ParameterError("clearance_model", clearance_model, "must be 'eq32' or 'envelope'")
+    T_c = disc_share * torque
+    theta = np.atleast_1d(np.asarray(mesh_angle, dtype=float))
+    if not np.all(np.isfinite(theta)):
+        raise ParameterError("mesh_angle", mesh_angle, "must be finite")
+    phase = stage.pin_phases(theta)
+    K1 = stage.K1
+    S = np.sqrt(1.0 + K1 * K1 - 2.0 * K1 * np.cos(phase))
+    lr = np.sin(phase) / S
+    loaded = lr > 1e-12
+    if clearance_model == "eq32":
+        clr = np.where(loaded, stage.initial_clearance(phase), np.inf)
+    else:
+        from gearte.geometry.cycloid import envelope_clearance
+
+        clr = np.where(loaded, envelope_clearance(stage, theta), np.inf)
+    rho = stage.rho0
+    A, B = compliance_constants(rho, stage.r, E, mu, stage.b)
+    if F_start is None:
+        F_start = start_force(T_c, K1, stage.z_c, stage.r_p)
+    solve = solve_load_sharing if implementation == "numba" else solve_load_sharing_plain
+    F, nev = solve(
+        lr,
+        np.where(loaded, clr, 1e300),
+        T_c=T_c,
+        r_c=stage.r_c,
+        A=A,
+        B=B,
+        F_start=F_start,
+        rtol=rtol,
+        max_iter=max_iter,
+    )
+    dmax = A * F * (2.0 / 3.0 + np.log(B / F))
+    if np.max(dmax) > 0.1 * stage.r:
+        raise ParameterError(
+            "torque",
+            torque,
+            f"gives a normal deformation of {np.max(dmax):.3g} mm, beyond the elastic contact "
+            f"model's range (at most 0.1 x pin radius = {0.1 * stage.r:.3g} mm)",
+        )
+    approach = lr * dmax[:, None]
+    in_mesh = loaded & (approach > clr)
+    force = np.where(in_mesh, (approach - clr) / dmax[:, None] * F[:, None], 0.0)
+    return ToothContact(
+        mesh_angle=theta,
+        phase=phase,
+        clearance=np.where(loaded, clr, np.nan),
+        approach=approach,
+        force=force,
+        in_mesh=in_mesh,
+        F_max=F,
+        delta_max=dmax,
+        n_eval=nev,
+        T_c=T_c,
+        rho=rho,
+    )

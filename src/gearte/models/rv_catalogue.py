@@ -1,0 +1,184 @@
+"""Catalogue quantities of an RV reducer from a virtual torsion test of the load-sharing model.
+
+The test follows the manufacturers' definitions (Nabtesco *Precision Reduction Gear RV* catalogue,
+"Rigidity and lost motion"; the same definitions are used by Sumitomo/Spinea and the Chinese
+test standard for robot reducers): the input is locked, a torque is applied to the output and
+swept ``0 → +T_r → 0 → −T_r → 0``, the output torsion angle is recorded — the *hysteresis curve*.
+
+* **Torsional rigidity** ``= (T_r/2) / (θ(T_r) − θ(T_r/2))``: slope of the straight line
+  through the points at 50 % and 100 % rated torque, averaged over both directions
+  [N·mm/rad; reported in N·m/arcmin].
+* **Lost motion** ``= θ_mid(+0.03 T_r) − θ_mid(−0.03 T_r)``: torsion angle between the midpoints
+  of the hysteresis curve at ±3 % rated torque.
+* **Backlash** ``= θ(0⁺) − θ(0⁻)``: width of the curve at zero torque, the free play.
+* **Hysteresis loss**: width of the curve at zero torque after unloading from ±T_r.
+* **Angular transmission error**: peak-to-peak of the output angle error over one output
+  revolution (unloaded: the geometric TE; loaded: the total TE).
+
+The quasi-static model has no friction, so the loading and unloading branches coincide except
+inside the backlash: the midpoints equal the curve, and the hysteresis loss equals the backlash.
+These are stated limitations, not fitted quantities.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from gearte.errors import ParameterError
+from gearte.geometry.rv import RVReducer
+from gearte.models.rv_load_sharing import assemble, contact_law
+from gearte.solvers.rv_equilibrium import ContactLaw, solve_positions
+
+__all__ = [
+    "TorsionTest",
+    "torque_path",
+    "torsion_test",
+    "backlash",
+    "CatalogueValues",
+    "catalogue_values",
+]
+
+
+def torque_path(turning_points: ArrayLike, steps_per_segment: int = 20) -> np.ndarray:
+    """Densify a torque sweep given by its turning points (fractions of rated torque).
+
+    Raises
+    ------
+    ParameterError
+        If the sweep does not cross zero (it needs both signs to show backlash and lost motion),
+        has fewer than two points, or leaves ``[-1.5, 1.5]``.
+    """
+    tp = np.asarray(turning_points, dtype=float)
+    if tp.ndim != 1 or tp.size < 2 or not np.all(np.isfinite(tp)):
+        raise ParameterError("torque_sweep", turning_points, "needs >= 2 finite turning points")
+    if not (tp.min() < 0.0 < tp.max()):
+        raise ParameterError(
+            "torque_sweep",
+            tp.tolist(),
+            "must cross zero torque (contain both positive and negative values)",
+        )
+    if np.any(np.abs(tp) > 1.5):
+        raise ParameterError("torque_sweep", tp.tolist(), "values must be in [-1.5, 1.5] x rated")
+    if int(steps_per_segment) != steps_per_segment or steps_per_segment < 2:
+        raise ParameterError("steps_per_segment", steps_per_segment, "must be an integer >= 2")
+    pieces = [tp[:1]]
+    for a, b in zip(tp[:-1], tp[1:], strict=True):
+        seg = np.linspace(a, b, steps_per_segment + 1)[1:]
+        if a * b < 0:  # make sure zero is approached from both sides
+            seg = np.sort(np.concatenate([seg, [0.0]]))[:: 1 if b > a else -1]
+        pieces.append(seg)
+    return np.concatenate(pieces)
+
+
+@dataclass(frozen=True)
+class TorsionTest:
+    """Output torsion angle along a torque path (input locked).
+
+    Attributes
+    ----------
+    torque : (K,) [N·mm]; angle : (K,) output torsion angle [rad] (positive with the torque).
+    """
+
+    torque: np.ndarray
+    angle: np.ndarray
+
+
+def _follow(reducer, theta, torques, law):
+    system = assemble(reducer, np.full(torques.size, float(theta)))
+    sol = solve_positions(system, torques, law)
+    # the torque resists the drive: the output turns against it; report angle along the torque
+    return -sol.q[:, system.layout.output_rotation]
+
+
+def torsion_test(
+    reducer: RVReducer,
+    turning_points: ArrayLike = (0.0, 1.0, 0.0, -1.0, 0.0, 1.0),
+    *,
+    theta: float = 0.0,
+    steps_per_segment: int = 20,
+    law: ContactLaw | None = None,
+) -> TorsionTest:
+    """Hysteresis curve: output torsion angle along a torque sweep (fractions of rated torque)."""
+    frac = torque_path(turning_points, steps_per_segment)
+    law = contact_law(reducer) if law is None else law
+    # a torque of exactly zero leaves the output free inside its backlash; approach it from the
+    # side the path comes from (±1e-4 T_r), which is what a frictionless test bench records
+    eps = 1e-4
+    prev = np.concatenate([[frac[0]], frac[:-1]])
+    frac_eff = np.where(frac == 0.0, np.where(prev >= 0.0, eps, -eps), frac)
+    if frac_eff[0] == 0.0:
+        frac_eff[0] = eps
+    torques = frac_eff * reducer.rated_torque
+    return TorsionTest(
+        torque=frac * reducer.rated_torque, angle=_follow(reducer, theta, torques, law)
+    )
+
+
+def backlash(reducer: RVReducer, *, theta: ArrayLike = 0.0, law: ContactLaw | None = None) -> float:
+    """Backlash θ(0⁺) − θ(0⁻) [rad]; the smallest over the output angles ``theta`` [rad].
+
+    0 (to the elastic deflection at ±1e-4 T_r) when the reducer is preloaded.
+    """
+    law = contact_law(reducer) if law is None else law
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    eps = 1e-4 * reducer.rated_torque
+    system = assemble(reducer, th)
+    out = system.layout.output_rotation
+    pos = -solve_positions(system, eps, law).q[:, out]
+    neg = -solve_positions(system, -eps, law).q[:, out]
+    return float(np.min(pos - neg))
+
+
+@dataclass(frozen=True)
+class CatalogueValues:
+    """Catalogue quantities [N·mm/rad, rad] and the curve they were read from."""
+
+    torsional_rigidity: float
+    lost_motion: float
+    backlash: float
+    hysteresis_loss: float
+    curve: TorsionTest
+
+
+def catalogue_values(
+    reducer: RVReducer,
+    *,
+    theta: float = 0.0,
+    turning_points: ArrayLike = (0.0, 1.0, 0.0, -1.0, 0.0, 1.0),
+    steps_per_segment: int = 20,
+    lost_motion_fraction: float = 0.03,
+    law: ContactLaw | None = None,
+) -> CatalogueValues:
+    """Torsional rigidity, lost motion, backlash and hysteresis loss from a virtual test.
+
+    Each quantity is read at its exact torque: the branches ``0 → ±T_r`` are followed with
+    warm starts through ``±1e-4, ±lost_motion_fraction, ±0.5, ±1`` × rated torque.
+    """
+    if not 0 < lost_motion_fraction < 0.5:
+        raise ParameterError("lost_motion_fraction", lost_motion_fraction, "must be in (0, 0.5)")
+    law = contact_law(reducer) if law is None else law
+    curve = torsion_test(
+        reducer, turning_points, theta=theta, steps_per_segment=steps_per_segment, law=law
+    )
+    levels = np.array([1e-4, lost_motion_fraction, 0.5, 1.0])
+    tr = reducer.rated_torque
+    pos = _follow(reducer, theta, levels * tr, law)
+    neg = _follow(reducer, theta, -levels * tr, law)
+    k_pos = 0.5 * tr / (pos[3] - pos[2])
+    k_neg = 0.5 * tr / (neg[2] - neg[3])
+    rigidity = 0.5 * (k_pos + k_neg)
+    lost_motion = pos[1] - neg[1]
+    backlash = pos[0] - neg[0]
+    # hysteresis loss: zero-torque width after unloading from ±T_r (same as backlash here)
+    back_pos = _follow(reducer, theta, np.array([1.0, 0.5, 1e-4]) * tr, law)[-1]
+    back_neg = _follow(reducer, theta, -np.array([1.0, 0.5, 1e-4]) * tr, law)[-1]
+    return CatalogueValues(
+        torsional_rigidity=float(rigidity),
+        lost_motion=float(lost_motion),
+        backlash=float(backlash),
+        hysteresis_loss=float(back_pos - back_neg),
+        curve=curve,
+    )

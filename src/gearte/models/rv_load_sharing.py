@@ -1,0 +1,593 @@
+"""Quasi-static load sharing of a whole RV reducer: springs, unilateral pin contacts, errors.
+
+The reducer is a planar assembly of rigid bodies connected by springs (Han et al. 2023, Fig 2,
+section 3.1 — here derived from kinematics and equilibrium, with inertia dropped):
+
+==========  ==================================  ===============================================
+body        degrees of freedom (ground frame)    connected by
+==========  ==================================  ===============================================
+sun         ``x_s, y_s`` (rotation prescribed)   support spring ``k_s``; meshes with planets
+crank i     ``x_pi, y_pi, theta_pi``             mesh ``k_m`` (line of action), carrier bearing
+                                                 ``k_b`` (isotropic), cam bearings ``k_cam``
+disc j      ``x_dj, y_dj, theta_dj``             cam bearings, unilateral pin contacts
+carrier     ``x_c, y_c, theta_c``                crank bearings, main bearings ``k_ca``
+==========  ==================================  ===============================================
+
+All coordinates are small displacements from the ideal kinematic position at output angle
+``theta``; the input (sun) rotation is held at its kinematic value and the output torque ``T``
+acts on the carrier against the drive direction. The carrier's rotation deviation
+``theta_c`` is then the loaded output angle error, the total transmission error (TE).
+
+Every connection is a scalar "spring row": ``w = B · q + e`` (deflection, ``e`` from
+manufacturing errors), energy ``k w² / 2``. Isotropic bearings are two rows (x and y); with a
+radial clearance ``c`` their energy is ``k (|w| − c)₊² / 2`` (a convex dead band). A pin contact
+is a unilateral row: approach ``delta = B · q - g`` with ``g`` the initial normal clearance
+(:func:`gearte.geometry.cycloid.normal_clearance_unclosed` of the modified profile, minus the
+pin-radius error, plus the pin-centre error projected on the normal), force ``k max(delta, 0)``
+with the load-dependent stiffness of Hu 2020 section 4 (:func:`contact_law`).
+
+Pin-contact geometry (derived, not taken from a paper's figure): for disc ``j`` with eccentric
+direction ``c_j`` the pitch point is ``P_j = a z_p c_j``; the contact normal of pin ``k`` passes
+through ``P_j`` and the pin centre, ``n = (p_k - P_j)/|p_k - P_j|`` with ``|p_k - P_j| = r_p S``,
+``S = sqrt(1 + K1² - 2 K1 cos phi)`` — hence the lever ``l = r_c sin(phi)/S`` of Hu 2020 eq 36
+and the classical load law ``F ∝ sin(phi)/S`` for a rigid rotation of the disc.
+
+References
+----------
+Han L., Xu W., Wang Y., Zhang Y. (2023). JERR 25(8). doi:10.9734/JERR/2023/v25i8970
+Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from gearte.errors import ParameterError
+from gearte.geometry.cycloid import CycloidStage, normal_clearance_unclosed
+from gearte.geometry.rv import RVReducer
+from gearte.solvers.rv_equilibrium import CLEARANCE_RESIDUAL, ContactLaw, solve_positions
+
+__all__ = [
+    "DofLayout",
+    "RVSystem",
+    "dof_layout",
+    "cycloid_stage",
+    "contact_law",
+    "assemble",
+    "LoadSharing",
+    "load_sharing",
+    "output_positions",
+    "TransmissionError",
+    "mesh_period",
+    "transmission_error",
+]
+
+
+# ------------------------------------------------------------------------------------------
+# The cycloid stage of the reducer and its contact law (reused from gearte.geometry.cycloid and
+# gearte.models.cycloid_contact, issue 2: one implementation of Hu 2020 eq 32–40)
+# ------------------------------------------------------------------------------------------
+def cycloid_stage(reducer: RVReducer) -> CycloidStage:
+    """The reducer's cycloid–pin stage as a :class:`gearte.geometry.cycloid.CycloidStage`.
+
+    Its validation (K1 < 1, no undercut, pins fit, non-interfering eq 32 clearance) applies.
+    """
+    return CycloidStage(
+        z_p=reducer.pins.count,
+        r_p=reducer.pins.circle_radius,
+        r_rp=reducer.pins.pin_radius,
+        a=reducer.cranks.eccentricity,
+        b=reducer.discs.face_width,
+        dr_rp=reducer.discs.equidistant_modification,
+        dr_p=reducer.discs.shift_modification,
+    )
+
+
+def contact_law(reducer: RVReducer, kind: str = "hu2020", stiffness: float = 2.0e5) -> ContactLaw:
+    """Pin-contact law of the reducer: Hu 2020 eq 38–40 with ρ(φ0) and the grinding pin radius.
+
+    The same constants as :func:`gearte.models.cycloid_contact.compliance_constants` use in the
+    cycloid-stage contact analysis (``stage.rho0``, ``stage.r``), so both analyses share one law.
+    """
+    st = cycloid_stage(reducer)
+    d = reducer.discs
+    return ContactLaw(
+        kind=kind,
+        stiffness=stiffness,
+        rho=abs(st.rho0),
+        pin_radius=st.r,
+        youngs_modulus=d.youngs_modulus,
+        poisson_ratio=d.poisson_ratio,
+        face_width=d.face_width,
+    )
+
+
+# ------------------------------------------------------------------------------------------
+# Degrees of freedom and assembly
+# ------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DofLayout:
+    """Index layout of the displacement vector ``q``."""
+
+    n_cranks: int
+    n_discs: int
+
+    @property
+    def sun(self) -> int:
+        return 0
+
+    def crank(self, i: int) -> int:
+        return 2 + 3 * i
+
+    def disc(self, j: int) -> int:
+        return 2 + 3 * self.n_cranks + 3 * j
+
+    @property
+    def carrier(self) -> int:
+        return 2 + 3 * self.n_cranks + 3 * self.n_discs
+
+    @property
+    def size(self) -> int:
+        return self.carrier + 3
+
+    @property
+    def output_rotation(self) -> int:
+        """Index of the carrier rotation (the output angle error)."""
+        return self.carrier + 2
+
+
+def dof_layout(reducer: RVReducer) -> DofLayout:
+    """DOF layout of a reducer."""
+    return DofLayout(reducer.cranks.count, reducer.discs.count)
+
+
+@dataclass(frozen=True)
+class RVSystem:
+    """Spring rows and contact rows of a reducer at ``P`` output positions.
+
+    Attributes
+    ----------
+    theta : (P,) output angles [rad].
+    spring_B : (P, ns, nd) rows; spring_e : (P, ns) offsets [mm]; spring_k : (ns,) [N/mm];
+    spring_c : (ns,) radial clearance [mm] of isotropic bearings (their x and y rows are
+    consecutive; 0 = linear spring).
+    contact_B : (P, nc, nd) rows; contact_gap : (P, nc) clearances [mm];
+    contact_group : (nc,) disc index of each contact; contact_pin : (nc,) pin index.
+    unit_load : (nd,) generalised force of a unit output torque [1/mm per N·mm].
+    labels : dict of slices into the spring rows (``"cam"``, ``"carrier_bearing"``, ``"mesh"``...).
+    """
+
+    theta: np.ndarray
+    spring_B: np.ndarray
+    spring_e: np.ndarray
+    spring_k: np.ndarray
+    contact_B: np.ndarray
+    contact_gap: np.ndarray
+    contact_group: np.ndarray
+    contact_pin: np.ndarray
+    unit_load: np.ndarray
+    labels: dict
+    layout: DofLayout
+    spring_c: np.ndarray | None = None
+
+
+def _u(a: np.ndarray) -> np.ndarray:
+    """Unit vectors ``(cos a, sin a)`` stacked on the last axis."""
+    return np.stack([np.cos(a), np.sin(a)], axis=-1)
+
+
+def _rot(v: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Rotate vectors ``v[..., 2]`` by angles ``a`` (broadcast)."""
+    c, s = np.cos(a), np.sin(a)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
+
+
+def _point_row(row: np.ndarray, dof: int, r: np.ndarray, n: np.ndarray, sign: float, rot=True):
+    """Add ``sign * n · u(point)`` of a body (dof x, y, theta) with lever ``r`` to ``row``.
+
+    ``row``: (P, nd); ``r``, ``n``: (P, 2).
+    """
+    row[:, dof] += sign * n[:, 0]
+    row[:, dof + 1] += sign * n[:, 1]
+    if rot:
+        row[:, dof + 2] += sign * (r[:, 0] * n[:, 1] - r[:, 1] * n[:, 0])
+
+
+def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
+    """Spring and contact rows of ``reducer`` at output angles ``theta`` [rad].
+
+    Parameters
+    ----------
+    reducer : RVReducer
+    theta : array_like
+        Output (carrier) angles [rad], shape ``(P,)``.
+
+    Returns
+    -------
+    RVSystem
+    """
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    if th.ndim != 1 or not np.all(np.isfinite(th)):
+        raise ParameterError("theta", theta, "must be a finite 1-D array of angles [rad]")
+    P = th.size
+    lay = dof_layout(reducer)
+    nd = lay.size
+    M, N = reducer.cranks.count, reducer.discs.count
+    zp, zc = reducer.pins.count, reducer.cycloid_teeth
+    a = reducer.cranks.eccentricity
+    Rdc = reducer.cranks.circle_radius
+    err = reducer.errors
+    ex, ey = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+    zero2 = np.zeros((P, 2))
+
+    rows: list[np.ndarray] = []
+    offs: list[np.ndarray] = []
+    ks: list[float] = []
+    cs: list[float] = []
+    labels: dict[str, slice] = {}
+
+    def add(row, off, k, c=0.0):
+        rows.append(row)
+        offs.append(off)
+        ks.append(k)
+        cs.append(c)
+
+    # sun support (2 rows)
+    start = len(rows)
+    for d in (ex, ey):
+        r = np.zeros((P, nd))
+        _point_row(r, lay.sun, zero2, np.broadcast_to(d, (P, 2)), 1.0, rot=False)
+        add(r, np.zeros(P), reducer.first_stage.sun_support_stiffness)
+    labels["sun_support"] = slice(start, len(rows))
+
+    # carrier main bearings (2 rows)
+    start = len(rows)
+    for d in (ex, ey):
+        r = np.zeros((P, nd))
+        _point_row(r, lay.carrier, zero2, np.broadcast_to(d, (P, 2)), 1.0)
+        add(r, np.zeros(P), reducer.supports.carrier_radial_stiffness)
+    labels["main_bearing"] = slice(start, len(rows))
+
+    crank_ang = th[:, None] + 2.0 * np.pi * np.arange(M)[None, :] / M  # (P, M)
+    crank_pos = Rdc * _u(crank_ang)  # (P, M, 2)
+    ecc1 = -zc * th  # absolute crank angle = eccentric direction of disc 1
+    ecc = ecc1[:, None] + 2.0 * np.pi * np.arange(N)[None, :] / N  # (P, N)
+
+    # carrier crank bearings: w = u_crank - u_carrier(bore) - eps_carrier
+    start = len(rows)
+    for i in range(M):
+        eps = _rot(np.broadcast_to(err.carrier_bore[i], (P, 2)), crank_ang[:, i])
+        for d in (ex, ey):
+            r = np.zeros((P, nd))
+            dd = np.broadcast_to(d, (P, 2))
+            _point_row(r, lay.crank(i), zero2, dd, 1.0)
+            _point_row(r, lay.carrier, crank_pos[:, i], dd, -1.0)
+            add(
+                r,
+                -eps @ d,
+                reducer.cranks.carrier_bearing_stiffness,
+                reducer.cranks.carrier_bearing_clearance,
+            )
+    labels["carrier_bearing"] = slice(start, len(rows))
+
+    # cam bearings: w = u_crank(cam) + eps_cam - u_disc(bore) - eps_bore
+    start = len(rows)
+    for i in range(M):
+        for j in range(N):
+            cam_r = a * _u(ecc[:, j])
+            eps_cam = _rot(np.broadcast_to(err.cam[i, j], (P, 2)), ecc[:, j])
+            eps_bore = _rot(np.broadcast_to(err.disc_bore[j, i], (P, 2)), crank_ang[:, i])
+            for d in (ex, ey):
+                r = np.zeros((P, nd))
+                dd = np.broadcast_to(d, (P, 2))
+                _point_row(r, lay.crank(i), cam_r, dd, 1.0)
+                _point_row(r, lay.disc(j), crank_pos[:, i], dd, -1.0)
+                add(
+                    r,
+                    (eps_cam - eps_bore) @ d,
+                    reducer.cranks.cam_bearing_stiffness,
+                    reducer.cranks.cam_bearing_clearance,
+                )
+    labels["cam_bearing"] = slice(start, len(rows))
+
+    # sun-planet meshes along the working line of action (sun drives, counter-clockwise)
+    start = len(rows)
+    alpha_w = reducer.working_pressure_angle
+    rb1, _ = reducer.first_stage.base_radii
+    z1, z2 = reducer.first_stage.sun_teeth, reducer.first_stage.planet_teeth
+    rw1 = Rdc * z1 / (z1 + z2)
+    for i in range(M):
+        rho = _u(crank_ang[:, i])
+        t = _u(crank_ang[:, i] + np.pi / 2)
+        n = np.cos(alpha_w) * t + np.sin(alpha_w) * rho  # force direction on the planet
+        pitch = rw1 * rho
+        cp = crank_pos[:, i]
+        tp = pitch - np.sum((pitch - cp) * n, axis=-1, keepdims=True) * n
+        r = np.zeros((P, nd))
+        _point_row(r, lay.sun, zero2, n, 1.0, rot=False)
+        _point_row(r, lay.crank(i), tp - cp, n, -1.0)
+        eps_pl = _rot(np.broadcast_to(err.planet[i], (P, 2)), ecc1)
+        add(r, -np.sum(eps_pl * n, axis=-1), reducer.first_stage.mesh_stiffness)
+    labels["mesh"] = slice(start, len(rows))
+
+    spring_B = np.stack(rows, axis=1)
+    spring_e = np.stack(offs, axis=1)
+    spring_k = np.asarray(ks)
+
+    # pin contacts
+    pins = reducer.pins
+    alpha_k = 2.0 * np.pi * np.arange(zp) / zp
+    pin_pos = pins.circle_radius * _u(alpha_k)  # (zp, 2)
+    pin_err = pins.radial_position_errors[:, None] * _u(alpha_k) + pins.tangential_position_errors[
+        :, None
+    ] * _u(alpha_k + np.pi / 2)
+    cB = np.zeros((P, N * zp, nd))
+    cg = np.zeros((P, N * zp))
+    group = np.repeat(np.arange(N), zp)
+    pin_index = np.tile(np.arange(zp), N)
+    for j in range(N):
+        cdir = _u(ecc[:, j])  # (P, 2)
+        ppt = a * zp * cdir
+        centre = a * cdir
+        v = pin_pos[None, :, :] - ppt[:, None, :]  # (P, zp, 2)
+        n = v / np.linalg.norm(v, axis=-1, keepdims=True)
+        contact = pin_pos[None] - pins.pin_radius * n
+        lever = contact - centre[:, None, :]
+        dof = lay.disc(j)
+        sl = slice(j * zp, (j + 1) * zp)
+        cB[:, sl, dof] = n[..., 0]
+        cB[:, sl, dof + 1] = n[..., 1]
+        cB[:, sl, dof + 2] = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
+        phi = alpha_k[None, :] - ecc[:, j][:, None]
+        gap = normal_clearance_unclosed(
+            phi,
+            z_p=zp,
+            r_p=pins.circle_radius,
+            a=a,
+            dr_rp=reducer.discs.equidistant_modification,
+            dr_p=reducer.discs.shift_modification,
+        )
+        gap = gap - pins.radius_errors[None, :] + np.sum(n * pin_err[None], axis=-1)
+        cg[:, sl] = gap
+
+    unit = np.zeros(nd)
+    unit[lay.output_rotation] = -1.0  # load torque resists the drive
+    return RVSystem(
+        th,
+        spring_B,
+        spring_e,
+        spring_k,
+        cB,
+        cg,
+        group,
+        pin_index,
+        unit,
+        labels,
+        lay,
+        np.asarray(cs),
+    )
+
+
+# ------------------------------------------------------------------------------------------
+# Analyses over one output revolution
+# ------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LoadSharing:
+    """Quasi-static load sharing over output positions.
+
+    Attributes
+    ----------
+    theta : (P,) output angles [rad].
+    torque : float
+        Output torque [N·mm].
+    pin_force : (P, N, z_p) contact force of every pin on every disc [N].
+    pairs_in_mesh : (P, N) loaded pins per disc [-].
+    cam_bearing_load : (P, M, N) radial load of each crank's cam bearing in each disc [N].
+    carrier_bearing_load : (P, M) radial load of each crank's bearing in the carrier [N].
+    mesh_force : (P, M) sun–planet mesh force [N].
+    disc_torque : (P, N) moment of the pin forces about each disc centre [N·mm].
+    output_error : (P,) output angle error ``theta_actual − theta_nominal`` [rad]
+        (negative = output lags).
+    contact_stiffness : (P, N) secant pin stiffness per disc [N/mm].
+    q : (P, nd) all displacements [mm, rad].
+    """
+
+    theta: np.ndarray
+    torque: float
+    pin_force: np.ndarray
+    pairs_in_mesh: np.ndarray
+    cam_bearing_load: np.ndarray
+    carrier_bearing_load: np.ndarray
+    mesh_force: np.ndarray
+    disc_torque: np.ndarray
+    output_error: np.ndarray
+    contact_stiffness: np.ndarray
+    q: np.ndarray
+
+    @property
+    def peak_pin_load(self) -> float:
+        """Largest pin force over the revolution [N]."""
+        return float(self.pin_force.max())
+
+
+def _postprocess(reducer: RVReducer, system: RVSystem, sol, torque: float) -> LoadSharing:
+    M, N, zp = reducer.cranks.count, reducer.discs.count, reducer.pins.count
+    P = system.theta.size
+    w = np.einsum("psi,pi->ps", system.spring_B, sol.q) + system.spring_e
+    f = w * system.spring_k[None, :]
+    c = system.spring_c
+    if c is not None and np.any(c > 0):  # bearings with radial clearance: k (|w| - c)+ w/|w|
+        first = np.flatnonzero(c > 0)[::2]
+        wx, wy = w[:, first], w[:, first + 1]
+        n = np.hypot(wx, wy)
+        kf, eps = system.spring_k[first], CLEARANCE_RESIDUAL
+        scale = eps * kf + (1 - eps) * kf * np.maximum(n - c[first], 0.0) / np.where(n > 0, n, 1.0)
+        f[:, first] = scale * wx
+        f[:, first + 1] = scale * wy
+    cam = f[:, system.labels["cam_bearing"]].reshape(P, M, N, 2)
+    car = f[:, system.labels["carrier_bearing"]].reshape(P, M, 2)
+    mesh = f[:, system.labels["mesh"]]
+    pin = sol.contact_force.reshape(P, N, zp)
+    lay = system.layout
+    # the rotation column of a contact row is the arm of its normal about the disc centre
+    arm = np.stack(
+        [system.contact_B[:, j * zp : (j + 1) * zp, lay.disc(j) + 2] for j in range(N)], axis=1
+    )  # (P, N, zp)
+    disc_torque = -np.sum(pin * arm, axis=-1)
+    return LoadSharing(
+        theta=system.theta,
+        torque=float(torque),
+        pin_force=pin,
+        pairs_in_mesh=(pin > 0.0).sum(axis=-1),
+        cam_bearing_load=np.linalg.norm(cam, axis=-1),
+        carrier_bearing_load=np.linalg.norm(car, axis=-1),
+        mesh_force=mesh,
+        disc_torque=disc_torque,
+        output_error=sol.q[:, lay.output_rotation].copy(),
+        contact_stiffness=sol.contact_stiffness,
+        q=sol.q,
+    )
+
+
+def output_positions(n_positions: int) -> np.ndarray:
+    """``n_positions`` equally spaced output angles over one revolution [rad]."""
+    if int(n_positions) != n_positions or n_positions < 1:
+        raise ParameterError("positions", n_positions, "must be an integer >= 1")
+    return np.linspace(0.0, 2.0 * np.pi, int(n_positions), endpoint=False)
+
+
+def load_sharing(
+    reducer: RVReducer,
+    torque: float,
+    theta: ArrayLike | None = None,
+    *,
+    law: ContactLaw | None = None,
+    system: RVSystem | None = None,
+    compiled: bool = True,
+) -> LoadSharing:
+    """Quasi-static load sharing of ``reducer`` under output ``torque`` [N·mm].
+
+    Parameters
+    ----------
+    reducer : RVReducer
+    torque : float
+        Output torque [N·mm]; positive resists the drive direction.
+    theta : array_like, optional
+        Output angles [rad]; default 360 positions over one revolution.
+    law : ContactLaw, optional
+        Pin-contact law; default :func:`contact_law` (Hu 2020).
+    system : RVSystem, optional
+        Pre-assembled rows (re-used across torques).
+    compiled : bool
+        Use the numba kernel (``False``: plain-Python twin).
+    """
+    if not np.isfinite(torque):
+        raise ParameterError("torque", torque, "must be finite [N·mm]")
+    if system is None:
+        system = assemble(reducer, output_positions(360) if theta is None else theta)
+    law = contact_law(reducer) if law is None else law
+    sol = solve_positions(system, torque, law, compiled=compiled)
+    return _postprocess(reducer, system, sol, torque)
+
+
+def mesh_period(reducer: RVReducer) -> float:
+    """Output angle [rad] after which the pin-contact pattern repeats: ``2π / (z_p z_c)``.
+
+    The eccentric turns ``-z_c θ`` and the pattern repeats when the pin phases have moved by one
+    pin pitch ``2π / z_p``; the mesh-stiffness ripple of the TE has this period.
+    """
+    return 2.0 * np.pi / (reducer.pins.count * reducer.cycloid_teeth)
+
+
+@dataclass(frozen=True)
+class TransmissionError:
+    """Loaded output angle error over a revolution, split into geometric and elastic parts.
+
+    ``total = geometric + elastic``; geometric is the output angle error at (nearly) zero load
+    ``zero_load_torque`` (errors, clearances and the preload they cause), elastic the rest.
+    All [rad]. ``theta, total, geometric, elastic`` are on the requested positions (for plots);
+    ``*_pp`` are peak-to-peak values over those positions *plus* one finely resolved mesh period
+    around each extreme, since the mesh ripple (period :func:`mesh_period`, ``z_p z_c`` cycles per
+    revolution) is aliased by any practical uniform sampling.
+    """
+
+    theta: np.ndarray
+    total: np.ndarray
+    geometric: np.ndarray
+    elastic: np.ndarray
+    loaded: LoadSharing
+    unloaded: LoadSharing
+    total_pp: float
+    geometric_pp: float
+    elastic_pp: float
+
+    @staticmethod
+    def peak_to_peak(x: np.ndarray) -> float:
+        return float(np.max(x) - np.min(x))
+
+
+def transmission_error(
+    reducer: RVReducer,
+    torque: float,
+    theta: ArrayLike | None = None,
+    *,
+    zero_load_fraction: float = 1e-3,
+    mesh_samples: int = 24,
+    law: ContactLaw | None = None,
+) -> TransmissionError:
+    """Total (loaded), geometric (zero-load) and elastic output angle error [rad].
+
+    Parameters
+    ----------
+    reducer : RVReducer
+    torque : float
+        Output torque [N·mm] (> 0).
+    theta : array_like, optional
+        Output angles [rad] (default 360 over one revolution).
+    zero_load_fraction : float
+        The geometric TE is solved at ``zero_load_fraction * torque`` in the same direction, so
+        that the contacts close their clearance without deflecting (a zero torque leaves the
+        output free within its backlash).
+    mesh_samples : int
+        Positions per mesh period in the refinement around the extremes (0: no refinement).
+    """
+    if not torque > 0:
+        raise ParameterError("torque", torque, "must be > 0 N·mm for the TE analysis")
+    if not 0 < zero_load_fraction < 0.05:
+        raise ParameterError("zero_load_fraction", zero_load_fraction, "must be in (0, 0.05)")
+    if int(mesh_samples) != mesh_samples or mesh_samples < 0:
+        raise ParameterError("mesh_samples", mesh_samples, "must be an integer >= 0")
+    system = assemble(reducer, output_positions(360) if theta is None else theta)
+    law = contact_law(reducer) if law is None else law
+    loaded = load_sharing(reducer, torque, law=law, system=system)
+    unloaded = load_sharing(reducer, zero_load_fraction * torque, law=law, system=system)
+    total = loaded.output_error
+    geo = unloaded.output_error
+    ela = total - geo
+    all_t, all_g, all_e = [total], [geo], [ela]
+    if mesh_samples:
+        centres = {int(np.argmax(x)) for x in (total, geo, ela)}
+        centres |= {int(np.argmin(x)) for x in (total, geo, ela)}
+        offs = (np.arange(mesh_samples) / mesh_samples - 0.5) * mesh_period(reducer)
+        fine = np.concatenate([system.theta[c] + offs for c in sorted(centres)])
+        fsys = assemble(reducer, fine)
+        ft = load_sharing(reducer, torque, law=law, system=fsys).output_error
+        fg = load_sharing(reducer, zero_load_fraction * torque, law=law, system=fsys).output_error
+        all_t.append(ft)
+        all_g.append(fg)
+        all_e.append(ft - fg)
+    pp = TransmissionError.peak_to_peak
+    return TransmissionError(
+        theta=system.theta,
+        total=total,
+        geometric=geo,
+        elastic=ela,
+        loaded=loaded,
+        unloaded=unloaded,
+        total_pp=pp(np.concatenate(all_t)),
+        geometric_pp=pp(np.concatenate(all_g)),
+        elastic_pp=pp(np.concatenate(all_e)),
+    )

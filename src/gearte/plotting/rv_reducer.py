@@ -1,0 +1,148 @@
+"""Figures of the ``rv_reducer`` study: pin-load map, peak pin load with/without errors, TE split,
+hysteresis curve with lost motion and rigidity. matplotlib is imported lazily (new_figure)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
+
+__all__ = ["figures"]
+
+
+def _pin_map(ls, title: str) -> Figure:
+    n_discs = ls.pin_force.shape[1]
+    fig, axes = new_figure(1, n_discs, figsize=(4.0 * n_discs + 1.0, 4.0), squeeze=False)
+    deg = rad_to_deg(ls.theta)
+    vmax = float(ls.pin_force.max()) or 1.0
+    im = None
+    for j in range(n_discs):
+        ax = axes[0, j]
+        im = ax.imshow(
+            ls.pin_force[:, j, :].T,
+            aspect="auto",
+            origin="lower",
+            extent=(deg[0], deg[-1] + (deg[1] - deg[0] if deg.size > 1 else 1.0), 0.5,
+                    ls.pin_force.shape[2] + 0.5),
+            vmin=0.0,
+            vmax=vmax,
+            cmap="viridis",
+        )  # fmt: skip
+        ax.set_xlabel("output angle [deg]")
+        ax.set_ylabel("pin")
+        ax.set_title(f"disc {j + 1}")
+    fig.colorbar(im, ax=axes[0, -1], label="pin load [N]")
+    return Figure(
+        title,
+        "Load of every pin on each disc over one output revolution (quasi-static equilibrium "
+        "of the whole reducer). Bright diagonal bands: the loaded flank travelling round the "
+        "pin ring z_c times per revolution.",
+        fig,
+    )
+
+
+def _peak(ls, ls0) -> Figure:
+    fig, ax = new_figure()
+    deg = rad_to_deg(ls.theta)
+    ax.plot(deg, ls.pin_force.max(axis=(1, 2)), color=PALETTE[1], label="with errors")
+    if ls0 is not None:
+        ax.plot(deg, ls0.pin_force.max(axis=(1, 2)), color=PALETTE[0], label="without errors")
+    ax.set_xlabel("output angle [deg]")
+    ax.set_ylabel("largest pin load [N]")
+    ax.legend()
+    return Figure(
+        "Peak pin load over one output revolution",
+        "Largest pin load of both discs at each output angle, with and without the measured "
+        "manufacturing errors (Han et al. 2023, Fig 6 style).",
+        fig,
+    )
+
+
+def _te(te) -> Figure:
+    fig, ax = new_figure()
+    deg = rad_to_deg(te.theta)
+    ax.plot(deg, rad_to_arcsec(te.total), color=PALETTE[7], label="total (loaded)")
+    ax.plot(deg, rad_to_arcsec(te.geometric), color=PALETTE[0], label="geometric (zero load)")
+    ax.plot(deg, rad_to_arcsec(te.elastic), color=PALETTE[1], label="elastic = total - geometric")
+    ax.set_xlabel("output angle [deg]")
+    ax.set_ylabel("output angle error [arcsec]")
+    ax.legend()
+    return Figure(
+        "Transmission error over one output revolution",
+        "Output angle error (actual - nominal, negative = lag) with the input held, split into "
+        "its geometric part (errors and clearances, zero load) and its elastic part.",
+        fig,
+    )
+
+
+def _hysteresis(cat, rated: float) -> Figure:
+    fig, ax = new_figure()
+    T = cat.curve.torque / rated * 100.0
+    ang = rad_to_arcmin(cat.curve.angle)
+    ax.plot(T, ang, "-o", ms=2.5, color=PALETTE[0], label="virtual test (input locked)")
+    # rigidity line through the 50 % and 100 % points of the positive branch
+    k = cat.torsional_rigidity  # N·mm/rad
+    pos = T > 0
+    if np.any(pos):
+        i100 = np.argmin(np.abs(T - 100.0))
+        t = np.array([50.0, 100.0])
+        ax.plot(
+            t,
+            ang[i100] + rad_to_arcmin((t - 100.0) / 100.0 * rated / k),
+            color=PALETTE[1],
+            lw=2,
+            label=f"rigidity {k / 1e3 / rad_to_arcmin(1.0):.0f} N*m/arcmin",
+        )
+    ax.axvspan(-3.0, 3.0, color=PALETTE[2], alpha=0.2,
+               label=f"±3 %: lost motion {rad_to_arcmin(cat.lost_motion):.3f}'")  # fmt: skip
+    ax.axvline(0.0, color="k", lw=0.5)
+    ax.set_xlabel("output torque [% rated]")
+    ax.set_ylabel("output torsion angle [arcmin]")
+    ax.set_title(f"backlash {rad_to_arcmin(cat.backlash):.3f}'")
+    ax.legend(fontsize=8)
+    return Figure(
+        "Hysteresis curve",
+        "Output torsion angle against output torque swept through ± rated torque with the input "
+        "locked; torsional rigidity from the 50-100 % points, lost motion between ±3 %, backlash "
+        "= jump at zero torque. The model is frictionless, so the branches coincide.",
+        fig,
+    )
+
+
+def _compensation(comp) -> Figure:
+    fig, axes = new_figure(1, 3, figsize=(9.0, 3.2))
+    labels = ["before", "after"]
+    pts = [comp.before, comp.after]
+    axes[0].bar(labels, [rad_to_arcsec(p.total_te_peak_to_peak) for p in pts], color=PALETTE[:2])
+    axes[0].set_ylabel("total TE p-p [arcsec]")
+    axes[1].bar(labels, [rad_to_arcmin(p.mean_lag) for p in pts], color=PALETTE[:2])
+    axes[1].set_ylabel("mean loaded lag [arcmin]")
+    axes[2].bar(labels, [p.peak_pin_load for p in pts], color=PALETTE[:2])
+    axes[2].set_ylabel("peak pin load [N]")
+    return Figure(
+        "Compensation before/after",
+        "Total TE, loaded output lag and peak pin load before and after the design change "
+        f"found by the model (objective {comp.objective}).",
+        fig,
+    )
+
+
+def figures(result) -> list[Figure]:
+    """All figures of an ``rv_reducer`` study result."""
+    out: list[Figure] = []
+    if "load_sharing" in result:
+        a = result["load_sharing"]
+        ls, ls0 = a.data["load"], a.data.get("load_without_errors")
+        out.append(_pin_map(ls, "Pin-load map"))
+        if ls0 is not None:
+            out.append(_pin_map(ls0, "Pin-load map without errors"))
+        out.append(_peak(ls, ls0))
+    if "transmission_error" in result:
+        out.append(_te(result["transmission_error"].data["te"]))
+    if "catalogue" in result:
+        cat = result["catalogue"].data["catalogue"]
+        out.append(_hysteresis(cat, result["catalogue"]["rated_torque [N*m]"] * 1e3))
+    if "compensation" in result:
+        out.append(_compensation(result["compensation"].data["compensation"]))
+    return out

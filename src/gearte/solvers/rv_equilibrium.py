@@ -1,0 +1,414 @@
+"""Equilibrium of spring rows + unilateral contacts with a load-dependent contact stiffness.
+
+Solves, at each output position ``p``, for the displacement ``q`` minimising the potential
+
+``Π(q) = ½ Σ_s k_s (B_s q + e_s)² + ½ Σ_c k_g(c) max(B_c q − g_c, 0)² − T uᵀ q``
+
+(springs ``s``, contacts ``c`` grouped by disc ``g``), i.e. the quasi-static equilibrium with
+unilateral pin contacts. For a fixed contact stiffness Π is convex and piecewise quadratic; it
+is minimised by an active-set (semismooth) Newton method with a backtracking line search on Π,
+which terminates when the active set repeats — the solution is then exact to round-off.
+
+The contact stiffness is load dependent (Hu et al. 2020 section 4): for each disc
+``k_g = F_max,g / δ(F_max,g)`` with ``δ`` the contact law of
+:func:`gearte.models.rv_load_sharing.hu2020_contact_deformation`. This outer fixed point is a
+contraction (the secant stiffness varies with ``ln F``) and is iterated to a relative change
+below ``tol``. Positions are solved in sequence, each warm-started from the previous one.
+
+A compiled kernel (numba) and its plain-Python twin (``_solve_position.py_func``) run the same
+algorithm; :func:`solve_reference` is an independent scipy check.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from gearte.errors import ConvergenceError
+
+__all__ = ["ContactLaw", "EquilibriumSolution", "solve_positions", "solve_reference"]
+
+LAW_LINEAR = 0
+LAW_HU2020 = 1
+#: Stiffness left inside a bearing clearance, relative to the bearing's stiffness. It keeps the
+#: equilibrium unique when parts float in their clearances (at zero load); its force is below
+#: 1e-6 k c (< 1 N for 10 µm at 1e5 N/mm).
+CLEARANCE_RESIDUAL = 1e-6
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """Pin-contact stiffness law.
+
+    Attributes
+    ----------
+    kind : str
+        ``"hu2020"`` (per-disc secant stiffness ``F_max/δ(F_max)``, Hu 2020 eq 33–36) or
+        ``"linear"`` (constant ``stiffness``).
+    stiffness : float
+        Constant stiffness for ``"linear"`` [N/mm]; starting value for ``"hu2020"``.
+    rho, pin_radius, youngs_modulus, poisson_ratio, face_width : float
+        Parameters of the Hu law: curvature radius at ``φ₀`` [mm], ``r_rp`` [mm], ``E`` [MPa],
+        ``μ`` [-], ``b`` [mm].
+    """
+
+    kind: str = "hu2020"
+    stiffness: float = 2.0e5
+    rho: float = 40.0
+    pin_radius: float = 3.0
+    youngs_modulus: float = 2.06e5
+    poisson_ratio: float = 0.3
+    face_width: float = 10.0
+
+    def params(self) -> np.ndarray:
+        return np.array(
+            [self.rho, self.pin_radius, self.youngs_modulus, self.poisson_ratio, self.face_width]
+        )
+
+    @property
+    def code(self) -> int:
+        if self.kind == "linear":
+            return LAW_LINEAR
+        if self.kind == "hu2020":
+            return LAW_HU2020
+        raise ValueError(f"contact law {self.kind!r}: must be 'hu2020' or 'linear'")
+
+
+@dataclass(frozen=True)
+class EquilibriumSolution:
+    """Solution at ``P`` positions.
+
+    Attributes
+    ----------
+    q : (P, nd) displacements [mm, rad].
+    contact_force : (P, nc) [N].
+    contact_stiffness : (P, ngroups) [N/mm].
+    iterations : (P,) Newton iterations used (summed over the stiffness fixed point).
+    """
+
+    q: np.ndarray
+    contact_force: np.ndarray
+    contact_stiffness: np.ndarray
+    iterations: np.ndarray
+
+
+@njit(cache=True, nogil=True)
+def _hu_delta(f, p):
+    rho = abs(p[0])
+    r = p[1]
+    e = p[2]
+    mu2 = 1.0 - p[3] * p[3]
+    b = p[4]
+    c2 = 4.99e-3**2 * (4.0 * mu2 * f * rho * r / (e * b * (rho + r)))
+    return 2.0 * f * mu2 / (np.pi * e * b) * (2.0 / 3.0 + np.log(16.0 * r * rho / c2))
+
+
+@njit(cache=True, nogil=True)
+def _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q):
+    e = 0.5 * q @ (K0 @ q) - f0 @ q
+    d = Bc @ q - gc
+    for c in range(d.size):
+        if d[c] > 0.0:
+            e += 0.5 * kc[c] * d[c] * d[c]
+    for m in range(kn.size):
+        wx = Bn[m, 0] @ q + en[m, 0]
+        wy = Bn[m, 1] @ q + en[m, 1]
+        rr = wx * wx + wy * wy
+        e += 0.5 * CLEARANCE_RESIDUAL * kn[m] * rr
+        r = np.sqrt(rr) - cn[m]
+        if r > 0.0:
+            e += 0.5 * (1.0 - CLEARANCE_RESIDUAL) * kn[m] * r * r
+    return e
+
+
+@njit(cache=True, nogil=True)
+def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
+    """Minimise Π for fixed contact stiffness; returns (q, iterations, ok).
+
+    ``Bn, en, kn, cn``: isotropic bearings with radial clearance, energy
+    ``ε k |w|²/2 + (1 − ε) k (|w| − c)₊² / 2`` with ``w = (Bn[m,0]·q + en[m,0], Bn[m,1]·q +
+    en[m,1])`` and ``ε = CLEARANCE_RESIDUAL`` (convex: squared distance to a disc).
+    """
+    nd = q.size
+    nc = gc.size
+    nm = kn.size
+    reg = 1e-13 * np.max(np.abs(np.diag(K0)))
+    active = np.zeros(nc, dtype=np.bool_)
+    d = Bc @ q - gc
+    for c in range(nc):
+        active[c] = d[c] > 0.0
+    for it in range(maxit):
+        H = K0.copy()
+        grad = K0 @ q - f0
+        for c in range(nc):
+            if active[c]:
+                w = kc[c] * d[c]
+                for a in range(nd):
+                    grad[a] += w * Bc[c, a]
+                    ba = kc[c] * Bc[c, a]
+                    for b in range(nd):
+                        H[a, b] += ba * Bc[c, b]
+        for m in range(nm):
+            wx = Bn[m, 0] @ q + en[m, 0]
+            wy = Bn[m, 1] @ q + en[m, 1]
+            rr = np.sqrt(wx * wx + wy * wy)
+            k0m = CLEARANCE_RESIDUAL * kn[m]
+            gx, gy = k0m * wx, k0m * wy
+            hxx, hyy, hxy = k0m, k0m, 0.0
+            if rr > cn[m]:
+                k1m = kn[m] - k0m
+                ux, uy = wx / rr, wy / rr
+                s = 1.0 - cn[m] / rr
+                # w-space gradient k (|w| - c) u and Hessian k [s I + (1 - s) u uᵀ]
+                gx += k1m * (rr - cn[m]) * ux
+                gy += k1m * (rr - cn[m]) * uy
+                hxx += k1m * (s + (1.0 - s) * ux * ux)
+                hyy += k1m * (s + (1.0 - s) * uy * uy)
+                hxy += k1m * (1.0 - s) * ux * uy
+            if True:
+                for a in range(nd):
+                    bx, by = Bn[m, 0, a], Bn[m, 1, a]
+                    grad[a] += gx * bx + gy * by
+                    ta = hxx * bx + hxy * by
+                    tb = hxy * bx + hyy * by
+                    for b in range(nd):
+                        H[a, b] += ta * Bn[m, 0, b] + tb * Bn[m, 1, b]
+        for a in range(nd):
+            H[a, a] += reg
+        dq = -np.linalg.solve(H, grad)
+        # backtracking line search on the convex potential
+        e0 = _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q)
+        step = 1.0
+        qn = q + dq
+        decreased = False
+        e1 = e0
+        for _ in range(60):
+            e1 = _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, qn)
+            if e1 <= e0 + 1e-12 * abs(e0):
+                decreased = True
+                break
+            step *= 0.5
+            qn = q + step * dq
+        if not decreased:
+            # no descent left at round-off level: q is the minimiser to machine precision
+            return q, it + 1, True
+        stalled = e0 - e1 <= 1e-14 * abs(e0)
+        q = qn
+        d = Bc @ q - gc
+        same = True
+        for c in range(nc):
+            a_new = d[c] > 0.0
+            if a_new != active[c]:
+                same = False
+            active[c] = a_new
+        small = np.max(np.abs(step * dq)) < tol
+        if small or (same and step == 1.0 and nm == 0) or (same and stalled and it > 2):
+            return q, it + 1, True
+    return q, maxit, False
+
+
+@njit(cache=True, nogil=True)
+def _solve_position(
+    K0, f0, Bn, en, kn, cn, Bc, gc, group, ngroups, law, params, k0, q0, tol, maxit
+):
+    """One position: Newton inside, fixed point on the per-disc contact stiffness outside."""
+    q = q0.copy()
+    k = k0.copy()
+    nc = gc.size
+    kc = np.empty(nc)
+    total = 0
+    qtol = 1e-13 * max(1.0, np.max(np.abs(q0)))
+    for _outer in range(200):
+        for c in range(nc):
+            kc[c] = k[group[c]]
+        q, its, ok = _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, qtol, maxit)
+        total += its
+        if not ok:
+            return q, k, kc * 0.0, total, False
+        d = Bc @ q - gc
+        force = np.zeros(nc)
+        for c in range(nc):
+            if d[c] > 0.0:
+                force[c] = kc[c] * d[c]
+        if law == LAW_LINEAR:
+            return q, k, force, total, True
+        change = 0.0
+        for g in range(ngroups):
+            fmax = 0.0
+            for c in range(nc):
+                if group[c] == g and force[c] > fmax:
+                    fmax = force[c]
+            if fmax > 0.0:
+                knew = fmax / _hu_delta(fmax, params)
+                change = max(change, abs(knew / k[g] - 1.0))
+                k[g] = knew
+        if change < tol:
+            for c in range(nc):
+                kc[c] = k[group[c]]
+            d = Bc @ q - gc
+            for c in range(nc):
+                force[c] = kc[c] * d[c] if d[c] > 0.0 else 0.0
+            return q, k, force, total, True
+    return q, k, kc * 0.0, total, False
+
+
+@njit(cache=True, nogil=True)
+def _solve_all(
+    K0s, f0s, Bns, ens, kn, cn, Bcs, gcs, group, ngroups, law, params, k0, q0, tol, maxit
+):
+    P = K0s.shape[0]
+    nd = q0.size
+    nc = gcs.shape[1]
+    Q = np.zeros((P, nd))
+    F = np.zeros((P, nc))
+    Ks = np.zeros((P, ngroups))
+    its = np.zeros(P, dtype=np.int64)
+    q = q0.copy()
+    k = k0.copy()
+    for p in range(P):
+        q, k, f, n, ok = _solve_position(
+            K0s[p], f0s[p], Bns[p], ens[p], kn, cn, Bcs[p], gcs[p], group, ngroups, law, params,
+            k, q, tol, maxit,
+        )  # fmt: skip
+        if not ok:
+            its[p] = -1
+            return Q, F, Ks, its
+        Q[p] = q
+        F[p] = f
+        Ks[p] = k
+        its[p] = n
+    return Q, F, Ks, its
+
+
+def _split_springs(system):
+    """Linear rows and clearance pairs of a system (pairs: consecutive x, y rows with c > 0)."""
+    c = getattr(system, "spring_c", None)
+    ns = system.spring_k.size
+    c = np.zeros(ns) if c is None else np.asarray(c, dtype=float)
+    lin = c == 0.0
+    first = np.flatnonzero(~lin)[::2]
+    Bn = np.ascontiguousarray(
+        np.stack([system.spring_B[:, first], system.spring_B[:, first + 1]], 2)
+    )
+    en = np.ascontiguousarray(
+        np.stack([system.spring_e[:, first], system.spring_e[:, first + 1]], 2)
+    )
+    return lin, Bn, en, system.spring_k[first].copy(), c[first].copy()
+
+
+def _linear_parts(spring_B, spring_e, spring_k, load):
+    """``K0 = Σ k B Bᵀ`` and ``f0 = load − Σ k e B`` per position."""
+    kB = spring_B * spring_k[None, :, None]
+    K0 = np.einsum("psi,psj->pij", kB, spring_B)
+    f0 = load - np.einsum("psi,ps->pi", kB, spring_e)
+    return np.ascontiguousarray(K0), np.ascontiguousarray(f0)
+
+
+def solve_positions(
+    system,
+    torque: float | np.ndarray,
+    law: ContactLaw,
+    *,
+    q0: np.ndarray | None = None,
+    k0: np.ndarray | None = None,
+    tol: float = 1e-9,
+    maxit: int = 100,
+    compiled: bool = True,
+) -> EquilibriumSolution:
+    """Quasi-static equilibrium at every position of ``system`` under output torque(s).
+
+    Parameters
+    ----------
+    system : gearte.models.rv_load_sharing.RVSystem
+        Spring and contact rows at ``P`` positions.
+    torque : float or (P,) array
+        Output load torque [N·mm] (positive resists the drive; may change sign along a sweep).
+    law : ContactLaw
+    q0, k0 : arrays, optional
+        Warm start for the first position (displacements, per-disc contact stiffness).
+    tol : float
+        Relative tolerance of the contact-stiffness fixed point.
+    compiled : bool
+        ``False`` runs the plain-Python twin of the same kernel (for tests).
+
+    Raises
+    ------
+    ConvergenceError
+        If Newton or the stiffness fixed point fails at some position.
+    """
+    P = system.theta.size
+    torque = np.broadcast_to(np.asarray(torque, dtype=float), (P,))
+    load = torque[:, None] * system.unit_load[None, :]
+    lin, Bn, en, kn, cn = _split_springs(system)
+    K0, f0 = _linear_parts(
+        system.spring_B[:, lin], system.spring_e[:, lin], system.spring_k[lin], load
+    )
+    ngroups = int(system.contact_group.max()) + 1
+    nd = K0.shape[1]
+    q0 = np.zeros(nd) if q0 is None else np.asarray(q0, dtype=float)
+    k0 = np.full(ngroups, law.stiffness) if k0 is None else np.asarray(k0, dtype=float)
+    fn = _solve_all if compiled else _solve_all.py_func
+    if not compiled:
+        # the twin calls the plain-Python versions of the inner kernels too
+        g = _solve_all.py_func.__globals__
+        saved = {n: g[n] for n in ("_solve_position", "_newton", "_energy", "_hu_delta")}
+        for n in saved:
+            g[n] = saved[n].py_func
+        try:
+            out = fn(
+                K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
+                np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
+                ngroups, law.code, law.params(), k0, q0, tol, maxit,
+            )  # fmt: skip
+        finally:
+            g.update(saved)
+    else:
+        out = fn(
+            K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
+            np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
+            ngroups, law.code, law.params(), k0, q0, tol, maxit,
+        )  # fmt: skip
+    Q, F, Ks, its = out
+    if np.any(its < 0):
+        p = int(np.argmax(its < 0))
+        raise ConvergenceError(
+            f"rv_equilibrium: no equilibrium at position {p} (theta = {system.theta[p]:.6f} rad) "
+            f"within {maxit} Newton iterations / 200 stiffness iterations, tolerance {tol:g}"
+        )
+    return EquilibriumSolution(Q, F, Ks, its)
+
+
+def solve_reference(system, torque: float, law: ContactLaw, p: int = 0, k=None):
+    """Independent check at one position with ``scipy.optimize.fsolve`` on the equilibrium.
+
+    Uses the *given* per-disc contact stiffness ``k`` (fixed), residual
+    ``K0 q − f0 + Σ k max(Bq − g, 0) B + Σ_bearings k (|w| − c)₊ ŵ·B``. Returns ``q``.
+    """
+    from scipy.optimize import fsolve
+
+    load = torque * system.unit_load[None, :]
+    lin, Bn, en, kn, cn = _split_springs(system)
+    K0, f0 = _linear_parts(
+        system.spring_B[p : p + 1, lin], system.spring_e[p : p + 1, lin], system.spring_k[lin], load
+    )
+    K0, f0 = K0[0], f0[0]
+    Bn, en = Bn[p], en[p]
+    Bc, gc = system.contact_B[p], system.contact_gap[p]
+    ngroups = int(system.contact_group.max()) + 1
+    k = np.full(ngroups, law.stiffness) if k is None else np.asarray(k)
+    kc = k[system.contact_group]
+    scale = np.max(np.abs(np.diag(K0)))
+
+    def res(q):
+        d = Bc @ q - gc
+        r = K0 @ q - f0 + Bc.T @ (kc * np.maximum(d, 0.0))
+        w = np.einsum("mxi,i->mx", Bn, q) + en
+        n = np.linalg.norm(w, axis=1)
+        eps = CLEARANCE_RESIDUAL
+        gain = eps * kn + (1 - eps) * kn * np.maximum(n - cn, 0.0) / np.where(n > 0, n, 1.0)
+        f = gain[:, None] * w
+        return (r + np.einsum("mxi,mx->i", Bn, f)) / scale
+
+    return fsolve(res, np.zeros(K0.shape[0]), xtol=1e-13, full_output=False)
