@@ -201,3 +201,49 @@ def test_paper_stiffness_puts_first_mode_near_cycloid_mesh():
     assert m.cycloid_fourier[0] == pytest.approx(2.62e5)
     assert 300.0 < m.modal().frequencies[0] < 360.0
     assert any("cycloid mesh" in w for w in m.resonance_warnings(0.1))
+
+
+def _li2023_reducer(errors=None):
+    from gearte.geometry.rv import Cranks, Discs, FirstStage, PinRing, RVReducer, Supports
+
+    eps = 1.556394  # contact ratio of 12/36, m = 1.5, α = 20° (checked below)
+    return RVReducer(
+        first_stage=FirstStage(12, 36, 1.5, np.deg2rad(20.0), 1.4e5 * eps, 4.68e4),
+        cranks=Cranks(3, 36.0, 1.3, 2.84e5, 5.76e5),
+        discs=Discs(2, 12.0, -0.01, -0.05),
+        pins=PinRing(40, 3.0, 85.8),
+        supports=Supports(3.15e5),
+        rated_torque=450e3,
+        errors=errors,
+    )
+
+
+def test_model_from_shared_rv_description(model):
+    """The dynamics reuse gearte.geometry.rv.RVReducer: same parameters, same errors."""
+    from gearte.geometry.rv import ErrorEntry, ManufacturingErrors
+    from gearte.models.rv_dynamics import (
+        errors_from_reducer,
+        involute_contact_ratio,
+        parameters_from_reducer,
+    )
+
+    assert involute_contact_ratio(12, 36, 1.5, np.deg2rad(20)) == pytest.approx(1.556394, abs=1e-6)
+    p = parameters_from_reducer(_li2023_reducer(), cycloid_stiffness="mean")
+    ref = model.params
+    assert p.pair == ref.pair
+    assert p.involute_single_pair_stiffness_N_per_m == pytest.approx(
+        ref.involute_single_pair_stiffness_N_per_m, rel=1e-3
+    )
+    for name in ("turning_arm_bearing_stiffness_N_per_m", "output_support_stiffness_N_per_m"):
+        assert getattr(p, name) == pytest.approx(getattr(ref, name), rel=1e-12)
+    entries = [
+        ErrorEntry("cam", 1, 1, 0.008, np.deg2rad(90)),
+        ErrorEntry("disc_crank_bore", 2, 1, 0.008, np.deg2rad(140)),
+        ErrorEntry("carrier_crank_bore", 3, None, 0.035, np.deg2rad(270)),
+    ]
+    red = _li2023_reducer(ManufacturingErrors.from_entries(entries, 3, 2))
+    err = errors_from_reducer(red)
+    np.testing.assert_allclose(err.cam[0, 0], [0.008, np.deg2rad(90)])
+    np.testing.assert_allclose(err.disc_hole[1, 0], [0.008, np.deg2rad(140)])
+    np.testing.assert_allclose(err.carrier_hole[2], [0.035, np.deg2rad(-90)])
+    assert err.cam[1:].sum() == 0 and err.disc_hole[0].sum() == 0

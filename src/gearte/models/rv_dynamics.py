@@ -69,6 +69,8 @@ __all__ = [
     "rv_dte",
     "RHS_SOURCE_KEY",
     "ode_system",
+    "parameters_from_reducer",
+    "errors_from_reducer",
 ]
 
 # --- unit conversions of the dynamic model (paper units → mm, N, s, t) -----------------------
@@ -1173,4 +1175,98 @@ def ode_system(model: RVDynamicModel, errors: RVErrors | None = None):
         rhs_python=m.rhs_numpy,
         output_python=lambda t, y: float(y[m.n_dof - 1] - y[2] / m.params.ratio),
         stability_eigenvalues=model.damped_eigenvalues(mesh="max"),
+    )
+
+
+# --- building the dynamic model from the shared RV description (gearte.geometry.rv) ----------
+def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
+    """RVDynamicsParameters from an :class:`gearte.geometry.rv.RVReducer` description.
+
+    The description supplies geometry, modification, material, mesh/bearing/support stiffnesses
+    (its N/mm → N/m here); ``dynamic`` supplies what only the dynamics needs (masses, inertias,
+    torsional and bending stiffnesses, damping, operating point), defaulting to paper 004 Table 2.
+    The description's mean involute mesh stiffness k̄ becomes the single-pair stiffness k̄/ε_α of
+    the rectangular wave.
+
+    Raises
+    ------
+    ParameterError
+        When the crank circle radius differs from the first-stage centre distance (the dynamic
+        model derives it from the gears) or a per-pin error is given (the equivalent single-spring
+        cycloid–pin contact cannot represent it).
+    """
+    fs, cr, di, pins = reducer.first_stage, reducer.cranks, reducer.discs, reducer.pins
+    a_h = fs.module * (fs.sun_teeth + fs.planet_teeth) / 2.0
+    if abs(cr.circle_radius - a_h) > 1e-6 * a_h:
+        raise ParameterError(
+            "cranks.circle_radius",
+            cr.circle_radius,
+            f"must equal the first-stage centre distance m (z_1 + z_2)/2 = {a_h:g} mm",
+        )
+    for name in ("radius_errors", "radial_position_errors", "tangential_position_errors"):
+        if np.any(getattr(pins, name) != 0):
+            raise ParameterError(
+                f"pins.{name}",
+                "non-zero",
+                "per-pin errors are not representable by the equivalent cycloid–pin spring of "
+                "the dynamic model; use the composite error RVErrors.pin_composite",
+            )
+    pair = CycloidPinPair(
+        pin_count=pins.count,
+        pin_radius_mm=pins.pin_radius,
+        pin_circle_radius_mm=pins.circle_radius,
+        eccentricity_mm=cr.eccentricity,
+        face_width_mm=di.face_width,
+        youngs_modulus_MPa=di.youngs_modulus,
+        poisson_ratio=di.poisson_ratio,
+        pin_radius_modification_mm=di.equidistant_modification,
+        pin_position_modification_mm=di.shift_modification,
+    )
+    eps = involute_contact_ratio(fs.sun_teeth, fs.planet_teeth, fs.module, fs.pressure_angle)
+    kw = dict(
+        sun_teeth=fs.sun_teeth,
+        planet_teeth=fs.planet_teeth,
+        module_mm=fs.module,
+        pressure_angle_deg=float(np.degrees(fs.pressure_angle)),
+        crank_count=cr.count,
+        disc_count=di.count,
+        pair=pair,
+        sun_support_stiffness_N_per_m=fs.sun_support_stiffness / N_PER_M_TO_N_PER_MM,
+        involute_single_pair_stiffness_N_per_m=fs.mesh_stiffness / eps / N_PER_M_TO_N_PER_MM,
+        turning_arm_bearing_stiffness_N_per_m=cr.cam_bearing_stiffness / N_PER_M_TO_N_PER_MM,
+        crank_bearing_stiffness_N_per_m=cr.carrier_bearing_stiffness / N_PER_M_TO_N_PER_MM,
+        output_support_stiffness_N_per_m=reducer.supports.carrier_radial_stiffness
+        / N_PER_M_TO_N_PER_MM,
+    )
+    kw.update(dynamic)
+    return RVDynamicsParameters(**kw)
+
+
+def errors_from_reducer(reducer, **paper004) -> RVErrors:
+    """RVErrors from the description's measured errors and clearances.
+
+    The description's error vectors (x, y) in the part frames use the same frames as this model
+    (planet: from disc 1's eccentric direction; disc bore and carrier bore: from the radial
+    direction; cam: from its eccentric direction), so they map 1:1 to (amplitude, phase). Its
+    disc-bore array is indexed (disc, crank) and is transposed. ``paper004`` adds the errors the
+    description does not hold (sun_eccentricity, sun_assembly, output_assembly, pin_composite,
+    output_bearing_clearance_mm).
+    """
+    e = reducer.errors
+    m, n = reducer.cranks.count, reducer.discs.count
+
+    def polar(v):
+        v = np.asarray(v, dtype=float)
+        return np.stack([np.hypot(v[..., 0], v[..., 1]), np.arctan2(v[..., 1], v[..., 0])], -1)
+
+    return RVErrors(
+        crank_count=m,
+        disc_count=n,
+        planet_eccentricity=polar(e.planet),
+        carrier_hole=polar(e.carrier_bore),
+        disc_hole=polar(np.swapaxes(e.disc_bore, 0, 1)),
+        cam=polar(e.cam),
+        turning_arm_clearance_mm=reducer.cranks.cam_bearing_clearance,
+        crank_bearing_clearance_mm=reducer.cranks.carrier_bearing_clearance,
+        **paper004,
     )
