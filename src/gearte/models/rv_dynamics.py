@@ -386,7 +386,7 @@ _P = {
 NPF = len(_P)
 
 
-@njit(cache=True, nogil=True, fastmath=False)
+@njit(cache=True, nogil=True)
 def _bearing(dx, dy, vx, vy, k, c, cl):
     """Force (on body a) of an isotropic bearing with radial clearance cl; returns fx, fy."""
     if cl <= 0.0:
@@ -704,6 +704,7 @@ class RVDynamicModel:
         names += [f"disc{j + 1}" for j in range(n)] + ["output"]
         self.body_names = names
         self.dof_names = [f"{b}.{c}" for b in names for c in ("x", "y", "theta")]
+        self._lu_cache: dict = {}
         self._beta_r = 0.0
         self._beta_r = self._calibrate_damping()
 
@@ -1039,14 +1040,21 @@ class RVDynamicModel:
 
         Raises ConvergenceError when the clearances prevent convergence in 100 iterations.
         """
-        K = self.stiffness_matrix(t, mesh="time")
+        from scipy.linalg import lu_factor, lu_solve
+
+        # K does not depend on the errors: its factorisation is shared by with_errors() copies
+        lu = self._lu_cache.get(t)
+        if lu is None:
+            lu = lu_factor(self.stiffness_matrix(t, mesh="time"))
+            self._lu_cache[t] = lu
         q = np.zeros(self.n_dof)
-        scale = np.max(np.abs(self.external_force(t)))
+        f_ext = self.external_force(t)
+        scale = np.max(np.abs(f_ext))
         for it in range(100):  # noqa: B007 - reported on failure
-            r = self.elastic_force(t, q) + self.external_force(t)
+            r = self.elastic_force(t, q) + f_ext
             if np.max(np.abs(r)) <= tol * scale:
                 return q
-            q = q + np.linalg.solve(K, r)
+            q = q + lu_solve(lu, r)
         raise ConvergenceError(
             f"static_equilibrium: modified Newton did not converge in {it + 1} iterations "
             f"(residual {np.max(np.abs(r)):.3g} N, tolerance {tol * scale:.3g} N)"
