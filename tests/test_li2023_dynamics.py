@@ -247,3 +247,13 @@ def test_model_from_shared_rv_description(model):
     np.testing.assert_allclose(err.disc_hole[1, 0], [0.008, np.deg2rad(140)])
     np.testing.assert_allclose(err.carrier_hole[2], [0.035, np.deg2rad(-90)])
     assert err.cam[1:].sum() == 0 and err.disc_hole[0].sum() == 0
+
+
+def test_spectrum_labels():
+    from gearte.models.rv_dynamics_sim import label_frequency
+
+    src = RVDynamicsParameters().frequencies()
+    assert label_frequency(8.26, src, 0.1) == "crank rotation"
+    assert label_frequency(595.04, src, 0.1) == "2× involute mesh"
+    assert "sideband" in label_frequency(322.31 + 8.264, src, 0.05)
+    assert label_frequency(4321.0, src, 0.1) == "unidentified"

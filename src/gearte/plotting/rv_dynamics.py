@@ -51,7 +51,7 @@ def _dte_figures(a) -> list[Figure]:
     )
     freq, spec, peaks = a.data["freq"], a.data["spec"], a.data["peaks"]
     fig, ax = new_figure(figsize=(8.0, 3.6))
-    ax.plot(freq, spec, lw=0.8, color=PALETTE[0])
+    ax.semilogy(freq[1:], np.maximum(spec[1:], 1e-6), lw=0.8, color=PALETTE[0])
     for k, pk in enumerate(peaks[:6]):
         f, amp = pk["frequency [Hz]"], pk["amplitude [arcsec]"]
         ax.annotate(
@@ -65,7 +65,8 @@ def _dte_figures(a) -> list[Figure]:
         ax.plot([f], [amp], "o", ms=3, color=PALETTE[1])
     ax.set_xlim(0, max(2.5 * max(a.data["sources"]["cycloid mesh"], 1.0), 10.0))
     ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("amplitude [arcsec]")
+    ax.set_ylabel("amplitude [arcsec] (log)")
+    ax.set_ylim(max(1e-6, 1e-4 * spec[1:].max()), 3 * spec[1:].max())
     ax.grid(alpha=0.3)
     out.append(
         Figure(

@@ -337,8 +337,21 @@ def _modal(case: Case, model, warnings: list[str]) -> AnalysisResult:
     res_msgs = model.resonance_warnings(opts.resonance_margin)
     warnings.extend(res_msgs)
     freqs = modal.frequencies
+    shapes = []
+    sq = np.sqrt(model.mass)
+    for k in range(min(12, freqs.size)):
+        e = (modal.shapes[:, k] * sq) ** 2
+        e = e / e.sum()
+        top = np.argsort(e)[::-1][:3]
+        shapes.append(
+            {
+                "frequency [Hz]": float(freqs[k]),
+                "dominant_dofs": {model.dof_names[i]: round(float(e[i]), 3) for i in top},
+            }
+        )
     values = {
         "natural_frequencies [Hz]": freqs,
+        "mode_shapes": shapes,
         "rigid_mode_ratio": rigid_ratio,
         "rigid_mode_disc_over_output": float(v[i_c]),
         "lowest_elastic_frequency_without_input_shaft [Hz]": float(free.frequencies[1]),
@@ -352,7 +365,8 @@ def _modal(case: Case, model, warnings: list[str]) -> AnalysisResult:
         values=values,
         references=["li2023"],
         notes=[
-            "Undamped modes at mean mesh stiffness, configuration at t = 0.",
+            "Undamped modes at mean mesh stiffness, configuration at t = 0; mode_shapes lists "
+            "each mode's three DOFs with the largest share of kinetic energy.",
             "Rigid mode computed with the input shaft spring removed: θ_s/θ_o must equal the "
             "ratio and the disc must rotate with the output.",
             f"Stiffness-proportional damping c = β_R k with β_R = 2ζ/ω_1, ζ = "
