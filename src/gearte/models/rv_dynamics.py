@@ -380,6 +380,10 @@ _P = {
             "r_bp",
             "n_m",
             "n_n",
+            "cos_alpha",
+            "sin_alpha",
+            "cos_beta_cr",
+            "sin_beta_cr",
         ]
     )
 }
@@ -449,8 +453,8 @@ def rv_rhs(t, y, args, dydt):
     a_h = pf[4]
     ecc = pf[5]
     r_bs = pf[6]
-    ca = np.cos(pf[7])
-    sa = np.sin(pf[7])
+    ca = pf[32]
+    sa = pf[33]
     br = pf[21]
     i_out = nd - 3
     # sun support (ground seat offset = sun assembly error) and input shaft torsion
@@ -558,8 +562,8 @@ def rv_rhs(t, y, args, dydt):
         f[ih + 1] += pf[24] * w2 * sps
     # discs
     w_h = pf[2] * w_o
-    sb = np.sin(pf[19])
-    cb = np.cos(pf[19])
+    sb = pf[35]
+    cb = pf[34]
     for j in range(nn):
         ic = 3 * (1 + 2 * nm + j)
         ex = chh * geo_n[j, 0] - shh * geo_n[j, 1]  # chi_j = th_h + π j
@@ -754,6 +758,10 @@ class RVDynamicModel:
             "r_bp": self.r_bp,
             "n_m": p.crank_count,
             "n_n": p.disc_count,
+            "cos_alpha": np.cos(self.alpha),
+            "sin_alpha": np.sin(self.alpha),
+            "cos_beta_cr": np.cos(self.beta_cr),
+            "sin_beta_cr": np.sin(self.beta_cr),
         }
         for key, val in vals.items():
             pf[_P[key]] = val
