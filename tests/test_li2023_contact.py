@@ -9,6 +9,8 @@ docs/validation/li2023.md).
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from gearte.errors import ParameterError
 from gearte.models.cycloid_loaded_contact import (
@@ -138,3 +140,23 @@ def test_fourier_fit_roundtrip(mod):
 def test_bad_torque():
     with pytest.raises(ParameterError, match="torque_Nmm"):
         loaded_contact(LI2023_PAIR, -5.0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    torque=st.floats(1e3, 1e6),
+    drr=st.floats(-0.02, 0.0),
+    drp=st.floats(-0.1, 0.0),
+    pos=st.floats(0.0, 2 * np.pi / 40),
+)
+def test_equilibrium_property(torque, drr, drp, pos):
+    try:
+        pair = CycloidPinPair(pin_radius_modification_mm=drr, pin_position_modification_mm=drp)
+    except ParameterError:
+        return  # interfering modification, rejected on construction
+    c = loaded_contact(pair, torque, pos)
+    moment = np.sum(c.force * np.where(c.arm > 0, c.arm, 0.0))
+    assert moment == pytest.approx(torque, rel=1e-8)
+    assert c.pins_in_contact[0] >= 1
+    assert 0.0 < c.pressure_angle[0] < np.radians(45.0)
+    assert c.mesh_stiffness[0] > 0

@@ -113,3 +113,15 @@ def test_li2023_rv_errors_cli(tmp_path):
     v = d["analyses"]["dte"]["values"]
     assert 5.0 <= v["dte_peak_to_peak [arcsec]"] <= 50.0
     assert v["dominant_dte_source"] == "crank rotation"
+
+
+def test_bad_solver_and_unknown_key():
+    data = _short("li2023_rv")
+    data["analyses"]["dte"]["method"] = "euler"
+    data["dynamics"]["dampin_ratio"] = 0.1
+    data["errors"] = {"placement": "every", "cam": {"amplitude_mm": -0.01, "phase_deg": 0.0}}
+    with pytest.raises(CaseFileError) as exc:
+        load_case_dict(data)
+    text = str(exc.value)
+    for field in ("analyses.dte.method", "dynamics.dampin_ratio", "errors.placement", "errors.cam"):
+        assert field in text, field
