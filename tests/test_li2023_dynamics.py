@@ -257,3 +257,11 @@ def test_spectrum_labels():
     assert label_frequency(595.04, src, 0.1) == "2× involute mesh"
     assert "sideband" in label_frequency(322.31 + 8.264, src, 0.05)
     assert label_frequency(4321.0, src, 0.1) == "unidentified"
+
+
+def test_static_equilibrium_compiled_equals_plain(model):
+    err = RVErrors.table3(placement="first", turning_arm_clearance_mm=0.001)
+    m = model.with_errors(err)
+    a = m.static_equilibrium(0.0)
+    b = m.static_equilibrium(0.0, compiled=False)
+    np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12)

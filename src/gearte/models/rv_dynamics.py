@@ -1043,10 +1043,14 @@ class RVDynamicModel:
         return np.concatenate([v, acc])
 
     # --- statics and modes ---------------------------------------------------------------------
-    def static_equilibrium(self, t: float = 0.0, *, tol: float = 1e-10) -> np.ndarray:
+    def static_equilibrium(
+        self, t: float = 0.0, *, tol: float = 1e-10, compiled: bool = True
+    ) -> np.ndarray:
         """Deviation q of static equilibrium at time t (modified Newton with the linear K).
 
-        Raises ConvergenceError when the clearances prevent convergence in 100 iterations.
+        The residual (all element forces + loads at zero velocity) comes from the compiled
+        :func:`rv_rhs` (``compiled=True``) or the plain element model. Raises ConvergenceError
+        when the clearances prevent convergence in 100 iterations.
         """
         from scipy.linalg import lu_factor, lu_solve
 
@@ -1055,11 +1059,20 @@ class RVDynamicModel:
         if lu is None:
             lu = lu_factor(self.stiffness_matrix(t, mesh="time"))
             self._lu_cache[t] = lu
-        q = np.zeros(self.n_dof)
+        nd = self.n_dof
+        q = np.zeros(nd)
         f_ext = self.external_force(t)
         scale = np.max(np.abs(f_ext))
+        args = self.kernel_args() if compiled else None
+        y = np.zeros(2 * nd)
+        dydt = np.empty(2 * nd)
         for it in range(100):  # noqa: B007 - reported on failure
-            r = self.elastic_force(t, q) + f_ext
+            if compiled:
+                y[:nd] = q
+                rv_rhs(t, y, args, dydt)
+                r = dydt[nd:] * self.mass
+            else:
+                r = self.elastic_force(t, q) + f_ext
             if np.max(np.abs(r)) <= tol * scale:
                 return q
             q = q + lu_solve(lu, r)

@@ -33,6 +33,31 @@ def _contact_figure(a) -> Figure:
     )
 
 
+def _load_figure(a) -> Figure:
+    sweep = a.values["load_sweep"]
+    t = [r["torque_per_disc [N·m]"] for r in sweep]
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(9.0, 3.4))
+    ax1.plot(t, [r["equivalent_pressure_angle_mean [deg]"] for r in sweep], "o-", color=PALETTE[0])
+    ax1.set_xlabel("torque per disc [N·m]")
+    ax1.set_ylabel("mean β [deg]")
+    ax2.plot(
+        t,
+        [r["equivalent_mesh_stiffness_mean [N/m]"] / 1e9 for r in sweep],
+        "o-",
+        color=PALETTE[1],
+    )
+    ax2.set_xlabel("torque per disc [N·m]")
+    ax2.set_ylabel("mean k_cr [GN/m]")
+    for ax in (ax1, ax2):
+        ax.grid(alpha=0.3)
+    return Figure(
+        "Equivalent pressure angle and mesh stiffness against load",
+        "Means over one mesh period; the Hertz contact stiffens with load and, with a "
+        "modification, more pins come into contact.",
+        fig,
+    )
+
+
 def _dte_figures(a) -> list[Figure]:
     r = a.data["dte"]
     out = []
@@ -151,6 +176,8 @@ def figures(result) -> list[Figure]:
     out: list[Figure] = []
     if "contact" in result:
         out.append(_contact_figure(result["contact"]))
+        if result["contact"].values.get("load_sweep"):
+            out.append(_load_figure(result["contact"]))
     if "dte" in result:
         out += _dte_figures(result["dte"])
     if "modal" in result:
