@@ -150,8 +150,9 @@ def dte_spectrum(
 ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Amplitude spectrum [arcsec] of a uniformly sampled DTE and its labelled peaks.
 
-    Hann window, amplitude-corrected; peaks are local maxima above 1 % of the largest, labelled
-    by :func:`label_frequency` within 1.5 frequency bins (at least 1 Hz).
+    Hann window, amplitude-corrected; peaks are the ``n_peaks`` largest local maxima above
+    0.1 % of the largest, labelled by :func:`label_frequency` within 1.5 frequency bins (at
+    least 1 Hz).
     """
     n = dte.size
     if n < 8:
@@ -163,7 +164,7 @@ def dte_spectrum(
     df = freq[1]
     inner = (spec[1:-1] > spec[:-2]) & (spec[1:-1] >= spec[2:])
     cand = np.nonzero(inner)[0] + 1
-    cand = cand[spec[cand] >= 0.01 * spec[1:].max()] if cand.size else cand
+    cand = cand[spec[cand] >= 1e-3 * spec[1:].max()] if cand.size else cand
     cand = cand[np.argsort(spec[cand])[::-1]][:n_peaks]
     peaks = [
         {

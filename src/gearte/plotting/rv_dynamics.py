@@ -77,7 +77,7 @@ def _dte_figures(a) -> list[Figure]:
     freq, spec, peaks = a.data["freq"], a.data["spec"], a.data["peaks"]
     fig, ax = new_figure(figsize=(8.0, 3.6))
     ax.semilogy(freq[1:], np.maximum(spec[1:], 1e-6), lw=0.8, color=PALETTE[0])
-    for k, pk in enumerate(peaks[:6]):
+    for k, pk in enumerate(peaks[:8]):
         f, amp = pk["frequency [Hz]"], pk["amplitude [arcsec]"]
         ax.annotate(
             f"{pk['source']}\n{f:.1f} Hz",
@@ -145,6 +145,9 @@ def _campbell_figure(a) -> Figure:
         fmax = max(fmax, 2 * line.max())
     for f in freqs[freqs <= 1.1 * fmax]:
         ax.axhline(f, color="0.6", lw=0.6)
+    op = a.data.get("operating_rpm")
+    if op is not None:
+        ax.axvline(op, color="k", ls=":", lw=1.0, label="operating speed")
     ax.set_xlabel("input speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
     ax.set_ylim(0, 1.1 * fmax)

@@ -372,7 +372,12 @@ def _modal(case: Case, model, warnings: list[str]) -> AnalysisResult:
             f"Stiffness-proportional damping c = β_R k with β_R = 2ζ/ω_1, ζ = "
             f"{model.params.damping_ratio:g}.",
         ],
-        data={"modal": modal, "speeds_rpm": speeds, "mesh_lines": meshes},
+        data={
+            "modal": modal,
+            "speeds_rpm": speeds,
+            "mesh_lines": meshes,
+            "operating_rpm": model.params.input_speed_rpm,
+        },
     )
 
 
