@@ -39,7 +39,6 @@ doi:10.3390/machines11060626
 from __future__ import annotations
 
 import hashlib
-import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -1183,11 +1182,6 @@ class RVDynamicModel:
         new = replace(self.params, **changes)
         same = new.pair == self.params.pair and new.output_torque_Nm == self.params.output_torque_Nm
         return RVDynamicModel(new, self.errors, contact=self.contact if same else None)
-
-
-def _warn_resonance(model: RVDynamicModel) -> None:  # pragma: no cover - convenience
-    for msg in model.resonance_warnings():
-        warnings.warn(msg, stacklevel=2)
 
 
 def ode_system(model: RVDynamicModel, errors: RVErrors | None = None):
