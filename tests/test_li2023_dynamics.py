@@ -13,6 +13,7 @@ import pytest
 from gearte.errors import DivergenceError, ParameterError
 from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED
 from gearte.models.rv_dynamics import (
+    RHS_WORK_SIZE,
     RVDynamicModel,
     RVDynamicsParameters,
     RVErrors,
@@ -75,9 +76,14 @@ def test_compiled_rhs_matches_plain_twin(model):
     m = model.with_errors(err)
     args = m.kernel_args()
     out = np.empty(2 * m.n_dof)
+    out2 = np.empty(2 * m.n_dof)
+    work = np.full(RHS_WORK_SIZE, np.nan)
     for t in (0.0, 0.021, 3.3):
         y = rng.normal(0, 2e-3, 2 * m.n_dof)
-        rv_rhs(t, y, args, out)
+        rv_rhs(t, y, args, out, np.full(RHS_WORK_SIZE, np.nan))
+        rv_rhs(t, y, args, out2, work)  # memoised path (second call at the same t)
+        rv_rhs(t, y, args, out2, work)
+        np.testing.assert_array_equal(out, out2)
         ref = m.rhs_numpy(t, y)
         np.testing.assert_allclose(out, ref, rtol=1e-11, atol=1e-9 * np.max(np.abs(ref)))
 

@@ -67,6 +67,7 @@ __all__ = [
     "rv_rhs",
     "rv_dte",
     "RHS_SOURCE_KEY",
+    "RHS_WORK_SIZE",
     "ode_system",
     "parameters_from_reducer",
     "errors_from_reducer",
@@ -81,6 +82,9 @@ N_PER_M_TO_N_PER_MM = 1e-3
 """Stiffness [N/m] → [N/mm]."""
 NM_PER_RAD_TO_NMM_PER_RAD = 1e3
 """Torsional stiffness [N·m/rad] → [N·mm/rad]."""
+
+RHS_WORK_SIZE = 23
+"""Scratch floats :func:`rv_rhs` uses to memoise its time-only trigonometry."""
 
 RHS_SOURCE_KEY = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16]
 """Hash of this file: part of the numba cache key of the integrators built on :func:`rv_rhs`."""
@@ -414,14 +418,16 @@ def _fourier2(mean, coef, c1, s1):
 
 
 @njit(cache=True, nogil=True)
-def rv_rhs(t, y, args, dydt):
+def rv_rhs(t, y, args, dydt, work):
     """dy/dt of the lumped RV model (compiled; plain twin: ``RVDynamicModel.rhs_numpy``).
 
     y = [q (6M+3N+6), q̇]; q per body (x [mm], y [mm], θ [rad]) in the order sun, planets 1..M,
     cranks 1..M, discs 1..N, output. ``args`` = (pf, inv_mass, fsp, fcr, err_g, err_m, err_mn,
     err_n, geo_m, geo_n) from :meth:`RVDynamicModel.kernel_args`; errors are given there as
     body-fixed Cartesian offsets (E cos β, E sin β) and rotated here with the body, so the only
-    trigonometric calls per evaluation are the five nominal angles.
+    trigonometric calls per evaluation are the five nominal angles. ``work`` (``RHS_WORK_SIZE``
+    floats, NaN-filled, one per integration) memoises them for the last two times, so RK4 computes
+    them twice per step instead of four times; pass ``np.full(RHS_WORK_SIZE, np.nan)``.
     """
     pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n, geo_m, geo_n = args
     nm = int(pf[30])
@@ -437,18 +443,51 @@ def rv_rhs(t, y, args, dydt):
     th_o = w_o * t
     th_s = pf[1] * th_o
     th_h = pf[3] + pf[2] * th_o
-    co = np.cos(th_o)
-    so = np.sin(th_o)
-    cs = np.cos(th_s)
-    ss = np.sin(th_s)
-    chh = np.cos(th_h)
-    shh = np.sin(th_h)
-    ph_s = pf[8] * (th_s - th_o)
-    cps0 = np.cos(ph_s)
-    sps0 = np.sin(ph_s)
-    ph_c = pf[9] * th_h
-    cpc0 = np.cos(ph_c)
-    spc0 = np.sin(ph_c)
+    # memo of the time-only trigonometry: two slots [t, 10 values] and the slot to overwrite
+    if work.size >= RHS_WORK_SIZE and work[0] == t:
+        base = 1
+    elif work.size >= RHS_WORK_SIZE and work[11] == t:
+        base = 12
+    else:
+        base = -1
+    if base > 0:
+        co = work[base]
+        so = work[base + 1]
+        cs = work[base + 2]
+        ss = work[base + 3]
+        chh = work[base + 4]
+        shh = work[base + 5]
+        cps0 = work[base + 6]
+        sps0 = work[base + 7]
+        cpc0 = work[base + 8]
+        spc0 = work[base + 9]
+    else:
+        co = np.cos(th_o)
+        so = np.sin(th_o)
+        cs = np.cos(th_s)
+        ss = np.sin(th_s)
+        chh = np.cos(th_h)
+        shh = np.sin(th_h)
+        ph_s = pf[8] * (th_s - th_o)
+        cps0 = np.cos(ph_s)
+        sps0 = np.sin(ph_s)
+        ph_c = pf[9] * th_h
+        cpc0 = np.cos(ph_c)
+        spc0 = np.sin(ph_c)
+        if work.size >= RHS_WORK_SIZE:
+            slot = 0 if work[22] == 1.0 else 11
+            work[22] = 0.0 if slot == 0 else 1.0
+            work[slot] = t
+            work[slot + 1] = co
+            work[slot + 2] = so
+            work[slot + 3] = cs
+            work[slot + 4] = ss
+            work[slot + 5] = chh
+            work[slot + 6] = shh
+            work[slot + 7] = cps0
+            work[slot + 8] = sps0
+            work[slot + 9] = cpc0
+            work[slot + 10] = spc0
     a_h = pf[4]
     ecc = pf[5]
     r_bs = pf[6]
@@ -1068,7 +1107,7 @@ class RVDynamicModel:
         for it in range(100):  # noqa: B007 - reported on failure
             if compiled:
                 y[:nd] = q
-                rv_rhs(t, y, args, dydt)
+                rv_rhs(t, y, args, dydt, np.full(RHS_WORK_SIZE, np.nan))
                 r = dydt[nd:] * self.mass
             else:
                 r = self.elastic_force(t, q) + f_ext
@@ -1198,6 +1237,7 @@ def ode_system(model: RVDynamicModel, errors: RVErrors | None = None):
         rhs_python=m.rhs_numpy,
         output_python=lambda t, y: float(y[m.n_dof - 1] - y[2] / m.params.ratio),
         stability_eigenvalues=model.damped_eigenvalues(mesh="max"),
+        work_size=RHS_WORK_SIZE,
     )
 
 

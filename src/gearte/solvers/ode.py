@@ -1,6 +1,6 @@
 """One interface for time integration: compiled RK4 / DOPRI5 kernels and scipy as reference.
 
-A system is a compiled right-hand side ``rhs(t, y, args, dydt)`` (numba ``@njit``), a compiled
+A system is a compiled right-hand side ``rhs(t, y, args, dydt, work)`` (numba ``@njit``), a compiled
 scalar output ``output(t, y, args) -> float`` (e.g. the dynamic transmission error) and the
 ``args`` tuple of arrays, plus plain-Python twins for :func:`scipy.integrate.solve_ivp`.
 
@@ -52,7 +52,9 @@ class ODESystem:
 
     Attributes
     ----------
-    rhs : numba dispatcher ``rhs(t, y, args, dydt)`` writing dy/dt in place.
+    rhs : numba dispatcher ``rhs(t, y, args, dydt, work)`` writing dy/dt in place; ``work`` is a
+        scratch array of ``work_size`` floats owned by one integration (NaN-filled at its start),
+        e.g. to reuse time-only quantities between stages; never shared between threads.
     output : numba dispatcher ``output(t, y, args) -> float`` summarised by the kernels.
     args : tuple of arrays passed to both.
     key : str, hash of the rhs source (part of the cache key of the kernels).
@@ -69,6 +71,7 @@ class ODESystem:
     rhs_python: Callable[[float, np.ndarray], np.ndarray] | None = None
     output_python: Callable[[float, np.ndarray], float] | None = None
     stability_eigenvalues: np.ndarray | None = field(default=None, repr=False)
+    work_size: int = 0
 
 
 @dataclass(frozen=True)
@@ -148,8 +151,9 @@ def _stats_update(stats, o):
     stats[4] += o * o
 
 
-def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, rec):
+def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, rec, work_size):
     n = y0.size
+    work = np.full(work_size, np.nan)
     y = y0.copy()
     k1 = np.empty(n)
     k2 = np.empty(n)
@@ -172,16 +176,17 @@ def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, r
             nrec = 1
     for s in range(n_steps):
         t = t0 + s * dt
-        rhs(t, y, args, k1)
+        rhs(t, y, args, k1, work)
         for i in range(n):
             tmp[i] = y[i] + h2 * k1[i]
-        rhs(t + h2, tmp, args, k2)
+        rhs(t + h2, tmp, args, k2, work)
         for i in range(n):
             tmp[i] = y[i] + h2 * k2[i]
-        rhs(t + h2, tmp, args, k3)
+        rhs(t + h2, tmp, args, k3, work)
         for i in range(n):
             tmp[i] = y[i] + dt * k3[i]
-        rhs(t + dt, tmp, args, k4)
+        t_next = t0 + (s + 1) * dt  # bit-identical to the next step's t (rhs may memoise by t)
+        rhs(t_next, tmp, args, k4, work)
         acc = 0.0
         for i in range(n):
             y[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
@@ -189,7 +194,7 @@ def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, r
         if not np.isfinite(acc):
             return y, stats, nrec, s + 1
         if s + 1 >= settle_steps:
-            o = output(t + dt, y, args)
+            o = output(t_next, y, args)
             _stats_update(stats, o)
             if rec_every > 0 and (s + 1 - settle_steps) % rec_every == 0:
                 if nrec < rec.shape[0]:
@@ -219,9 +224,23 @@ e1, e3, e4, e5, e6, e7 = (
 
 
 def _dopri5_template(
-    y0, t0, t_end, h0, h_max, rtol, atol, args, t_settle, rec_dt, rec_idx, rec, max_steps
+    y0,
+    t0,
+    t_end,
+    h0,
+    h_max,
+    rtol,
+    atol,
+    args,
+    t_settle,
+    rec_dt,
+    rec_idx,
+    rec,
+    max_steps,
+    work_size,
 ):
     n = y0.size
+    work = np.full(work_size, np.nan)
     y = y0.copy()
     k1 = np.empty(n)
     k2 = np.empty(n)
@@ -238,7 +257,7 @@ def _dopri5_template(
     counters = np.zeros(3)  # accepted, rejected, rhs evaluations
     t = t0
     h = h0
-    rhs(t, y, args, k1)
+    rhs(t, y, args, k1, work)
     counters[2] += 1
     next_rec = t_settle
     nrec = 0
@@ -249,24 +268,24 @@ def _dopri5_template(
             h = t_end - t
         for i in range(n):
             tmp[i] = y[i] + h * a21 * k1[i]
-        rhs(t + c2 * h, tmp, args, k2)
+        rhs(t + c2 * h, tmp, args, k2, work)
         for i in range(n):
             tmp[i] = y[i] + h * (a31 * k1[i] + a32 * k2[i])
-        rhs(t + c3 * h, tmp, args, k3)
+        rhs(t + c3 * h, tmp, args, k3, work)
         for i in range(n):
             tmp[i] = y[i] + h * (a41 * k1[i] + a42 * k2[i] + a43 * k3[i])
-        rhs(t + c4 * h, tmp, args, k4)
+        rhs(t + c4 * h, tmp, args, k4, work)
         for i in range(n):
             tmp[i] = y[i] + h * (a51 * k1[i] + a52 * k2[i] + a53 * k3[i] + a54 * k4[i])
-        rhs(t + c5 * h, tmp, args, k5)
+        rhs(t + c5 * h, tmp, args, k5, work)
         for i in range(n):
             tmp[i] = y[i] + h * (
                 a61 * k1[i] + a62 * k2[i] + a63 * k3[i] + a64 * k4[i] + a65 * k5[i]
             )
-        rhs(t + h, tmp, args, k6)
+        rhs(t + h, tmp, args, k6, work)
         for i in range(n):
             yn[i] = y[i] + h * (b1 * k1[i] + b3 * k3[i] + b4 * k4[i] + b5 * k5[i] + b6 * k6[i])
-        rhs(t + h, yn, args, k7)
+        rhs(t + h, yn, args, k7, work)
         counters[2] += 6
         err = 0.0
         for i in range(n):
@@ -463,7 +482,9 @@ def integrate(
             n_rec = min(max_records, (n_steps - settle_steps) // rec_every + 1)
         rec = np.zeros((n_rec, 1 + idx.size))
         rk4, _ = kernels(system.rhs, system.output, system.key)
-        y, stats, nrec, status = rk4(y0, t0, dt, n_steps, a, settle_steps, rec_every, idx, rec)
+        y, stats, nrec, status = rk4(
+            y0, t0, dt, n_steps, a, settle_steps, rec_every, idx, rec, system.work_size
+        )
         if status >= 0:
             raise DivergenceError(
                 f"RK4 diverged: non-finite state at t = {t0 + status * dt:.6g} s "
@@ -493,6 +514,7 @@ def integrate(
             idx,
             rec,
             max_steps,
+            system.work_size,
         )
         if status == 1:
             raise DivergenceError("DOPRI5 diverged: non-finite state or error estimate")
