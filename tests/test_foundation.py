@@ -85,6 +85,7 @@ def test_results_json_and_report_are_written(tmp_path):
     assert data["analyses"]["demo"]["values"]["total_length [mm]"] == pytest.approx(15.0)
     assert data["analyses"]["demo"]["values"]["x [mm]"] == [0.0, 5.0, 10.0]
     assert data["case"]["kind"] == "foundation_test" and "gearte_version" in data
+    assert paths["results"].stat().st_mode & 0o044 == 0o044  # readable by others, like any file
     html = paths["report"].read_text()
     assert "data:image/png;base64," in html and "total_length [mm]" in html
 
@@ -173,3 +174,14 @@ def test_cli_run_validate_and_errors(tmp_path):
     assert "demo.length_mm" in r.output and "Traceback" not in r.output
     r = runner.invoke(main, ["run", "no_such_case"])
     assert r.exit_code == 2 and "bundled cases" in r.output
+
+
+def test_extra_output_files_are_written_beside_results(tmp_path):
+    result = run_case(GOOD)
+    result["demo"].files["table.csv"] = "a,b\n1,2\n"
+    paths = write_outputs(result, tmp_path / "o", report=False)
+    assert (tmp_path / "o" / "table.csv").read_text() == "a,b\n1,2\n"
+    assert set(paths) == {"results", "table.csv"}
+    result["demo"].files = {"../escape.csv": "x"}
+    with pytest.raises(ValueError, match="bad output file name"):
+        write_outputs(result, tmp_path / "o2", report=False)

@@ -245,3 +245,18 @@ def test_han2023_error_te_has_crank_frequency(reducers):
             spec = np.abs(np.fft.rfft(g))
             assert int(np.argmax(spec)) == red.pins.count
     assert pp["carrier_bore"] < 0.05 * pp["cam"]
+
+
+@pytest.mark.parametrize("factor", [0.3, 2.0, 5.0])
+def test_han2023_linear_law_zero_clearance_is_linear_in_torque(reducers, factor):
+    """Constant pin stiffness, no errors, no clearance: the loaded set does not change with the
+    torque, so displacements scale exactly with it (a property of the equilibrium, not a fit)."""
+    from gearte.solvers.rv_equilibrium import ContactLaw
+
+    _, red0 = reducers
+    law = ContactLaw(kind="linear", stiffness=2.0e5)
+    th = output_positions(12)
+    a = load_sharing(red0, red0.rated_torque, th, law=law)
+    b = load_sharing(red0, factor * red0.rated_torque, th, law=law)
+    np.testing.assert_allclose(b.output_error, factor * a.output_error, rtol=1e-9)
+    np.testing.assert_allclose(b.pin_force, factor * a.pin_force, rtol=1e-9, atol=1e-9)

@@ -42,3 +42,8 @@ def test_rv_reducer_case_runs_through_cli(name, tmp_path):
         assert key in values, key
         assert values[key] is not None
     assert (out / "report.html").stat().st_size > 10_000
+    pins = (out / "pin_loads.csv").read_text(encoding="utf-8").splitlines()
+    assert pins[0].startswith("output_angle [deg],disc,pin_1 [N]")
+    assert len(pins) == 1 + 360 * 2
+    te = (out / "transmission_error.csv").read_text(encoding="utf-8").splitlines()
+    assert len(te) == 1 + 360

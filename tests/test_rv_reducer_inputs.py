@@ -98,3 +98,12 @@ def test_valid_case_loads(han_dict):
     case = load_case_dict(copy.deepcopy(han_dict))
     assert len(case.reducer.errors) == 18
     assert np.isclose(case.reducer.rated_torque_Nm, 1078.0)
+
+
+def test_all_reducer_problems_reported_at_once(han_dict):
+    data = copy.deepcopy(han_dict)
+    data["reducer"]["first_stage"]["planets"] = 2
+    data["reducer"]["errors"][0]["crank"] = 5
+    text = " ".join(f"{f}: {m}" for f, m in _errors_of(data))
+    assert "first_stage.planets = 2" in text
+    assert "errors[0].crank = 5" in text

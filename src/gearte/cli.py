@@ -45,6 +45,9 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
 
     try:
         return fn()
+    except BrokenPipeError:  # output piped into `head` and closed: not an error of ours
+        sys.stderr.close()
+        sys.exit(0)
     except CaseFileError as exc:
         _error("invalid case", str(exc))
         sys.exit(EXIT_BAD_INPUT)

@@ -9,31 +9,30 @@ __all__ = ["REFERENCES", "cite"]
 
 REFERENCES: dict[str, str] = {
     "hu2020": (
-        "Hu Y., Li G., Zhu W., Cui J. (2020). An Elastic Transmission Error Compensation Method "
-        "for Rotary Vector Speed Reducers Based on Error Sensitivity Analysis. Applied Sciences "
-        "10(2), 481. "
+        "Hu, Li, Zhu, Cui (2020). An Elastic Transmission Error Compensation Method for Rotary "
+        "Vector Speed Reducers Based on Error Sensitivity Analysis. Applied Sciences 10(2), 481. "
         "doi:10.3390/app10020481"
     ),
     "jiang2024": (
-        "Jiang Z., Zhong Y., Lv X., Lai J., Jin X. (2024). Gear backlash modeling and tolerance "
+        "Jiang J., Zhong X., Lv L., Lai J., Jin D. (2024). Gear backlash modeling and tolerance "
         "simulation of fully gear-coupled robot. Journal of Zhejiang University (Engineering "
-        "Science) 58(8). doi:10.3785/j.issn.1008-973X.2024.08.000"
+        "Science) 58(8), 1533-1542. doi:10.3785/j.issn.1008-973X.2024.08.001"
     ),
     "wang2013": (
-        "Wang S., Chen Z., Li X., Chen W. (2013). Coupling Compensation of Transmission Error for "
-        "Planetary Gear. Transactions of the Chinese Society for Agricultural Machinery 44(8)."
+        "Wang C., Chen X., Li Y., Chen H. (2013). Coupling Compensation of Transmission Error for "
+        "Planetary Gear. Transactions of the Chinese Society for Agricultural Machinery 44(8). "
+        "doi:10.6041/j.issn.1000-1298.2013.08.049"
     ),
     "han2023": (
-        "Han X., Xu W., Wang J., Zhang Y. (2023). Impact of Manufacturing Errors on Tooth Surface "
-        "Forces in RV Reducer Cycloid Pinwheels. Journal of Engineering Research and Reports 25(8)."
+        "Han L., Xu W., Wang Y., Zhang Y. (2023). Impact of Manufacturing Errors on Tooth Surface "
+        "Forces in RV Reducer Cycloid Pinwheels. Journal of Engineering Research and Reports "
+        "25(8). doi:10.9734/JERR/2023/v25i8970"
     ),
     "li2023": (
-        "Li X., Huang C., Ding Y., Guo L., Niu W. (2023). Dynamic Modeling and Analysis of an RV "
-        "Reducer Considering Tooth Profile Modifications and Errors. Machines 11(6), 626. "
+        "Li, Huang, Ding, Guo, Niu (2023). Dynamic Modeling and Analysis of an RV Reducer "
+        "Considering Tooth Profile Modifications and Errors. Machines 11(6), 626. "
         "doi:10.3390/machines11060626"
     ),
-    "iso1328": "ISO 1328-1:2013 Cylindrical gears — ISO system of flank tolerance classification.",
-    "jisb1702": "JIS B 1702-1 / GB/T 10095 gear accuracy grades.",
 }
 
 

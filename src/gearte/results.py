@@ -59,6 +59,9 @@ class AnalysisResult:
         Assumptions and remarks shown in the report and JSON.
     data : dict
         Extra objects for plotting; not serialised.
+    files : dict
+        Extra output files, plain file name → text (e.g. a compensation table a controller
+        loads); written beside ``results.json`` by :func:`gearte.report.write_outputs`.
     """
 
     name: str
@@ -67,6 +70,7 @@ class AnalysisResult:
     references: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     data: dict[str, Any] = field(default_factory=dict, repr=False)
+    files: dict[str, str] = field(default_factory=dict, repr=False)
 
     def __getitem__(self, key: str) -> Any:
         return self.values[key]

@@ -39,6 +39,15 @@ Stiffness laws
   load of the most loaded roller ``Q = 4.08 F_r / Z`` — see :func:`palmgren_radial_stiffness`.
 * Involute mesh: given, or ``c_gamma * b`` with ``c_gamma`` the ISO 6336-1 mean mesh stiffness
   per unit face width (default 20 N/(mm·µm)).
+
+Reuse
+-----
+A case file's ``[reducer]`` section becomes an :class:`RVReducer` through
+:func:`gearte.studies.rv_reducer.build_reducer`. :func:`gearte.models.rv_load_sharing.assemble`
+turns it into spring rows ``w = B q + e`` (stiffness ``k``, bearing clearance ``c``) and
+unilateral pin-contact rows at any output angles, over the 3M + 3N + 5 displacement DOF of
+:class:`gearte.models.rv_load_sharing.DofLayout`; a dynamic model adds masses and inertias
+(not part of this description) to the same DOF.
 """
 
 from __future__ import annotations
@@ -246,7 +255,7 @@ class Discs:
             raise ParameterError("discs.poisson_ratio", self.poisson_ratio, "must be in [0, 0.5)")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
 class PinRing:
     """The fixed ring of ``z_p`` pins.
 
@@ -332,7 +341,7 @@ class ErrorEntry:
 _PARTS = ("planet_base_circle", "disc_crank_bore", "cam", "carrier_crank_bore")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
 class ManufacturingErrors:
     """Measured eccentricity errors as arrays of error vectors in the parts' frames [mm].
 
@@ -422,7 +431,7 @@ class ManufacturingErrors:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
 class RVReducer:
     """A whole RV reducer.
 

@@ -15,6 +15,13 @@ from typing import Any
 __all__ = ["write_outputs", "atomic_write_text"]
 
 
+def _public_mode() -> int:
+    """Mode of a normally created file (0o666 less the umask); ``mkstemp`` makes 0o600."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def atomic_write_text(path: Path, text: str) -> None:
     """Write ``text`` to ``path`` atomically (temporary file in the same folder + rename)."""
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -22,6 +29,7 @@ def atomic_write_text(path: Path, text: str) -> None:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
+        os.chmod(tmp, _public_mode())
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -37,7 +45,7 @@ def write_outputs(
     Returns
     -------
     dict
-        ``{"results": path, "report": path}`` of the files written.
+        ``{"results": path, "report": path, <extra file name>: path}`` of the files written.
     """
     out = Path(out_dir)
     json_text = result.to_json()
@@ -47,18 +55,25 @@ def write_outputs(
 
         html_text = render_report(result)
     paths = {"results": out / "results.json"}
+    texts: dict[str, str] = {"results": json_text}
     if html_text is not None:
         paths["report"] = out / "report.html"
+        texts["report"] = html_text
+    for analysis in result.analyses:
+        for fname, text in analysis.files.items():
+            if Path(fname).name != fname or fname in ("results.json", "report.html"):
+                raise ValueError(f"analysis {analysis.name!r}: bad output file name {fname!r}")
+            paths[fname] = out / fname
+            texts[fname] = text
     # Both documents exist in memory: only now touch the disk.
     tmp_files: list[tuple[str, Path]] = []
     out.mkdir(parents=True, exist_ok=True)
     try:
-        for key, text in (("results", json_text), ("report", html_text)):
-            if text is None:
-                continue
+        for key, text in texts.items():
             fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".tmp", dir=out)
             with os.fdopen(fd, "w", encoding="utf-8") as fh:
                 fh.write(text)
+            os.chmod(tmp, _public_mode())
             tmp_files.append((tmp, paths[key]))
         for tmp, final in tmp_files:
             os.replace(tmp, final)

@@ -11,7 +11,7 @@ which terminates when the active set repeats — the solution is then exact to r
 
 The contact stiffness is load dependent (Hu et al. 2020 section 4): for each disc
 ``k_g = F_max,g / δ(F_max,g)`` with ``δ`` the contact law of
-:func:`gearte.models.rv_load_sharing.hu2020_contact_deformation`. This outer fixed point is a
+:func:`gearte.models.cycloid_contact.max_normal_deformation`. This outer fixed point is a
 contraction (the secant stiffness varies with ``ln F``) and is iterated to a relative change
 below ``tol``. Positions are solved in sequence, each warm-started from the previous one.
 
@@ -21,12 +21,13 @@ algorithm; :func:`solve_reference` is an independent scipy check.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from gearte.errors import ConvergenceError
+from gearte.errors import ConvergenceError, ParameterError
 
 __all__ = ["ContactLaw", "EquilibriumSolution", "solve_positions", "solve_reference"]
 
@@ -36,6 +37,8 @@ LAW_HU2020 = 1
 #: equilibrium unique when parts float in their clearances (at zero load); its force is below
 #: 1e-6 k c (< 1 N for 10 µm at 1e5 N/mm).
 CLEARANCE_RESIDUAL = 1e-6
+
+_TWIN_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -73,7 +76,7 @@ class ContactLaw:
             return LAW_LINEAR
         if self.kind == "hu2020":
             return LAW_HU2020
-        raise ValueError(f"contact law {self.kind!r}: must be 'hu2020' or 'linear'")
+        raise ParameterError("contact_law.kind", self.kind, "must be 'hu2020' or 'linear'")
 
 
 @dataclass(frozen=True)
@@ -351,8 +354,10 @@ def solve_positions(
     k0 = np.full(ngroups, law.stiffness) if k0 is None else np.asarray(k0, dtype=float)
     fn = _solve_all if compiled else _solve_all.py_func
     if not compiled:
-        # the twin calls the plain-Python versions of the inner kernels too
+        # the twin calls the plain-Python versions of the inner kernels too (swapped in under a
+        # lock for the duration of the call; compiled callers do not look these names up)
         g = _solve_all.py_func.__globals__
+        _TWIN_LOCK.acquire()
         saved = {n: g[n] for n in ("_solve_position", "_newton", "_energy", "_hu_delta")}
         for n in saved:
             g[n] = saved[n].py_func
@@ -364,6 +369,7 @@ def solve_positions(
             )  # fmt: skip
         finally:
             g.update(saved)
+            _TWIN_LOCK.release()
     else:
         out = fn(
             K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),

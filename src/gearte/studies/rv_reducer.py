@@ -29,7 +29,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gearte.errors import ParameterError
+from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.rv import (
     Cranks,
     Discs,
@@ -169,10 +169,27 @@ class ReducerSection(StrictModel):
 
     @model_validator(mode="after")
     def _build(self):
-        try:
-            build_reducer(self)
-        except ParameterError as exc:
-            raise ValueError(str(exc)) from None
+        problems = []
+        if self.first_stage.planets != self.cranks.count:
+            problems.append(
+                f"first_stage.planets = {self.first_stage.planets}: must equal cranks.count = "
+                f"{self.cranks.count} (each planet drives one crank)"
+            )
+        for k, e in enumerate(self.errors):
+            entry = ErrorEntry(e.part, e.crank, e.disc, um_to_mm(e.value_um), 0.0)
+            try:
+                ManufacturingErrors.from_entries(
+                    [entry], self.cranks.count, self.discs.count, field_name="errors"
+                )
+            except ParameterError as exc:
+                problems.append(str(exc).replace("errors[0]", f"errors[{k}]"))
+        if not problems:
+            try:
+                build_reducer(self)
+            except ParameterError as exc:
+                problems.append(str(exc))
+        if problems:
+            raise ValueError("; ".join(problems))
         return self
 
 
@@ -376,16 +393,28 @@ def _load_sharing(red, red0, sec: LoadSharingSection) -> AnalysisResult:
             "peak_pin_load_cycloid_stage_analysis: one disc alone (centre fixed, rigid "
             "supports, no errors, moment T (1 - 1/i) z_c/(z_p N)) — the cycloid_stage contact law."
         )
-    except Exception as exc:  # pragma: no cover - reported, not fatal
+    except (ParameterError, ConvergenceError) as exc:  # pragma: no cover - reported, not fatal
         notes.append(f"cycloid-stage comparison not available: {exc}")
     return AnalysisResult(
         name="load_sharing",
         title="Pin load sharing over one output revolution",
         values=values,
         references=["han2023", "hu2020"],
-        notes=notes,
+        notes=notes + ["pin_loads.csv: the load of every pin on every disc at every position."],
         data=data,
+        files={"pin_loads.csv": _pin_csv(ls)},
     )
+
+
+def _pin_csv(ls) -> str:
+    """Pin-load table: one row per output angle and disc, one column per pin [N]."""
+    zp = ls.pin_force.shape[2]
+    lines = ["output_angle [deg],disc," + ",".join(f"pin_{k + 1} [N]" for k in range(zp))]
+    for p, th in enumerate(np.degrees(ls.theta)):
+        for j in range(ls.pin_force.shape[1]):
+            vals = ",".join(f"{v:.3f}" for v in ls.pin_force[p, j])
+            lines.append(f"{th:.4f},{j + 1},{vals}")
+    return "\n".join(lines) + "\n"
 
 
 def _transmission_error(red, sec: TESection) -> AnalysisResult:
@@ -422,7 +451,21 @@ def _transmission_error(red, sec: TESection) -> AnalysisResult:
             "ripple has z_p z_c cycles per revolution and is aliased by uniform sampling.",
         ],
         data={"te": te},
+        files={"transmission_error.csv": _te_csv(te)},
     )
+
+
+def _te_csv(te) -> str:
+    rows = ["output_angle [deg],total_te [arcsec],geometric_te [arcsec],elastic_te [arcsec]"]
+    for th, t, g, e in zip(
+        np.degrees(te.theta),
+        rad_to_arcsec(te.total),
+        rad_to_arcsec(te.geometric),
+        rad_to_arcsec(te.elastic),
+        strict=True,
+    ):
+        rows.append(f"{th:.4f},{t:.6f},{g:.6f},{e:.6f}")
+    return "\n".join(rows) + "\n"
 
 
 def _catalogue(red, sec: CatalogueSection) -> AnalysisResult:

@@ -1,0 +1,574 @@
+"""Study kind ``gear_chain``: lost motion of a gear chain at the joint and at the end effector,
+shim of a bevel pair, motor-angle compensation (Jiang et al. 2024, §4, eqs. 30–33).
+
+A chain is a list of stages from the motor to the joint, of any length and order. Each stage
+gives its return error in one of three ways:
+
+* ``lost_motion_max_arcmin`` (optionally mean/min): a catalogue value (the paper's planetary
+  reducer, 1′);
+* ``backlash_{min,mean,max}_um`` with ``output_diameter_mm``: backlash values obtained
+  elsewhere (measured, or the paper's 3DCS simulation, Tables 4 and 8) → eq. (14)/(29);
+* ``[chain.stages.pair]``: the pair's data and tolerances (same tables as the ``gear_pair``
+  kind) → gearte's backlash stack, min/mean/max at ``analysis.confidence`` → eq. (14)/(29).
+
+Optional ``[shim]``: shim thickness under both gears of a bevel stage for a target minimum
+backlash (eq. 32), the backlash after shimming (shifted stack), and the chain after shimming.
+The paper verified the shimmed backlash by a 3DCS run (0.025–0.061 mm) and used that range
+downstream; ``verified_backlash_*_um`` lets a case do the same with a verified (measured or
+simulated) range; without it, gearte's shifted backlash is used.
+
+Optional ``[compensation]``: stages compensated by their mean return error when the load torque
+reverses; motor offset (eq. 33), residual per stage, joint and end error after it. It acts on
+the chain after the shim when there is one (the paper's order).
+
+Analyses: one group per stage (``<stage>_backlash`` …, see ``gear_pair``), ``chain``
+(``joint_lost_motion_max [arcmin]``, ``end_effector_error_max [mm]``), ``shim``
+(``shim_thickness [mm]`` …), ``compensation`` (``motor_compensation_angle [deg]``,
+``end_effector_error_after_compensation [mm]``, the compensation table).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from gearte.io.schema import CaseBase, StrictModel
+from gearte.models.backlash import BevelPair, summarise_backlash
+from gearte.models.lost_motion import (
+    StageLostMotion,
+    analyse_chain,
+    compensation_table,
+    compensation_table_csv,
+    compensation_table_json,
+    return_error,
+    shim_backlash_reduction,
+    shim_thickness,
+)
+from gearte.results import AnalysisResult, StudyResult
+from gearte.studies.gear_pair import PairAnalysisSpec, PairSpec, analyse_pair
+from gearte.units import (
+    arcmin_to_rad,
+    deg_to_rad,
+    format_dms,
+    mm_to_um,
+    rad_to_arcmin,
+    rad_to_deg,
+    um_to_mm,
+)
+
+__all__ = ["KIND", "REFERENCES", "FIGURES", "StageSpec", "ChainSpec", "ShimSpec", "Case", "run"]
+
+KIND = "gear_chain"
+REFERENCES = ["jiang2024"]
+FIGURES = "gearte.plotting.gear_chain"
+
+
+def _slug(name: str) -> str:
+    return re.sub(r"[^a-z0-9]+", "_", name.lower()).strip("_") or "stage"
+
+
+class StageSpec(StrictModel):
+    """One stage of the chain (motor side first)."""
+
+    name: str = Field(min_length=1, description="Unique stage name.")
+    ratio: float = Field(gt=0, le=1e6, description="Reduction ratio i = ω_in/ω_out (> 0).")
+    compensate: bool = Field(default=False, description="Compensate by the motor angle (eq. 33).")
+    lost_motion_max_arcmin: float | None = Field(default=None, ge=0, le=6000)
+    lost_motion_mean_arcmin: float | None = Field(default=None, ge=0, le=6000)
+    lost_motion_min_arcmin: float | None = Field(default=None, ge=0, le=6000)
+    backlash_min_um: float | None = Field(default=None, ge=0, le=100_000)
+    backlash_mean_um: float | None = Field(default=None, ge=0, le=100_000)
+    backlash_max_um: float | None = Field(default=None, ge=0, le=100_000)
+    output_diameter_mm: float | None = Field(
+        default=None, gt=0, le=100_000, description="Driven gear d (spur) or dm (bevel) [mm]."
+    )
+    pressure_angle_deg: float = Field(default=20.0, gt=0, lt=45)
+    min_backlash_limit_um: float = Field(default=0.0, ge=0, le=100_000)
+    pair: PairSpec | None = None
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        lm = self.lost_motion_max_arcmin is not None
+        bl = any(
+            v is not None
+            for v in (self.backlash_min_um, self.backlash_mean_um, self.backlash_max_um)
+        )
+        pr = self.pair is not None
+        if lm + bl + pr != 1:
+            raise ValueError(
+                f"stage {self.name!r}: give exactly one of lost_motion_max_arcmin, "
+                "backlash_{min,mean,max}_um (+ output_diameter_mm), or a [pair] table"
+            )
+        if lm:
+            vals = [
+                v
+                for v in (
+                    self.lost_motion_min_arcmin,
+                    self.lost_motion_mean_arcmin,
+                    self.lost_motion_max_arcmin,
+                )
+                if v is not None
+            ]
+            if vals != sorted(vals):
+                raise ValueError(f"stage {self.name!r}: lost motion needs min <= mean <= max")
+        if bl:
+            trio = (self.backlash_min_um, self.backlash_mean_um, self.backlash_max_um)
+            if any(v is None for v in trio) or self.output_diameter_mm is None:
+                raise ValueError(
+                    f"stage {self.name!r}: backlash_min_um, backlash_mean_um, backlash_max_um "
+                    "and output_diameter_mm are all required"
+                )
+            if list(trio) != sorted(trio):  # type: ignore[type-var]
+                raise ValueError(
+                    f"stage {self.name!r}: inverted limits, need backlash_min_um <= "
+                    f"backlash_mean_um <= backlash_max_um (got {trio})"
+                )
+        if pr:
+            p = self.pair
+            assert p is not None
+            z = p.driven.teeth / p.driving.teeth
+            if abs(z / self.ratio - 1) > 1e-3:
+                raise ValueError(
+                    f"stage {self.name!r}: ratio {self.ratio} disagrees with the pair's teeth "
+                    f"{p.driven.teeth}/{p.driving.teeth} = {z:.6g} (more than 0.1 %)"
+                )
+        if self.compensate and not (bl or pr or self.lost_motion_mean_arcmin is not None):
+            raise ValueError(
+                f"stage {self.name!r}: compensate = true needs a mean return error "
+                "(lost_motion_mean_arcmin, backlash values or a pair)"
+            )
+        return self
+
+
+class ChainSpec(StrictModel):
+    """The chain: its stages from the motor to the joint and the lever to the end effector."""
+
+    lever_length_mm: float = Field(
+        gt=0, le=1e6, description="Distance L from the joint axis to the end effector [mm]."
+    )
+    stages: list[StageSpec] = Field(min_length=1, description="Stages from motor to joint.")
+
+    @model_validator(mode="after")
+    def _unique(self):
+        names = [s.name for s in self.stages]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"stage names must be unique; repeated: {dup}")
+        slugs = [_slug(n) for n in names]
+        if len(set(slugs)) != len(slugs):
+            raise ValueError(f"stage names must differ in letters/digits: {names}")
+        return self
+
+
+class ShimSpec(StrictModel):
+    """Shims under both gears of a bevel stage to reach a target minimum backlash (eq. 32)."""
+
+    stage: str = Field(description="Name of the bevel stage to shim.")
+    target_min_backlash_um: float = Field(
+        gt=0, le=100_000, description="Wanted minimum normal backlash [µm]."
+    )
+    current_min_backlash_um: float | None = Field(
+        default=None,
+        gt=0,
+        le=100_000,
+        description="Minimum backlash eq. 32 starts from [µm]; default: the stage's minimum.",
+    )
+    rounding_mm: float = Field(
+        default=0.001, ge=0, le=1, description="Shim stock increment [mm] (0: exact)."
+    )
+    rounding: Literal["nearest", "down", "up"] = Field(
+        default="nearest", description="How to round to the stock ('down' keeps min >= target)."
+    )
+    cone_angle_driving_deg: float = Field(
+        default=45.0, gt=0, lt=90, description="δ1, only for stages given by backlash values."
+    )
+    cone_angle_driven_deg: float = Field(
+        default=45.0, gt=0, lt=90, description="δ2, only for stages given by backlash values."
+    )
+    verified_backlash_min_um: float | None = Field(default=None, ge=0, le=100_000)
+    verified_backlash_mean_um: float | None = Field(default=None, ge=0, le=100_000)
+    verified_backlash_max_um: float | None = Field(default=None, ge=0, le=100_000)
+
+    @model_validator(mode="after")
+    def _verified(self):
+        lo, mid, hi = (
+            self.verified_backlash_min_um,
+            self.verified_backlash_mean_um,
+            self.verified_backlash_max_um,
+        )
+        if (lo is None) != (hi is None):
+            raise ValueError("verified_backlash_min_um and verified_backlash_max_um go together")
+        if mid is not None and lo is None:
+            raise ValueError("verified_backlash_mean_um needs verified min and max")
+        if lo is not None and hi is not None:
+            vals = [v for v in (lo, mid, hi) if v is not None]
+            if vals != sorted(vals):
+                raise ValueError(
+                    f"inverted verified backlash range {vals}: need min <= mean <= max"
+                )
+        return self
+
+
+class CompensationSpec(StrictModel):
+    """Motor-angle compensation when the load torque reverses (eq. 33)."""
+
+    enabled: bool = True
+
+
+class Case(CaseBase):
+    chain: ChainSpec
+    analysis: PairAnalysisSpec = PairAnalysisSpec()
+    shim: ShimSpec | None = None
+    compensation: CompensationSpec | None = None
+
+    @model_validator(mode="after")
+    def _shim_target(self):
+        if self.shim is None:
+            return self
+        stages = {s.name: s for s in self.chain.stages}
+        st = stages.get(self.shim.stage)
+        if st is None:
+            raise ValueError(
+                f"shim.stage = {self.shim.stage!r} is not a stage name; stages: {list(stages)}"
+            )
+        if st.lost_motion_max_arcmin is not None:
+            raise ValueError(
+                f"shim.stage = {st.name!r} gives only a lost motion; a shim needs its backlash"
+            )
+        if st.pair is not None and st.pair.type != "bevel":
+            raise ValueError(f"shim.stage = {st.name!r} is a spur pair; shims are for bevel pairs")
+        current, limit = _current_min_um(st, self.analysis.confidence)
+        if self.shim.current_min_backlash_um is not None:
+            current = self.shim.current_min_backlash_um
+        if not self.shim.target_min_backlash_um < current:
+            raise ValueError(
+                f"shim.target_min_backlash_um = {self.shim.target_min_backlash_um} must be below "
+                f"the current minimum backlash {current:.4g} µm of stage {st.name!r} "
+                "(a shim can only reduce backlash)"
+            )
+        if self.shim.target_min_backlash_um < limit:
+            raise ValueError(
+                f"shim.target_min_backlash_um = {self.shim.target_min_backlash_um} is below the "
+                f"minimum limit normal backlash {limit:g} µm of stage {st.name!r}"
+            )
+        return self
+
+
+def _current_min_um(st: StageSpec, confidence: float) -> tuple[float, float]:
+    """Current minimum backlash [µm] of a stage and its minimum limit [µm]."""
+    if st.pair is not None:
+        s = summarise_backlash(st.pair.backlash_stack(), confidence=confidence)
+        return float(mm_to_um(s.min)), st.pair.min_backlash_limit_um
+    assert st.backlash_min_um is not None
+    return st.backlash_min_um, st.min_backlash_limit_um
+
+
+def _stage_backlash_mm(st: StageSpec, confidence: float):
+    """(min, mean, max) backlash [mm], output diameter [mm], α [rad], pair or None."""
+    if st.pair is not None:
+        pair = st.pair.build()
+        s = summarise_backlash(st.pair.backlash_stack(), confidence=confidence)
+        return (s.min, s.mean, s.max), pair.output_diameter, pair.pressure_angle, pair
+    assert st.backlash_min_um is not None and st.backlash_max_um is not None
+    assert st.backlash_mean_um is not None and st.output_diameter_mm is not None
+    trio = tuple(
+        float(um_to_mm(v)) for v in (st.backlash_min_um, st.backlash_mean_um, st.backlash_max_um)
+    )
+    return trio, st.output_diameter_mm, float(deg_to_rad(st.pressure_angle_deg)), None
+
+
+def _lost(trio, d, alpha, name: str, warnings: list[str]) -> tuple[float, float, float]:
+    """(min, mean, max) return error [rad]; a negative backlash (interference) loses no motion."""
+    if trio[0] < 0:
+        warnings.append(
+            f"{name}: minimum normal backlash {mm_to_um(trio[0]):.1f} µm < 0 (the flanks "
+            "interfere); its lost motion is counted as 0 there"
+        )
+    return tuple(float(return_error(max(j, 0.0), d, alpha)) for j in trio)  # type: ignore[return-value]
+
+
+def _statistical_joint_max(res, confidence: float) -> float:
+    """Joint lost motion [rad] at ``confidence`` for independent normal stages (not eq. 30)."""
+    from gearte.tolerance.stackup import z_for_confidence
+
+    z = z_for_confidence(confidence)
+    mean = 0.0
+    var = 0.0
+    for s, f in zip(res.stages, res.transfer, strict=True):
+        if s.mean is None or s.min is None:
+            mean += f * s.max
+            continue
+        mean += f * s.mean
+        var += (f * (s.max - s.min) / (2 * z)) ** 2
+    return mean + z * math.sqrt(var)
+
+
+def _round_shim(x: float, step: float, how: str) -> float:
+    if step <= 0:
+        return x
+    q = x / step
+    k = {"nearest": round(q), "down": math.floor(q + 1e-9), "up": math.ceil(q - 1e-9)}[how]
+    return k * step
+
+
+def run(case: Case, options) -> StudyResult:
+    conf = case.analysis.confidence
+    analyses: list[AnalysisResult] = []
+    warnings: list[str] = []
+    stages: list[StageLostMotion] = []
+    backlash: dict[str, tuple] = {}
+
+    # -- stages ----------------------------------------------------------------------------------
+    for st in case.chain.stages:
+        slug = _slug(st.name)
+        if st.lost_motion_max_arcmin is not None:
+            mx = float(arcmin_to_rad(st.lost_motion_max_arcmin))
+            mean = (
+                None
+                if st.lost_motion_mean_arcmin is None
+                else float(arcmin_to_rad(st.lost_motion_mean_arcmin))
+            )
+            mn = (
+                None
+                if st.lost_motion_min_arcmin is None
+                else float(arcmin_to_rad(st.lost_motion_min_arcmin))
+            )
+            stages.append(StageLostMotion(st.name, st.ratio, mx, mean, mn, st.compensate))
+            analyses.append(
+                AnalysisResult(
+                    name=f"{slug}_lost_motion",
+                    title=f"{st.name}: return error (given)",
+                    values={
+                        "ratio": st.ratio,
+                        "lost_motion_max [arcmin]": st.lost_motion_max_arcmin,
+                        "lost_motion_mean [arcmin]": st.lost_motion_mean_arcmin,
+                        "lost_motion_min [arcmin]": st.lost_motion_min_arcmin,
+                    },
+                    references=["jiang2024"],
+                    notes=["Return error given in the case (e.g. the reducer maker's data)."],
+                )
+            )
+            continue
+        trio, d, alpha, pair = _stage_backlash_mm(st, conf)
+        backlash[st.name] = (trio, d, alpha, pair)
+        lo, mean, mx = _lost(trio, d, alpha, st.name, warnings)
+        stages.append(StageLostMotion(st.name, st.ratio, mx, mean, lo, st.compensate))
+        if pair is not None:
+            assert st.pair is not None
+            analyses += analyse_pair(
+                st.pair, case.analysis, options, prefix=f"{slug}_", title_prefix=f"{st.name}: "
+            )
+        else:
+            analyses.append(
+                AnalysisResult(
+                    name=f"{slug}_backlash",
+                    title=f"{st.name}: normal backlash (given) and lost motion",
+                    values={
+                        "ratio": st.ratio,
+                        "output_diameter [mm]": d,
+                        "backlash_mean [um]": st.backlash_mean_um,
+                        "backlash_min [um]": st.backlash_min_um,
+                        "backlash_max [um]": st.backlash_max_um,
+                        "lost_motion_mean [arcmin]": float(rad_to_arcmin(mean)),
+                        "lost_motion_min [arcmin]": float(rad_to_arcmin(lo)),
+                        "lost_motion_max [arcmin]": float(rad_to_arcmin(mx)),
+                        "lost_motion_mean_dms": format_dms(mean),
+                        "lost_motion_min_dms": format_dms(lo),
+                        "lost_motion_max_dms": format_dms(mx),
+                    },
+                    references=["jiang2024"],
+                    notes=[
+                        "Backlash values given in the case (measured or simulated elsewhere); "
+                        "lost motion by eq. (14)/(29)."
+                    ],
+                )
+            )
+
+    # -- chain (eqs. 30, 31) ---------------------------------------------------------------------
+    L = case.chain.lever_length_mm
+    before = analyse_chain(stages, L)
+
+    def chain_values(res) -> dict[str, float]:
+        """Each stage's maximum return error referred to the joint [arcmin]."""
+        return {
+            s.name: float(rad_to_arcmin(s.max * f))
+            for s, f in zip(res.stages, res.transfer, strict=True)
+        }
+
+    analyses.append(
+        AnalysisResult(
+            name="chain",
+            title="Lost motion of the chain at the joint and the end effector (eqs. 30-31)",
+            values={
+                "joint_lost_motion_max [arcmin]": float(rad_to_arcmin(before.joint_max)),
+                "joint_lost_motion_max_dms": format_dms(before.joint_max),
+                "joint_lost_motion_mean [arcmin]": (
+                    None if before.joint_mean is None else float(rad_to_arcmin(before.joint_mean))
+                ),
+                "end_effector_error_max [mm]": before.end_effector_max,
+                "lever_length [mm]": L,
+                "stage_ratio": {s.name: s.ratio for s in stages},
+                "stage_lost_motion_max [arcmin]": {
+                    s.name: float(rad_to_arcmin(s.max)) for s in stages
+                },
+                "stage_at_joint_max [arcmin]": chain_values(before),
+                "stage_share [%]": {k: 100 * v for k, v in before.shares().items()},
+                "joint_lost_motion_statistical_max [arcmin]": float(
+                    rad_to_arcmin(_statistical_joint_max(before, conf))
+                ),
+            },
+            references=["jiang2024"],
+            notes=[
+                "Worst case: each stage at its maximum return error, referred to the joint by "
+                "the downstream ratios (eq. 30); end error = joint error × lever length (eq. 31).",
+                "joint_lost_motion_statistical_max: not in the paper. Stages with a min and a max "
+                "taken as independent normals with σ = (max − min)/(2z) about their mean; stages "
+                "with only a maximum held at it; mean + z·σ at the same confidence.",
+            ],
+            data={"chain": before},
+        )
+    )
+
+    # -- shim (eq. 32) ---------------------------------------------------------------------------
+    comp_stages = stages
+    if case.shim is not None:
+        sh = case.shim
+        trio, d, alpha, pair = backlash[sh.stage]
+        if isinstance(pair, BevelPair):
+            sens = pair.shim_sensitivity()
+            limit = pair.min_backlash_limit
+        else:
+            d1, d2 = deg_to_rad(sh.cone_angle_driving_deg), deg_to_rad(sh.cone_angle_driven_deg)
+            sens = 2 * math.sin(alpha) * (math.sin(d1) + math.sin(d2))
+            limit = float(
+                um_to_mm(
+                    next(s for s in case.chain.stages if s.name == sh.stage).min_backlash_limit_um
+                )
+            )
+        target = float(um_to_mm(sh.target_min_backlash_um))
+        start = (
+            trio[0] if sh.current_min_backlash_um is None else um_to_mm(sh.current_min_backlash_um)
+        )
+        exact = shim_thickness(start, target, alpha, shim_sensitivity=sens, min_limit=limit)
+        thick = _round_shim(exact, sh.rounding_mm, sh.rounding)
+        red = float(shim_backlash_reduction(thick, alpha, sens))
+        after = tuple(j - red for j in trio)
+        if after[0] < limit:
+            warnings.append(
+                f"after the {thick:.4g} mm shim the minimum backlash {mm_to_um(after[0]):.1f} µm "
+                f"of {sh.stage!r} is below its minimum limit {mm_to_um(limit):.1f} µm"
+            )
+        if sh.verified_backlash_min_um is not None:
+            assert sh.verified_backlash_max_um is not None
+            vmin, vmax = sh.verified_backlash_min_um, sh.verified_backlash_max_um
+            vmean = sh.verified_backlash_mean_um
+            if vmean is None:
+                vmean = 0.5 * (vmin + vmax)
+            used = tuple(float(um_to_mm(v)) for v in (vmin, vmean, vmax))
+            source = "verified range given in the case"
+        else:
+            used = after
+            source = "gearte's backlash shifted by the shim"
+        lo, mean, mx = _lost(used, d, alpha, f"{sh.stage} after shim", warnings)
+        k = next(i for i, s in enumerate(stages) if s.name == sh.stage)
+        old = stages[k]
+        shim_stages = list(stages)
+        shim_stages[k] = StageLostMotion(old.name, old.ratio, mx, mean, lo, old.compensate)
+        res_shim = analyse_chain(shim_stages, L)
+        comp_stages = shim_stages
+        vals = {
+            "stage": sh.stage,
+            "shim_thickness [mm]": thick,
+            "shim_thickness_exact [mm]": exact,
+            "shims": 2,
+            "backlash_reduction [um]": float(mm_to_um(red)),
+            "backlash_before_min [um]": float(mm_to_um(trio[0])),
+            "backlash_before_mean [um]": float(mm_to_um(trio[1])),
+            "backlash_before_max [um]": float(mm_to_um(trio[2])),
+            "target_min_backlash [um]": sh.target_min_backlash_um,
+            "shim_start_min_backlash [um]": float(mm_to_um(start)),
+            "backlash_after_shim_min [um]": float(mm_to_um(after[0])),
+            "backlash_after_shim_mean [um]": float(mm_to_um(after[1])),
+            "backlash_after_shim_max [um]": float(mm_to_um(after[2])),
+            "lost_motion_source": source,
+            "lost_motion_after_shim_mean [arcmin]": float(rad_to_arcmin(mean)),
+            "lost_motion_after_shim_max [arcmin]": float(rad_to_arcmin(mx)),
+            "lost_motion_after_shim_mean_dms": format_dms(mean),
+            "lost_motion_after_shim_max_dms": format_dms(mx),
+            "joint_lost_motion_max_after_shim [arcmin]": float(rad_to_arcmin(res_shim.joint_max)),
+            "joint_lost_motion_max_after_shim_dms": format_dms(res_shim.joint_max),
+            "end_effector_error_after_shim [mm]": res_shim.end_effector_max,
+            "stage_at_joint_max_after_shim [arcmin]": chain_values(res_shim),
+        }
+        if sh.verified_backlash_min_um is not None:
+            vals["verified_backlash_after_shim_min [um]"] = used[0] * 1e3
+            vals["verified_backlash_after_shim_mean [um]"] = used[1] * 1e3
+            vals["verified_backlash_after_shim_max [um]"] = used[2] * 1e3
+        analyses.append(
+            AnalysisResult(
+                name="shim",
+                title=f"Shims under both gears of {sh.stage!r} (eq. 32)",
+                values=vals,
+                references=["jiang2024"],
+                notes=[
+                    f"Δjn = {mm_to_um(start):.4g} µm (minimum) − target; "
+                    f"ΔP = Δjn / (2 sin α (sin δ1 + sin δ2)) = {exact:.5f} mm, "
+                    f"rounded ({sh.rounding}) to the {sh.rounding_mm:g} mm stock: {thick:.4g} mm. "
+                    "Shimming shifts the whole backlash distribution by the reduction.",
+                    f"Lost motion after the shim from the {source}.",
+                ],
+                data={"chain": res_shim},
+            )
+        )
+
+    # -- motor-angle compensation (eq. 33) -------------------------------------------------------
+    if case.compensation is not None and case.compensation.enabled:
+        res = analyse_chain(comp_stages, L)
+        if not any(s.compensate for s in comp_stages):
+            warnings.append("compensation enabled but no stage has compensate = true")
+        table = compensation_table(res)
+        analyses.append(
+            AnalysisResult(
+                name="compensation",
+                title="Motor-angle compensation when the load torque reverses (eq. 33)",
+                values={
+                    "motor_compensation_angle [deg]": float(rad_to_deg(res.motor_compensation)),
+                    "compensated_stages": [s.name for s in comp_stages if s.compensate],
+                    "residual_lost_motion_max [arcmin]": {
+                        s.name: float(rad_to_arcmin(r))
+                        for s, r in zip(comp_stages, res.residuals, strict=True)
+                    },
+                    "residual_lost_motion_max_dms": {
+                        s.name: format_dms(r)
+                        for s, r in zip(comp_stages, res.residuals, strict=True)
+                    },
+                    "stage_at_joint_residual [arcmin]": {
+                        s.name: float(rad_to_arcmin(r * f))
+                        for s, r, f in zip(comp_stages, res.residuals, res.transfer, strict=True)
+                    },
+                    "joint_lost_motion_max_after_compensation [arcmin]": float(
+                        rad_to_arcmin(res.joint_max_after)
+                    ),
+                    "joint_lost_motion_max_after_compensation_dms": format_dms(res.joint_max_after),
+                    "end_effector_error_after_compensation [mm]": res.end_effector_max_after,
+                    "compensation_table": table,
+                    "compensation_table_csv": compensation_table_csv(table),
+                },
+                references=["jiang2024"],
+                notes=[
+                    "Δφc = Σ (Π i up to the stage) · Δφm over the compensated stages, applied at "
+                    "the motor when the load torque reverses; a compensated stage keeps "
+                    "max(Δφmax − Δφm, Δφm − Δφmin), the others their Δφmax."
+                    + (" Acts on the chain after the shim." if case.shim is not None else ""),
+                ],
+                data={"chain": res},
+                files={
+                    "compensation.csv": compensation_table_csv(table),
+                    "compensation.json": compensation_table_json(table),
+                },
+            )
+        )
+    return StudyResult(case=case, analyses=analyses, warnings=warnings)
