@@ -120,12 +120,13 @@ def simulate_dte(
 def label_frequency(f: float, sources: dict[str, float], tol: float) -> str:
     """Physical source of a spectral line at f [Hz]: a harmonic of a source or a mesh sideband.
 
-    Tries h × source (h = 1..4) first, then mesh ± k × rotation sidebands (k = 1..3); returns
+    Tries h × source first (h = 1..8 for meshes, whose rectangular stiffness wave is rich in
+    harmonics, 1..4 for rotations), then mesh ± k × rotation sidebands (k = 1..3); returns
     ``"unidentified"`` when nothing lies within ``tol`` [Hz].
     """
     best, err = "unidentified", tol
     for name, fs in sources.items():
-        for h in range(1, 5):
+        for h in range(1, 9 if "mesh" in name else 5):
             d = abs(f - h * fs)
             if d <= err:
                 best, err = (name if h == 1 else f"{h}× {name}"), d
