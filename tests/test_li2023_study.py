@@ -125,3 +125,24 @@ def test_bad_solver_and_unknown_key():
     text = str(exc.value)
     for field in ("analyses.dte.method", "dynamics.dampin_ratio", "errors.placement", "errors.cam"):
         assert field in text, field
+
+
+def test_speed_sweep_finds_cycloid_mesh_resonance():
+    data = tomllib.loads(case_path("li2023_rv_modified_fourier").read_text())
+    data["case"]["name"] = "sweep"
+    data["analyses"] = {
+        "speed_sweep": {
+            "speed_min_rpm": 1500.0,
+            "speed_max_rpm": 2410.0,
+            "count": 3,
+            "duration_s": 0.08,
+            "settle_s": 0.1,
+        }
+    }
+    res = run_case(load_case_dict(data), RunOptions(progress=False, workers=2))
+    v = res["speed_sweep"].values
+    p2p = v["dte_peak_to_peak [arcsec]"]
+    assert v["worst_speed [rpm]"] == pytest.approx(1955.0)
+    assert p2p[1] > 3.0 * max(p2p[0], p2p[2])
+    cyc = [c for c in v["mesh_mode_crossings"] if c["source"] == "cycloid mesh"]
+    assert cyc and cyc[0]["input_speed [rpm]"] == pytest.approx(1955, abs=10)

@@ -161,6 +161,24 @@ def _campbell_figure(a) -> Figure:
     )
 
 
+def _sweep_figure(a) -> Figure:
+    fig, ax = new_figure(figsize=(7.0, 3.6))
+    v = a.values
+    ax.plot(v["input_speed [rpm]"], v["dte_peak_to_peak [arcsec]"], "o-", color=PALETTE[0])
+    for c in a.data["crossings"]:
+        col = PALETTE[1] if "cycloid" in c["source"] else PALETTE[2]
+        ax.axvline(c["input_speed [rpm]"], color=col, ls=":", lw=0.9)
+    ax.set_xlabel("input speed [rpm]")
+    ax.set_ylabel("DTE peak-to-peak [arcsec]")
+    ax.grid(alpha=0.3)
+    return Figure(
+        "DTE peak-to-peak against input speed",
+        "Dotted: speeds where the cycloid (orange) or involute (green) mesh frequency equals one "
+        "of the lowest natural frequencies.",
+        fig,
+    )
+
+
 def _batch_figure(a) -> Figure:
     fig, ax = new_figure(figsize=(6.0, 3.4))
     rows = a.data["rows"]
@@ -185,6 +203,8 @@ def figures(result) -> list[Figure]:
         out += _dte_figures(result["dte"])
     if "modal" in result:
         out.append(_campbell_figure(result["modal"]))
+    if "speed_sweep" in result:
+        out.append(_sweep_figure(result["speed_sweep"]))
     if "batch" in result:
         out.append(_batch_figure(result["batch"]))
     return out

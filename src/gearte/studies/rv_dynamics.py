@@ -6,6 +6,7 @@ Analyses:
 * ``modal``     natural frequencies, rigid-mode check, mesh frequencies over a speed range.
 * ``dte``       dynamic transmission error from static equilibrium: peak-to-peak, spectrum with
   labelled peaks, trajectories and phase portraits (paper Figs 10–11).
+* ``speed_sweep`` DTE peak-to-peak over a range of input speeds, with the mesh/mode crossings.
 * ``batch``     DTE statistics over random error realisations drawn from tolerances (parallel).
 """
 
@@ -159,6 +160,22 @@ class DTEOptions(StrictModel):
     record_dt_s: float = Field(1e-4, gt=0, le=0.1, description="recording interval [s]")
 
 
+class SpeedSweepOptions(StrictModel):
+    """DTE peak-to-peak over a range of input speeds (resonances of the mesh excitation)."""
+
+    speed_min_rpm: float = Field(300.0, gt=0, le=2e4)
+    speed_max_rpm: float = Field(3000.0, gt=0, le=2e4)
+    count: int = Field(19, ge=2, le=500)
+    duration_s: float = Field(0.1, gt=0, le=10, description="simulated time per speed [s]")
+    settle_s: float = Field(0.1, ge=0, le=10)
+
+    @model_validator(mode="after")
+    def _order(self):
+        if not self.speed_max_rpm > self.speed_min_rpm:
+            raise ValueError("speed_max_rpm must be > speed_min_rpm")
+        return self
+
+
 class BatchOptions(StrictModel):
     samples: int = Field(16, ge=1, le=100000)
     duration_s: float = Field(0.5, gt=0, le=60)
@@ -172,6 +189,7 @@ class Analyses(StrictModel):
     contact: ContactOptions | None = None
     modal: ModalOptions | None = None
     dte: DTEOptions | None = None
+    speed_sweep: SpeedSweepOptions | None = None
     batch: BatchOptions | None = None
 
 
@@ -441,6 +459,64 @@ def _dte(case: Case, model, warnings: list[str]) -> AnalysisResult:
     )
 
 
+def _sweep_one(task) -> float:
+    model, rpm, duration, settle = task
+    from gearte.models.rv_dynamics_sim import simulate_dte
+
+    m = model.with_params(input_speed_rpm=float(rpm))
+    return simulate_dte(m, duration, settle_s=settle, record_dt=None).peak_to_peak
+
+
+def _speed_sweep(case: Case, model, options) -> AnalysisResult:
+    from gearte.execution import map_chunks
+
+    o = case.analyses.speed_sweep
+    speeds = np.linspace(o.speed_min_rpm, o.speed_max_rpm, o.count)
+    p2p = np.array(
+        map_chunks(
+            _sweep_one,
+            [(model, s, o.duration_s, o.settle_s) for s in speeds],
+            workers=options.workers,
+            scheduler=options.scheduler,
+            progress=options.progress,
+            description="speed sweep",
+        )
+    )
+    per_rpm = {
+        k: f / model.params.input_speed_rpm
+        for k, f in model.params.frequencies().items()
+        if "mesh" in k
+    }
+    freqs = model.modal().frequencies
+    crossings = []
+    for name, per in per_rpm.items():
+        for f in freqs[:6]:
+            rpm = f / per
+            if o.speed_min_rpm <= rpm <= o.speed_max_rpm:
+                crossings.append(
+                    {"source": name, "mode [Hz]": float(f), "input_speed [rpm]": float(rpm)}
+                )
+    i = int(np.argmax(p2p))
+    return AnalysisResult(
+        name="speed_sweep",
+        title="DTE peak-to-peak against input speed",
+        values={
+            "input_speed [rpm]": speeds,
+            "dte_peak_to_peak [arcsec]": p2p,
+            "worst_speed [rpm]": float(speeds[i]),
+            "worst_dte_peak_to_peak [arcsec]": float(p2p[i]),
+            "mesh_mode_crossings": crossings,
+        },
+        references=["li2023"],
+        notes=[
+            f"{o.duration_s:g} s simulated after {o.settle_s:g} s settling per speed, from static "
+            "equilibrium; crossings are the speeds where a mesh frequency equals one of the six "
+            "lowest natural frequencies.",
+        ],
+        data={"crossings": crossings},
+    )
+
+
 def _batch(case: Case, model, options) -> AnalysisResult:
     from gearte.models.rv_dynamics_sim import ErrorTolerances, dte_batch
 
@@ -516,6 +592,8 @@ def run(case: Case, options) -> StudyResult:
         analyses.append(_modal(case, model, warnings))
     if a.dte is not None:
         analyses.append(_dte(case, model, warnings))
+    if a.speed_sweep is not None:
+        analyses.append(_speed_sweep(case, model, options))
     if a.batch is not None:
         analyses.append(_batch(case, model, options))
     return StudyResult(case=case, analyses=analyses, warnings=warnings)
