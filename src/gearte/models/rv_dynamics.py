@@ -83,8 +83,9 @@ N_PER_M_TO_N_PER_MM = 1e-3
 NM_PER_RAD_TO_NMM_PER_RAD = 1e3
 """Torsional stiffness [N·m/rad] → [N·mm/rad]."""
 
-RHS_WORK_SIZE = 23
-"""Scratch floats :func:`rv_rhs` uses to memoise its time-only trigonometry."""
+_SLOT = 16  # t, 6 trigonometric values, 6 involute and 3 cycloid mesh stiffnesses
+RHS_WORK_SIZE = 2 * _SLOT + 1
+"""Scratch floats :func:`rv_rhs` uses to memoise time-only quantities (≤ 6 cranks, ≤ 3 discs)."""
 
 RHS_SOURCE_KEY = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16]
 """Hash of this file: part of the numba cache key of the integrators built on :func:`rv_rhs`."""
@@ -159,6 +160,12 @@ class RVDynamicsParameters:
         for name, lo in ints.items():
             if int(getattr(self, name)) < lo:
                 raise ParameterError(name, getattr(self, name), f"must be an integer ≥ {lo}")
+        if self.crank_count > 6 or self.disc_count > 3:
+            raise ParameterError(
+                "crank_count/disc_count",
+                (self.crank_count, self.disc_count),
+                "at most 6 cranks and 3 discs (size of the right-hand side's memo)",
+            )
         for name, val in self.__dict__.items():
             if name in ints or name in ("pair", "crank_phase_deg", "cycloid_stiffness"):
                 continue
@@ -426,8 +433,9 @@ def rv_rhs(t, y, args, dydt, work):
     err_n, geo_m, geo_n) from :meth:`RVDynamicModel.kernel_args`; errors are given there as
     body-fixed Cartesian offsets (E cos β, E sin β) and rotated here with the body, so the only
     trigonometric calls per evaluation are the five nominal angles. ``work`` (``RHS_WORK_SIZE``
-    floats, NaN-filled, one per integration) memoises them for the last two times, so RK4 computes
-    them twice per step instead of four times; pass ``np.full(RHS_WORK_SIZE, np.nan)``.
+    floats, NaN-filled, one per integration) memoises them and the mesh stiffnesses for the last
+    two times, so RK4 computes them twice per step instead of four times; pass
+    ``np.full(RHS_WORK_SIZE, np.nan)`` (a shorter array makes the call allocate its own).
     """
     pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n, geo_m, geo_n = args
     nm = int(pf[30])
@@ -443,51 +451,50 @@ def rv_rhs(t, y, args, dydt, work):
     th_o = w_o * t
     th_s = pf[1] * th_o
     th_h = pf[3] + pf[2] * th_o
-    # memo of the time-only trigonometry: two slots [t, 10 values] and the slot to overwrite
-    if work.size >= RHS_WORK_SIZE and work[0] == t:
-        base = 1
-    elif work.size >= RHS_WORK_SIZE and work[11] == t:
-        base = 12
+    # Memo of everything that depends on t only (nominal angles, mesh stiffnesses): two slots
+    # [t, cos/sin of θ_o, θ_s, θ_H, k_sp,i (≤ 6), k_cr,j (≤ 3)] and a flag naming the older slot.
+    if work.size < RHS_WORK_SIZE:
+        work = np.full(RHS_WORK_SIZE, np.nan)
+    if work[0] == t:
+        o = 0
+    elif work[_SLOT] == t:
+        o = _SLOT
     else:
-        base = -1
-    if base > 0:
-        co = work[base]
-        so = work[base + 1]
-        cs = work[base + 2]
-        ss = work[base + 3]
-        chh = work[base + 4]
-        shh = work[base + 5]
-        cps0 = work[base + 6]
-        sps0 = work[base + 7]
-        cpc0 = work[base + 8]
-        spc0 = work[base + 9]
-    else:
-        co = np.cos(th_o)
-        so = np.sin(th_o)
-        cs = np.cos(th_s)
-        ss = np.sin(th_s)
-        chh = np.cos(th_h)
-        shh = np.sin(th_h)
+        o = _SLOT if work[2 * _SLOT] != 1.0 else 0
+        work[2 * _SLOT] = 1.0 if o == _SLOT else 0.0
+        work[o] = t
+        work[o + 1] = np.cos(th_o)
+        work[o + 2] = np.sin(th_o)
+        work[o + 3] = np.cos(th_s)
+        work[o + 4] = np.sin(th_s)
+        work[o + 5] = np.cos(th_h)
+        work[o + 6] = np.sin(th_h)
         ph_s = pf[8] * (th_s - th_o)
         cps0 = np.cos(ph_s)
         sps0 = np.sin(ph_s)
+        for i in range(nm):  # involute mesh stiffness (eq 11), phase z_s(θ_s − θ_o) + z_s ψ_i
+            work[o + 7 + i] = _fourier2(
+                pf[12],
+                fsp,
+                cps0 * geo_m[i, 2] - sps0 * geo_m[i, 3],
+                sps0 * geo_m[i, 2] + cps0 * geo_m[i, 3],
+            )
         ph_c = pf[9] * th_h
         cpc0 = np.cos(ph_c)
         spc0 = np.sin(ph_c)
-        if work.size >= RHS_WORK_SIZE:
-            slot = 0 if work[22] == 1.0 else 11
-            work[22] = 0.0 if slot == 0 else 1.0
-            work[slot] = t
-            work[slot + 1] = co
-            work[slot + 2] = so
-            work[slot + 3] = cs
-            work[slot + 4] = ss
-            work[slot + 5] = chh
-            work[slot + 6] = shh
-            work[slot + 7] = cps0
-            work[slot + 8] = sps0
-            work[slot + 9] = cpc0
-            work[slot + 10] = spc0
+        for j in range(nn):  # cycloid–pin stiffness (eq 13), phase z_p χ_j
+            work[o + 13 + j] = _fourier2(
+                pf[17],
+                fcr,
+                cpc0 * geo_n[j, 2] - spc0 * geo_n[j, 3],
+                spc0 * geo_n[j, 2] + cpc0 * geo_n[j, 3],
+            )
+    co = work[o + 1]
+    so = work[o + 2]
+    cs = work[o + 3]
+    ss = work[o + 4]
+    chh = work[o + 5]
+    shh = work[o + 6]
     a_h = pf[4]
     ecc = pf[5]
     r_bs = pf[6]
@@ -533,12 +540,7 @@ def rv_rhs(t, y, args, dydt, work):
         ny = tx
         px = r_bs * tx
         py = r_bs * ty
-        ksp = _fourier2(
-            pf[12],
-            fsp,
-            cps0 * geo_m[i, 2] - sps0 * geo_m[i, 3],
-            sps0 * geo_m[i, 2] + cps0 * geo_m[i, 3],
-        )
+        ksp = work[o + 7 + i]
         pex = err_m[i, 0, 0] * chh - err_m[i, 0, 1] * shh
         pey = err_m[i, 0, 0] * shh + err_m[i, 0, 1] * chh
         ga_t = px * ny - py * nx  # arm of the sun
@@ -633,12 +635,7 @@ def rv_rhs(t, y, args, dydt, work):
             f[ic + 1] -= fy
             f[ic + 2] -= chx * fy - chy * fx
         # equivalent cycloid–pin contact at the pitch point P = z_p e ê_χ (eq 27, rotating)
-        kcr = _fourier2(
-            pf[17],
-            fcr,
-            cpc0 * geo_n[j, 2] - spc0 * geo_n[j, 3],
-            spc0 * geo_n[j, 2] + cpc0 * geo_n[j, 3],
-        )
+        kcr = work[o + 13 + j]
         # force on the disc along d = sgn sinβ ê + cosβ ẑ×ê ; approach direction n = −d
         nx = -(pf[20] * sb * ex - cb * ey)
         ny = -(pf[20] * sb * ey + cb * ex)
