@@ -1,0 +1,210 @@
+"""Figures of the ``rv_dynamics`` study (paper 004 Figs 9–11 and a Campbell-style diagram).
+
+matplotlib is imported lazily through :func:`gearte.plotting.new_figure`; nothing calls show().
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gearte.plotting import PALETTE, Figure, new_figure
+
+__all__ = ["figures"]
+
+
+def _contact_figure(a) -> Figure:
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(9.0, 3.6))
+    v = a.values
+    x = np.asarray(v["mesh_position [deg]"])
+    ax1.plot(x, v["equivalent_pressure_angle [deg]"], color=PALETTE[0])
+    ax1.set_xlabel("mesh position [deg of meshing phase]")
+    ax1.set_ylabel("equivalent pressure angle β [deg]")
+    ax2.plot(x, np.asarray(v["equivalent_mesh_stiffness [N/m]"]) / 1e9, color=PALETTE[1])
+    ax2.set_xlabel("mesh position [deg of meshing phase]")
+    ax2.set_ylabel("equivalent mesh stiffness k_cr [GN/m]")
+    for ax in (ax1, ax2):
+        ax.grid(alpha=0.3)
+    return Figure(
+        "Equivalent pressure angle and mesh stiffness over one mesh period",
+        f"Paper 004 Fig 9 at {v['torque_per_disc [N·m]']:g} N·m per disc: mean β = "
+        f"{v['equivalent_pressure_angle_mean [deg]']:.2f}°, mean k_cr = "
+        f"{v['equivalent_mesh_stiffness_mean [N/m]']:.3g} N/m.",
+        fig,
+    )
+
+
+def _load_figure(a) -> Figure:
+    sweep = a.values["load_sweep"]
+    t = [r["torque_per_disc [N·m]"] for r in sweep]
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(9.0, 3.4))
+    ax1.plot(t, [r["equivalent_pressure_angle_mean [deg]"] for r in sweep], "o-", color=PALETTE[0])
+    ax1.set_xlabel("torque per disc [N·m]")
+    ax1.set_ylabel("mean β [deg]")
+    ax2.plot(
+        t,
+        [r["equivalent_mesh_stiffness_mean [N/m]"] / 1e9 for r in sweep],
+        "o-",
+        color=PALETTE[1],
+    )
+    ax2.set_xlabel("torque per disc [N·m]")
+    ax2.set_ylabel("mean k_cr [GN/m]")
+    for ax in (ax1, ax2):
+        ax.grid(alpha=0.3)
+    return Figure(
+        "Equivalent pressure angle and mesh stiffness against load",
+        "Means over one mesh period; the Hertz contact stiffens with load and, with a "
+        "modification, more pins come into contact.",
+        fig,
+    )
+
+
+def _dte_figures(a) -> list[Figure]:
+    r = a.data["dte"]
+    out = []
+    fig, ax = new_figure(figsize=(8.0, 3.4))
+    ax.plot(r.t, r.dte, lw=0.7, color=PALETTE[0])
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("DTE − mean [arcsec]")
+    ax.grid(alpha=0.3)
+    out.append(
+        Figure(
+            "Dynamic transmission error",
+            f"θ_o − θ_s/i after settling, static wind-up {r.dte_mean:.2f}″ removed; peak-to-peak "
+            f"{r.peak_to_peak:.3g}″ (paper 004 Fig 11: 0.78″ without, 17.25″ with errors).",
+            fig,
+        )
+    )
+    freq, spec, peaks = a.data["freq"], a.data["spec"], a.data["peaks"]
+    fig, ax = new_figure(figsize=(8.0, 3.6))
+    ax.semilogy(freq[1:], np.maximum(spec[1:], 1e-6), lw=0.8, color=PALETTE[0])
+    for k, pk in enumerate(peaks[:8]):
+        f, amp = pk["frequency [Hz]"], pk["amplitude [arcsec]"]
+        ax.annotate(
+            f"{pk['source']}\n{f:.1f} Hz",
+            (f, amp),
+            xytext=(5, 5 + 12 * (k % 3)),
+            textcoords="offset points",
+            fontsize=7,
+            color=PALETTE[1],
+        )
+        ax.plot([f], [amp], "o", ms=3, color=PALETTE[1])
+    ax.set_xlim(0, max(2.5 * max(a.data["sources"]["cycloid mesh"], 1.0), 10.0))
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("amplitude [arcsec] (log)")
+    ax.set_ylim(max(1e-6, 1e-4 * spec[1:].max()), 3 * spec[1:].max())
+    ax.grid(alpha=0.3)
+    out.append(
+        Figure(
+            "DTE spectrum with labelled sources",
+            "Peaks labelled by their physical source: rotations (crank relative to the carrier, "
+            "input, output), involute and cycloid mesh frequencies and their sidebands.",
+            fig,
+        )
+    )
+    names = r.state_names
+    bodies = []
+    for n in names:
+        b = n.split(".")[0]
+        if b not in bodies:
+            bodies.append(b)
+    fig, axes = new_figure(2, len(bodies), figsize=(3.0 * len(bodies), 5.6))
+    axes = np.atleast_2d(axes)
+    for c, b in enumerate(bodies):
+        ix, iy = names.index(f"{b}.x"), names.index(f"{b}.y")
+        it, iw = names.index(f"{b}.theta"), names.index(f"{b}.omega")
+        s = r.states
+        axes[0, c].plot(s[:, ix] * 1e3, s[:, iy] * 1e3, lw=0.5, color=PALETTE[0])
+        axes[0, c].set_title(b, fontsize=9)
+        axes[0, c].set_xlabel("x [µm]")
+        axes[0, c].set_ylabel("y [µm]")
+        th = s[:, it] - s[:, it].mean()
+        axes[1, c].plot(th * 206264.806, s[:, iw], lw=0.5, color=PALETTE[2])
+        axes[1, c].set_xlabel("θ − mean [arcsec]")
+        axes[1, c].set_ylabel("dθ/dt [rad/s]")
+    out.append(
+        Figure(
+            "Trajectories and phase portraits",
+            "Top: centre trajectories (vibration about the nominal motion); bottom: torsional "
+            "phase portraits (paper 004 Fig 10).",
+            fig,
+        )
+    )
+    return out
+
+
+def _campbell_figure(a) -> Figure:
+    fig, ax = new_figure(figsize=(7.0, 4.2))
+    speeds = a.data["speeds_rpm"]
+    freqs = np.asarray(a.values["natural_frequencies [Hz]"])
+    fmax = 0.0
+    for k, (name, line) in enumerate(a.data["mesh_lines"].items()):
+        line = np.asarray(line)
+        ax.plot(speeds, line, color=PALETTE[(k + 1) % len(PALETTE)], label=name)
+        if "mesh" in name:
+            ax.plot(speeds, 2 * line, ls="--", color=PALETTE[(k + 1) % len(PALETTE)], lw=0.8)
+        fmax = max(fmax, 2 * line.max())
+    for f in freqs[freqs <= 1.1 * fmax]:
+        ax.axhline(f, color="0.6", lw=0.6)
+    op = a.data.get("operating_rpm")
+    if op is not None:
+        ax.axvline(op, color="k", ls=":", lw=1.0, label="operating speed")
+    ax.set_xlabel("input speed [rpm]")
+    ax.set_ylabel("frequency [Hz]")
+    ax.set_ylim(0, 1.1 * fmax)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.2)
+    return Figure(
+        "Natural frequencies against excitation frequencies (Campbell diagram)",
+        "Grey: natural frequencies at mean mesh stiffness; solid: mesh and rotation frequencies, "
+        "dashed: second mesh harmonics. A crossing near the operating speed is a resonance.",
+        fig,
+    )
+
+
+def _sweep_figure(a) -> Figure:
+    fig, ax = new_figure(figsize=(7.0, 3.6))
+    v = a.values
+    ax.plot(v["input_speed [rpm]"], v["dte_peak_to_peak [arcsec]"], "o-", color=PALETTE[0])
+    for c in a.data["crossings"]:
+        col = PALETTE[1] if "cycloid" in c["source"] else PALETTE[2]
+        ax.axvline(c["input_speed [rpm]"], color=col, ls=":", lw=0.9)
+    ax.set_xlabel("input speed [rpm]")
+    ax.set_ylabel("DTE peak-to-peak [arcsec]")
+    ax.grid(alpha=0.3)
+    return Figure(
+        "DTE peak-to-peak against input speed",
+        "Dotted: speeds where the cycloid (orange) or involute (green) mesh frequency equals one "
+        "of the lowest natural frequencies.",
+        fig,
+    )
+
+
+def _batch_figure(a) -> Figure:
+    fig, ax = new_figure(figsize=(6.0, 3.4))
+    rows = a.data["rows"]
+    ax.hist(rows[:, 0], bins=max(5, int(np.sqrt(rows.shape[0]))), color=PALETTE[0])
+    ax.set_xlabel("DTE peak-to-peak [arcsec]")
+    ax.set_ylabel("realisations")
+    return Figure(
+        "DTE peak-to-peak over random error realisations",
+        f"{rows.shape[0]} realisations, mean {rows[:, 0].mean():.3g}″.",
+        fig,
+    )
+
+
+def figures(result) -> list[Figure]:
+    """All figures of an ``rv_dynamics`` result."""
+    out: list[Figure] = []
+    if "contact" in result:
+        out.append(_contact_figure(result["contact"]))
+        if result["contact"].values.get("load_sweep"):
+            out.append(_load_figure(result["contact"]))
+    if "dte" in result:
+        out += _dte_figures(result["dte"])
+    if "modal" in result:
+        out.append(_campbell_figure(result["modal"]))
+    if "speed_sweep" in result:
+        out.append(_sweep_figure(result["speed_sweep"]))
+    if "batch" in result:
+        out.append(_batch_figure(result["batch"]))
+    return out

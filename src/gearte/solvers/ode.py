@@ -1,0 +1,566 @@
+"""One interface for time integration: compiled RK4 / DOPRI5 kernels and scipy as reference.
+
+A system is a compiled right-hand side ``rhs(t, y, args, dydt, work)`` (numba ``@njit``), a compiled
+scalar output ``output(t, y, args) -> float`` (e.g. the dynamic transmission error) and the
+``args`` tuple of arrays, plus plain-Python twins for :func:`scipy.integrate.solve_ivp`.
+
+The kernels run the whole time loop in compiled code without the GIL (``nogil=True``), so threads
+run realisations in parallel; they reduce the output to summary statistics (min, max, mean, rms
+after a settling time) inside the loop and record only a decimated trace when asked, so a batch
+never stores trajectories. Non-finite states are detected in the loop and raised as
+:class:`gearte.errors.DivergenceError`; a fixed RK4 step above the stability limit of the
+linearised system is refused with the limit in the message.
+
+Caching: the kernels are copies of module-level templates whose globals bind the system's
+``rhs``/``output``, compiled with ``cache=True`` under a name that carries a hash of the source
+files of ``rhs`` and ``output``: editing the model gives a new cache entry instead of silently
+reusing a kernel with a stale inlined rhs (numba itself only checks the kernel's own file). No
+closures: numba keys cached closures by their pickled cells, which change every process.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import time
+import types
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from gearte.errors import DivergenceError, ParameterError
+
+__all__ = [
+    "ODESystem",
+    "ODEResult",
+    "integrate",
+    "rk4_stability_limit",
+    "kernels",
+]
+
+_STATS = 5  # count, min, max, sum, sum of squares
+
+
+@dataclass(frozen=True)
+class ODESystem:
+    """A first-order system y' = f(t, y) in compiled and plain form.
+
+    Attributes
+    ----------
+    rhs : numba dispatcher ``rhs(t, y, args, dydt, work)`` writing dy/dt in place; ``work`` is a
+        scratch array of ``work_size`` floats owned by one integration (NaN-filled at its start),
+        e.g. to reuse time-only quantities between stages; never shared between threads.
+    output : numba dispatcher ``output(t, y, args) -> float`` summarised by the kernels.
+    args : tuple of arrays passed to both.
+    key : str, hash of the rhs source (part of the cache key of the kernels).
+    rhs_python : ``f(t, y) -> dydt`` plain twin for solve_ivp (optional).
+    output_python : ``g(t, y) -> float`` plain twin (optional; defaults to ``output.py_func``).
+    stability_eigenvalues : eigenvalues of the linearised state matrix at its stiffest [1/s]
+        (optional); used to refuse RK4 steps above the stability limit.
+    """
+
+    rhs: Any
+    output: Any
+    args: tuple
+    key: str
+    rhs_python: Callable[[float, np.ndarray], np.ndarray] | None = None
+    output_python: Callable[[float, np.ndarray], float] | None = None
+    stability_eigenvalues: np.ndarray | None = field(default=None, repr=False)
+    work_size: int = 0
+
+
+@dataclass(frozen=True)
+class ODEResult:
+    """Result of :func:`integrate`.
+
+    t [s] and output (plus the recorded states ``states``, columns = ``record_states``) on the
+    recording grid after the settling time; ``stats`` of the output after settling (min, max,
+    mean, rms, peak_to_peak, count); ``y_final``; counters and wall time [s].
+    """
+
+    method: str
+    t: np.ndarray
+    output: np.ndarray
+    states: np.ndarray
+    y_final: np.ndarray
+    stats: dict[str, float]
+    n_steps: int
+    n_rhs: int
+    wall_time: float
+
+    @property
+    def peak_to_peak(self) -> float:
+        return self.stats["peak_to_peak"]
+
+
+def _rk4_amp(z: np.ndarray) -> np.ndarray:
+    return np.abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
+
+
+def rk4_stability_limit(eigenvalues: np.ndarray) -> float:
+    """Largest step h [s] with |R(hλ)| ≤ 1 for every eigenvalue λ (classical RK4).
+
+    R(z) = 1 + z + z²/2 + z³/6 + z⁴/24. For each λ the first crossing of |R| = 1 along the ray
+    h λ is bracketed on a fine grid and refined by bisection; purely imaginary λ (|R| > 1 for
+    small h, a mild instability RK4 shares with every explicit scheme) are bounded at |hλ| = 2√2.
+    """
+    lam = np.asarray(eigenvalues, dtype=complex)
+    lam = lam[np.abs(lam) > 0]
+    if lam.size == 0:
+        return np.inf
+    limits = []
+    for lm in lam:
+        s = np.linspace(1e-6, 3.5, 3501) / abs(lm)
+        amp = _rk4_amp(s * lm)
+        bad = np.nonzero(amp > 1.0 + 1e-12)[0]
+        if bad.size == 0:
+            limits.append(3.5 / abs(lm))
+            continue
+        if bad[0] == 0:  # marginal (imaginary axis): use the imaginary-axis bound
+            limits.append(2.0 * np.sqrt(2.0) / abs(lm))
+            continue
+        lo, hi = s[bad[0] - 1], s[bad[0]]
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            if _rk4_amp(mid * lm) > 1.0 + 1e-12:
+                hi = mid
+            else:
+                lo = mid
+        limits.append(lo)
+    return float(np.min(limits))
+
+
+# Placeholders of the templates' free names; each specialised kernel rebinds them (_specialise).
+rhs: Any = None
+output: Any = None
+
+
+@njit(cache=True, nogil=True)
+def _stats_update(stats, o):
+    stats[0] += 1.0
+    if o < stats[1]:
+        stats[1] = o
+    if o > stats[2]:
+        stats[2] = o
+    stats[3] += o
+    stats[4] += o * o
+
+
+def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, rec, work_size):
+    n = y0.size
+    work = np.full(work_size, np.nan)
+    y = y0.copy()
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    tmp = np.empty(n)
+    stats = np.zeros(_STATS)
+    stats[1] = np.inf
+    stats[2] = -np.inf
+    nrec = 0
+    h2 = 0.5 * dt
+    h6 = dt / 6.0
+    if settle_steps == 0:
+        o = output(t0, y, args)
+        _stats_update(stats, o)
+        if rec_every > 0 and rec.shape[0] > 0:
+            rec[0, 0] = o
+            for c in range(rec_idx.size):
+                rec[0, 1 + c] = y[rec_idx[c]]
+            nrec = 1
+    for s in range(n_steps):
+        t = t0 + s * dt
+        rhs(t, y, args, k1, work)
+        for i in range(n):
+            tmp[i] = y[i] + h2 * k1[i]
+        rhs(t + h2, tmp, args, k2, work)
+        for i in range(n):
+            tmp[i] = y[i] + h2 * k2[i]
+        rhs(t + h2, tmp, args, k3, work)
+        for i in range(n):
+            tmp[i] = y[i] + dt * k3[i]
+        t_next = t0 + (s + 1) * dt  # bit-identical to the next step's t (rhs may memoise by t)
+        rhs(t_next, tmp, args, k4, work)
+        acc = 0.0
+        for i in range(n):
+            y[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            acc += y[i]
+        if not np.isfinite(acc):
+            return y, stats, nrec, s + 1
+        if s + 1 >= settle_steps:
+            o = output(t_next, y, args)
+            _stats_update(stats, o)
+            if rec_every > 0 and (s + 1 - settle_steps) % rec_every == 0:
+                if nrec < rec.shape[0]:
+                    rec[nrec, 0] = o
+                    for c in range(rec_idx.size):
+                        rec[nrec, 1 + c] = y[rec_idx[c]]
+                    nrec += 1
+    return y, stats, nrec, -1
+
+
+# Dormand–Prince 5(4) tableau
+c2, c3, c4, c5 = 1 / 5, 3 / 10, 4 / 5, 8 / 9
+a21 = 1 / 5
+a31, a32 = 3 / 40, 9 / 40
+a41, a42, a43 = 44 / 45, -56 / 15, 32 / 9
+a51, a52, a53, a54 = 19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729
+a61, a62, a63, a64, a65 = 9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656
+b1, b3, b4, b5, b6 = 35 / 384, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84
+e1, e3, e4, e5, e6, e7 = (
+    71 / 57600,
+    -71 / 16695,
+    71 / 1920,
+    -17253 / 339200,
+    22 / 525,
+    -1 / 40,
+)
+
+
+def _dopri5_template(
+    y0,
+    t0,
+    t_end,
+    h0,
+    h_max,
+    rtol,
+    atol,
+    args,
+    t_settle,
+    rec_dt,
+    rec_idx,
+    rec,
+    max_steps,
+    work_size,
+):
+    n = y0.size
+    work = np.full(work_size, np.nan)
+    y = y0.copy()
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    yn = np.empty(n)
+    tmp = np.empty(n)
+    stats = np.zeros(_STATS)
+    stats[1] = np.inf
+    stats[2] = -np.inf
+    counters = np.zeros(3)  # accepted, rejected, rhs evaluations
+    t = t0
+    h = h0
+    rhs(t, y, args, k1, work)
+    counters[2] += 1
+    next_rec = t_settle
+    nrec = 0
+    while t < t_end:
+        if counters[0] + counters[1] >= max_steps:
+            return y, stats, nrec, counters, -2
+        if t + h > t_end:
+            h = t_end - t
+        for i in range(n):
+            tmp[i] = y[i] + h * a21 * k1[i]
+        rhs(t + c2 * h, tmp, args, k2, work)
+        for i in range(n):
+            tmp[i] = y[i] + h * (a31 * k1[i] + a32 * k2[i])
+        rhs(t + c3 * h, tmp, args, k3, work)
+        for i in range(n):
+            tmp[i] = y[i] + h * (a41 * k1[i] + a42 * k2[i] + a43 * k3[i])
+        rhs(t + c4 * h, tmp, args, k4, work)
+        for i in range(n):
+            tmp[i] = y[i] + h * (a51 * k1[i] + a52 * k2[i] + a53 * k3[i] + a54 * k4[i])
+        rhs(t + c5 * h, tmp, args, k5, work)
+        for i in range(n):
+            tmp[i] = y[i] + h * (
+                a61 * k1[i] + a62 * k2[i] + a63 * k3[i] + a64 * k4[i] + a65 * k5[i]
+            )
+        rhs(t + h, tmp, args, k6, work)
+        for i in range(n):
+            yn[i] = y[i] + h * (b1 * k1[i] + b3 * k3[i] + b4 * k4[i] + b5 * k5[i] + b6 * k6[i])
+        rhs(t + h, yn, args, k7, work)
+        counters[2] += 6
+        err = 0.0
+        for i in range(n):
+            ei = h * (e1 * k1[i] + e3 * k3[i] + e4 * k4[i] + e5 * k5[i] + e6 * k6[i] + e7 * k7[i])
+            sc = atol[i] + rtol * max(abs(y[i]), abs(yn[i]))
+            err += (ei / sc) ** 2
+        err = np.sqrt(err / n)
+        if not np.isfinite(err):
+            if h < 1e-14:
+                return y, stats, nrec, counters, 1
+            h *= 0.1
+            counters[1] += 1
+            continue
+        if err <= 1.0:
+            t_new = t + h
+            # record on the uniform grid by cubic Hermite interpolation of the step
+            while next_rec <= t_new + 1e-15 and t_new > t:
+                th = (next_rec - t) / h
+                h00 = 2 * th**3 - 3 * th**2 + 1
+                h10 = th**3 - 2 * th**2 + th
+                h01 = -2 * th**3 + 3 * th**2
+                h11 = th**3 - th**2
+                for i in range(n):
+                    tmp[i] = h00 * y[i] + h10 * h * k1[i] + h01 * yn[i] + h11 * h * k7[i]
+                o = output(next_rec, tmp, args)
+                _stats_update(stats, o)
+                if nrec < rec.shape[0]:
+                    rec[nrec, 0] = o
+                    for c in range(rec_idx.size):
+                        rec[nrec, 1 + c] = tmp[rec_idx[c]]
+                    nrec += 1
+                next_rec += rec_dt
+            t = t_new
+            acc = 0.0
+            for i in range(n):
+                y[i] = yn[i]
+                k1[i] = k7[i]
+                acc += y[i]
+            if not np.isfinite(acc):
+                return y, stats, nrec, counters, 1
+            counters[0] += 1
+            fac = 0.9 * err ** (-0.2) if err > 0 else 5.0
+            h = h * min(5.0, max(0.2, fac))
+        else:
+            counters[1] += 1
+            h = h * max(0.2, 0.9 * err ** (-0.2))
+        if h > h_max:
+            h = h_max
+    return y, stats, nrec, counters, -1
+
+
+def _specialise(template, rhs, output, key: str, name: str):
+    """A copy of ``template`` whose globals bind ``rhs``/``output``, compiled with cache=True.
+
+    numba files a cached function under its module and ``__qualname__`` and checks the source
+    file's time stamp; the qualname carries ``key`` (a hash of the files defining rhs and output),
+    so a changed model gets a new cache entry instead of a stale kernel with the old rhs inlined.
+    """
+    g = dict(template.__globals__)
+    g["rhs"] = rhs
+    g["output"] = output
+    fn = types.FunctionType(template.__code__, g, f"{name}_{key}", template.__defaults__, None)
+    fn.__qualname__ = f"{name}_{key}"
+    fn.__module__ = template.__module__
+    return njit(cache=True, nogil=True)(fn)
+
+
+def _source_key(*funcs) -> str:
+    h = hashlib.sha256()
+    for f in funcs:
+        py = getattr(f, "py_func", f)
+        h.update(py.__module__.encode())
+        h.update(py.__qualname__.encode())
+        h.update(Path(inspect.getsourcefile(py)).read_bytes())
+    return h.hexdigest()[:16]
+
+
+@lru_cache(maxsize=16)
+def kernels(rhs, output, key: str = ""):
+    """Compiled (RK4, DOPRI5) kernels specialised on ``rhs``/``output`` (cached on disk).
+
+    The cache key combines ``key`` with a hash of the source files of ``rhs`` and ``output``.
+    """
+    k = hashlib.sha256((key + _source_key(rhs, output)).encode()).hexdigest()[:16]
+    return (
+        _specialise(_rk4_template, rhs, output, k, "rk4"),
+        _specialise(_dopri5_template, rhs, output, k, "dopri5"),
+    )
+
+
+_LIMITS: dict[int, tuple[Any, float]] = {}
+
+
+def _cached_limit(system: ODESystem) -> float:
+    """RK4 stability limit of a system, computed once per eigenvalue array."""
+    ev = system.stability_eigenvalues
+    hit = _LIMITS.get(id(ev))
+    if hit is not None and hit[0] is ev:
+        return hit[1]
+    lim = rk4_stability_limit(ev)
+    if len(_LIMITS) > 64:
+        _LIMITS.clear()
+    _LIMITS[id(ev)] = (ev, lim)
+    return lim
+
+
+def _finish_stats(stats: np.ndarray) -> dict[str, float]:
+    cnt = stats[0]
+    if cnt == 0:
+        raise ParameterError("t_settle", None, "no output sample after the settling time")
+    mean = stats[3] / cnt
+    return {
+        "min": float(stats[1]),
+        "max": float(stats[2]),
+        "mean": float(mean),
+        "rms": float(np.sqrt(max(stats[4] / cnt, 0.0))),
+        "peak_to_peak": float(stats[2] - stats[1]),
+        "count": float(cnt),
+    }
+
+
+def integrate(
+    system: ODESystem,
+    y0: np.ndarray,
+    t_span: tuple[float, float],
+    *,
+    method: str = "rk4",
+    dt: float | None = None,
+    rtol: float = 1e-7,
+    atol: float | np.ndarray = 1e-12,
+    t_settle: float = 0.0,
+    record_dt: float | None = None,
+    record_states: np.ndarray | list[int] | None = None,
+    max_records: int = 2_000_000,
+    max_steps: int = 50_000_000,
+    args: tuple | None = None,
+) -> ODEResult:
+    """Integrate ``system`` from ``y0`` over ``t_span`` [s].
+
+    Parameters
+    ----------
+    method : "rk4" (compiled fixed step ``dt``), "dopri5" (compiled adaptive, ``rtol``/``atol``)
+        or "scipy" (:func:`scipy.integrate.solve_ivp` RK45 on the plain twin, the reference).
+    dt : float
+        RK4 step [s]; refused above the stability limit when the system gives its eigenvalues.
+        For DOPRI5 the initial step.
+    t_settle : float
+        Time [s] after t_span[0] before the output is summarised and recorded.
+    record_dt : float, optional
+        Recording interval [s] (a multiple of dt for RK4); ``None`` records nothing.
+    record_states : indices of state components recorded beside the output.
+    args : tuple, optional
+        Replaces ``system.args`` (e.g. another error realisation) without recompiling.
+
+    Raises
+    ------
+    ParameterError
+        Bad method, step above the stability limit, inconsistent times.
+    DivergenceError
+        A non-finite state (the result is never returned).
+    """
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    if not t1 > t0:
+        raise ParameterError("t_span", t_span, "end must be after start")
+    if not 0.0 <= t_settle < t1 - t0:
+        raise ParameterError("t_settle", t_settle, f"must be in [0, {t1 - t0:g}) s")
+    y0 = np.ascontiguousarray(y0, dtype=float)
+    if not np.all(np.isfinite(y0)):
+        raise ParameterError("y0", "non-finite", "initial state must be finite")
+    a = system.args if args is None else args
+    idx = np.asarray([] if record_states is None else record_states, dtype=np.int64)
+    t_start = time.perf_counter()
+    if method == "rk4":
+        if dt is None or not dt > 0:
+            raise ParameterError("dt", dt, "RK4 needs a step > 0 s")
+        if system.stability_eigenvalues is not None:
+            lim = _cached_limit(system)
+            if dt > lim:
+                raise ParameterError(
+                    "dt",
+                    dt,
+                    f"above the RK4 stability limit {lim:.4g} s of this system (largest "
+                    f"|λ| = {np.max(np.abs(system.stability_eigenvalues)):.4g} 1/s); use dt ≤ "
+                    f"{lim:.4g} s",
+                )
+        # end exactly at t1: the step is shortened (never lengthened) to fit the span
+        n_steps = max(1, int(np.ceil((t1 - t0) / dt - 1e-9)))
+        dt = (t1 - t0) / n_steps
+        settle_steps = int(round(t_settle / dt))
+        if record_dt is None:
+            rec_every, n_rec = 0, 0
+        else:
+            rec_every = max(1, int(round(record_dt / dt)))
+            n_rec = min(max_records, (n_steps - settle_steps) // rec_every + 1)
+        rec = np.zeros((n_rec, 1 + idx.size))
+        rk4, _ = kernels(system.rhs, system.output, system.key)
+        y, stats, nrec, status = rk4(
+            y0, t0, dt, n_steps, a, settle_steps, rec_every, idx, rec, system.work_size
+        )
+        if status >= 0:
+            raise DivergenceError(
+                f"RK4 diverged: non-finite state at t = {t0 + status * dt:.6g} s "
+                f"(step {status} of {n_steps}, dt = {dt:.3g} s)"
+            )
+        t_rec = t0 + (settle_steps + rec_every * np.arange(nrec)) * dt
+        n_rhs = 4 * n_steps
+        steps = n_steps
+    elif method == "dopri5":
+        h0 = dt if dt is not None else 1e-6
+        rec_dt = record_dt if record_dt is not None else (t1 - t0) / 10000
+        n_rec = 0 if record_dt is None else min(max_records, int((t1 - t0 - t_settle) / rec_dt) + 2)
+        rec = np.zeros((n_rec, 1 + idx.size))
+        atol_arr = np.broadcast_to(np.asarray(atol, dtype=float), y0.shape).copy()
+        _, dp = kernels(system.rhs, system.output, system.key)
+        y, stats, nrec, counters, status = dp(
+            y0,
+            t0,
+            t1,
+            h0,
+            t1 - t0,
+            rtol,
+            atol_arr,
+            a,
+            t0 + t_settle,
+            rec_dt,
+            idx,
+            rec,
+            max_steps,
+            system.work_size,
+        )
+        if status == 1:
+            raise DivergenceError("DOPRI5 diverged: non-finite state or error estimate")
+        if status == -2:
+            raise DivergenceError(f"DOPRI5 exceeded {max_steps} steps (stiff or diverging)")
+        t_rec = t0 + t_settle + rec_dt * np.arange(nrec)
+        n_rhs = int(counters[2])
+        steps = int(counters[0])
+    elif method == "scipy":
+        from scipy.integrate import solve_ivp
+
+        if system.rhs_python is None:
+            raise ParameterError("method", method, "the system has no plain-Python rhs")
+        rec_dt = record_dt if record_dt is not None else dt if dt is not None else 1e-4
+        t_eval = t0 + t_settle + rec_dt * np.arange(int(round((t1 - t0 - t_settle) / rec_dt)) + 1)
+        t_eval = t_eval[t_eval <= t1 + 1e-12]
+        t_eval[-1] = min(t_eval[-1], t1)
+        sol = solve_ivp(
+            system.rhs_python, (t0, t1), y0, method="RK45", t_eval=t_eval, rtol=rtol, atol=atol
+        )
+        if not sol.success or not np.all(np.isfinite(sol.y)):
+            raise DivergenceError(f"solve_ivp failed or diverged: {sol.message}")
+        out_fn = system.output_python or (lambda t, yy: system.output.py_func(t, yy, a))
+        outs = np.array([out_fn(tt, sol.y[:, c]) for c, tt in enumerate(sol.t)])
+        st = np.array([outs.size, outs.min(), outs.max(), outs.sum(), np.sum(outs**2)])
+        stats = st
+        y = sol.y[:, -1]
+        rec = np.column_stack([outs] + [sol.y[i] for i in idx]) if outs.size else np.zeros((0, 1))
+        nrec = outs.size
+        t_rec = sol.t
+        n_rhs = int(sol.nfev)
+        steps = int(sol.t.size)
+    else:
+        raise ParameterError("method", method, "must be 'rk4', 'dopri5' or 'scipy'")
+    wall = time.perf_counter() - t_start
+    st = _finish_stats(np.asarray(stats))
+    if not np.all(np.isfinite(list(st.values()))):
+        raise DivergenceError(f"{method}: non-finite output statistics")
+    return ODEResult(
+        method=method,
+        t=t_rec[:nrec],
+        output=rec[:nrec, 0].copy(),
+        states=rec[:nrec, 1:].copy(),
+        y_final=np.asarray(y).copy(),
+        stats=st,
+        n_steps=steps,
+        n_rhs=n_rhs,
+        wall_time=wall,
+    )
