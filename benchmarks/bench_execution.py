@@ -1,22 +1,23 @@
 """Execution layer (issue 7): local 1 worker vs 2 workers vs a Dask LocalCluster of 2 workers.
 
-Two workloads, each run on every backend with the same seed (results must be identical):
+Workloads, each run on every backend with the same seed (results must be identical):
 
 1. Tolerance study: 1e7-sample Monte-Carlo of the normal backlash of Jiang et al. (2024)'s spur
-   pair (``examples/jiang2024_spur_pair.toml``) through ``gearte.tolerance.montecarlo`` — the real
-   issue-3 kernel.
-2. Dynamics batch: 200 runs of a torsional dynamics model with random errors. **Stand-in**: the
-   RV dynamics batch of issue 6 is not on main yet, so this uses a representative compiled kernel
-   of its own (:func:`standin_dte_chunk`: a numba ``nogil`` RK4 of a two-mass torsional system
-   with time-varying mesh stiffness and random eccentricity errors, 10⁵ RK4 steps per run,
-   ~10 ms). To use the real batch, change the one line marked ``DYNAMICS_BATCH =`` below.
+   pair (``examples/jiang2024_spur_pair.toml``) through ``gearte.tolerance.montecarlo`` (issue 3),
+   in 40 chunks of 250 000. Plain baseline: the same stack sampled by numpy in one call.
+2. Dynamics batch: 200 runs of issue 6's RV dynamics model (Li et al. 2023 prototype, Table 3
+   errors) over random error realisations, ``gearte.models.rv_dynamics_sim.dte_batch`` (0.5 s
+   simulated + 0.1 s settling per run, chunks of 4 runs). The batch is chosen by the one line
+   ``DYNAMICS_BATCH =`` below.
+3. Calibration (stand-in kernel, :func:`standin_dynamics_batch`): 200 runs of a small numba
+   ``nogil`` RK4 torsional model of this file, also timed as a bare Python loop and on bare
+   ``threading.Thread``s without gearte. It tells how much parallel speed-up the machine offers
+   at that moment (on a shared machine other load caps every backend) and what the layer costs.
 
 Printed: wall time per backend, speed-up and parallel efficiency against 1 worker (goal ≥ 0.8 on
-2 cores for the dynamics batch), the plain baseline (a bare Python loop over the same kernel,
-no execution layer) and the layer's overhead ratio, the speed-up bare threads attain on the
-machine at that moment (on a shared machine, other load caps every backend), and the
-LocalCluster's start-up and per-study overhead. Each backend is warmed up first (JIT compile /
-cache load in every worker); times are the best of ``--repeat``.
+2 cores for the dynamics batch), the plain baselines and their ratios, and the LocalCluster's
+start-up and per-study overhead. Each backend is warmed up first (JIT compile / cache load in
+every worker); times are the best of ``--repeat`` interleaved runs.
 
 Run: ``PYTHONPATH=src python benchmarks/bench_execution.py [--runs 200] [--samples 1e7]``.
 """
@@ -137,9 +138,51 @@ def bare_threads_loop(runs: int, *, seed: int = 6, threads: int = 2) -> RunningS
 
 N_STEPS = 100_000
 
-#: The dynamics batch benchmarked: ``f(runs, options) -> summary``. When issue 6 lands, e.g.
-#: ``lambda runs, o: dte_batch(MODEL, runs, scheduler=o.scheduler, workers=o.workers)``.
-DYNAMICS_BATCH = standin_dynamics_batch  # <- the one line to swap
+
+def rv_dynamics_batch(runs: int, options: RunOptions, *, seed: int = 6) -> np.ndarray:
+    """Issue 6's batch: DTE of the Li et al. (2023) RV prototype over random error realisations;
+    returns the per-run rows (peak-to-peak, rms, mean DTE [arcsec])."""
+    from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED
+    from gearte.models.rv_dynamics import RVDynamicModel, RVDynamicsParameters, RVErrors
+    from gearte.models.rv_dynamics_sim import dte_batch
+
+    params = RVDynamicsParameters(pair=LI2023_PAIR_MODIFIED, cycloid_stiffness="mean")
+    model = RVDynamicModel(params, RVErrors.table3(placement="first"))
+    r = dte_batch(
+        model, runs, seed=seed, chunk_size=4, scheduler=options.scheduler, workers=options.workers
+    )
+    return r["rows"]
+
+
+def _rv_chunk_shared(task: tuple[int, Any], shared: tuple[Any, ...]) -> np.ndarray:
+    from gearte.models.rv_dynamics_sim import _batch_chunk
+
+    model, system, tol, duration, settle, dt = shared
+    n, rng = task
+    return _batch_chunk((model, system, tol, n, rng, duration, settle, dt, {}))
+
+
+def rv_dynamics_batch_shared(runs: int, options: RunOptions, *, seed: int = 6) -> np.ndarray:
+    """The same batch (same chunks, same streams, same rows) with the model and its compiled
+    system sent once per worker through ``map_chunks(shared=...)`` instead of with every chunk
+    (~0.2 MB and ~9 ms of pickling each): what issue 6's ``dte_batch`` gains by adopting it."""
+    from gearte.execution import chunk_sizes, spawn_generators
+    from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED
+    from gearte.models.rv_dynamics import RVDynamicModel, RVDynamicsParameters, RVErrors, ode_system
+    from gearte.models.rv_dynamics_sim import ErrorTolerances, default_step
+
+    params = RVDynamicsParameters(pair=LI2023_PAIR_MODIFIED, cycloid_stiffness="mean")
+    model = RVDynamicModel(params, RVErrors.table3(placement="first"))
+    sizes = chunk_sizes(runs, 4)
+    tasks = list(zip(sizes, spawn_generators(seed, len(sizes)), strict=True))
+    shared = (model, ode_system(model), ErrorTolerances(), 0.5, 0.1, default_step(model))
+    parts = map_chunks(_rv_chunk_shared, tasks, options=options, shared=shared)
+    return np.concatenate(parts)
+
+
+#: The dynamics batch benchmarked: ``f(runs, options) -> summary``; ``standin_dynamics_batch``
+#: runs the stand-in kernel of this file instead.
+DYNAMICS_BATCH = rv_dynamics_batch  # <- the one line to swap
 
 # ----------------------------------------------------------------------------------------------
 # Tolerance study: the real issue-3 Monte-Carlo
@@ -154,9 +197,22 @@ def tolerance_study(samples: int, options: RunOptions) -> Any:
     return monte_carlo(stack, samples, seed=2024, chunk_size=250_000, options=options)
 
 
-def _summary(r: Any) -> tuple[float, ...]:
+def plain_tolerance(samples: int) -> tuple[float, float]:
+    """Baseline: the same stack sampled by numpy in one call (no chunks, no execution layer)."""
+    from gearte.io.case_file import load_case
+
+    stack = load_case("jiang2024_spur_pair").pair.backlash_stack()
+    y = stack.sample(np.random.default_rng(2024), samples)
+    return float(y.mean()), float(y.std(ddof=1))
+
+
+def _summary(r: Any) -> Any:
     if isinstance(r, RunningStats):
         return r.as_tuple()
+    if isinstance(r, np.ndarray):
+        return r.tobytes()
+    if isinstance(r, tuple):
+        return r
     return (r.n, r.mean, r.sd, r.min, r.max)
 
 
@@ -170,7 +226,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--runs", type=int, default=200, help="dynamics runs")
     ap.add_argument("--samples", type=float, default=1e7, help="tolerance samples")
-    ap.add_argument("--repeat", type=int, default=3, help="best of N interleaved timings")
+    ap.add_argument("--repeat", type=int, default=2, help="best of N interleaved timings")
     a = ap.parse_args()
     samples = int(a.samples)
     print(f"cores available: {len(os.sched_getaffinity(0))}; load average {os.getloadavg()[0]:.2f}")
@@ -185,8 +241,14 @@ def main() -> None:
     }
     workloads = {
         f"tolerance MC, {samples:.0e} samples": (tolerance_study, samples, min(samples, 500_000)),
-        f"dynamics batch, {a.runs} runs": (DYNAMICS_BATCH, a.runs, 8),
+        f"dynamics batch, {a.runs} runs ({DYNAMICS_BATCH.__name__})": (DYNAMICS_BATCH, a.runs, 8),
     }
+    if DYNAMICS_BATCH is not standin_dynamics_batch:
+        workloads[f"calibration: stand-in kernel, {a.runs} runs"] = (
+            standin_dynamics_batch,
+            a.runs,
+            8,
+        )
     try:
         for wname, (fn, size, warm) in workloads.items():
             print(f"\n{wname}")
@@ -194,6 +256,12 @@ def main() -> None:
                 b: (lambda fn=fn, ex=ex, n=size: fn(n, RunOptions(scheduler=ex, progress=False)))
                 for b, (ex, _) in backends.items()
             }
+            if fn is rv_dynamics_batch:
+                runs["LocalCluster, model shared"] = lambda n=size: rv_dynamics_batch_shared(
+                    n, RunOptions(scheduler=cluster, progress=False)
+                )
+            if fn is tolerance_study:
+                runs["plain numpy (no gearte)"] = lambda n=size: plain_tolerance(n)
             if fn is standin_dynamics_batch:
                 runs["plain loop (no gearte)"] = lambda n=size: plain_dynamics_loop(n)
                 runs["bare 2 threads (no gearte)"] = lambda n=size: bare_threads_loop(n)
@@ -216,8 +284,24 @@ def main() -> None:
                     f"  {name:27s} {best[name]:7.3f} s   speed-up {speedup:4.2f}   "
                     f"efficiency {speedup / n:4.2f}   result {same}"
                 )
+            if "plain numpy (no gearte)" in best:
+                tp = best["plain numpy (no gearte)"]
+                m, sd = summaries["plain numpy (no gearte)"]
+                print(
+                    f"  {'plain numpy (no gearte)':27s} {tp:7.3f} s   gearte 1 worker / plain = "
+                    f"{t1 / tp:4.2f}; 2 workers / plain = {best['local, 2 workers'] / tp:4.2f}   "
+                    f"(other streams: mean {m * 1e3:.4f} vs {ref[1] * 1e3:.4f} um)"
+                )
             overhead = best["LocalCluster, 2 workers"] - best["local, 2 workers"]
             print(f"  cluster overhead vs local threads: {overhead:+.3f} s per study")
+            if "LocalCluster, model shared" in best:
+                tsh = best["LocalCluster, model shared"]
+                ok = summaries["LocalCluster, model shared"] == ref
+                same = "identical" if ok else "DIFFERENT"
+                print(
+                    f"  {'LocalCluster, model shared':27s} {tsh:7.3f} s   speed-up {t1 / tsh:4.2f}"
+                    f"   efficiency {t1 / tsh / 2:4.2f}   result {same}   (map_chunks(shared=...))"
+                )
             if "plain loop (no gearte)" in best:
                 tp, tb = best["plain loop (no gearte)"], best["bare 2 threads (no gearte)"]
                 same = "identical" if summaries["plain loop (no gearte)"] == ref else "DIFFERENT"

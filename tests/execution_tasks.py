@@ -16,3 +16,14 @@ def crash_once(task):
         Path(marker).write_text("crashed")
         os._exit(1)
     return sample_chunk(chunk)
+
+
+def weighted_chunk(chunk, shared):
+    """Statistics of ``weights[k] * z`` for a shared weight table (``map_chunks(shared=...)``)."""
+    import numpy as np
+
+    from gearte.execution import RunningStats
+
+    weights = shared["weights"]
+    z = chunk.rng().standard_normal(chunk.size)
+    return RunningStats.of(weights[np.arange(chunk.size) % weights.size] * z)

@@ -214,6 +214,28 @@ def test_local_process_that_dies_is_replaced_and_its_chunks_rerun(reference, tmp
     assert stats.as_tuple() == reference.as_tuple()
 
 
+def test_shared_data_is_passed_to_every_chunk_on_every_backend(client):
+    import numpy as np
+
+    from execution_tasks import weighted_chunk
+
+    shared = {"weights": np.linspace(0.5, 2.0, 200_000)}  # 1.6 MB: shipped once per worker
+    chunks = seeded_chunks(60_000, 5_000, 3)
+    runs = [
+        map_chunks(
+            weighted_chunk, chunks, shared=shared, reduce=RunningStats.merge, progress=False, **kw
+        ).as_tuple()
+        for kw in (
+            {"workers": 1},
+            {"workers": 2},
+            {"scheduler": "processes", "workers": 2},
+            {"scheduler": client},
+        )
+    ]
+    assert all(r == runs[0] for r in runs)
+    assert runs[0][0] == 60_000
+
+
 def test_client_passed_in_stays_open_and_internal_ones_are_closed(client):
     r = check_backend(client, samples=20_000, chunk_size=5_000)
     assert r["identical"] and r["backend"] == "dask"

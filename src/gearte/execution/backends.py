@@ -60,8 +60,12 @@ class ChunkExecutor:
     name = "base"
     workers = 1
 
-    def batch(self) -> Batch:
-        """A new set of chunks to submit and collect (one per :func:`map_chunks` call)."""
+    def batch(self, shared: Any = None, *, has_shared: bool = False) -> Batch:
+        """A new set of chunks to submit and collect (one per :func:`map_chunks` call).
+
+        With ``has_shared``, every chunk runs as ``func(task, shared)``; ``shared`` is shipped
+        to each worker once (Dask: scattered and broadcast), not with every task.
+        """
         raise NotImplementedError
 
     def close(self) -> None:
@@ -80,8 +84,9 @@ class ChunkExecutor:
 class Batch:
     """Chunks of one :func:`map_chunks` call in flight on an executor."""
 
-    def __init__(self) -> None:
+    def __init__(self, extra: tuple[Any, ...] = ()) -> None:
         self.pending: dict[Any, int] = {}
+        self.extra = extra  # further positional arguments of every call: (shared,) or ()
 
     def __len__(self) -> int:
         return len(self.pending)
@@ -105,7 +110,7 @@ class Batch:
 class _SequentialBatch(Batch):
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
         self.pending[object()] = index
-        self._result = func(task)
+        self._result = func(task, *self.extra)
 
     def next_done(self) -> list[tuple[int, Any]]:
         (index,) = self.pending.values()
@@ -119,18 +124,18 @@ class SequentialExecutor(ChunkExecutor):
     name = "sequential"
     workers = 1
 
-    def batch(self) -> Batch:
-        return _SequentialBatch()
+    def batch(self, shared: Any = None, *, has_shared: bool = False) -> Batch:
+        return _SequentialBatch((shared,) if has_shared else ())
 
 
 class _PoolBatch(Batch):
-    def __init__(self, executor: PoolExecutor) -> None:
-        super().__init__()
+    def __init__(self, executor: PoolExecutor, extra: tuple[Any, ...]) -> None:
+        super().__init__(extra)
         self._ex = executor
         self._jobs: dict[Any, tuple[Callable[[Any], Any], Any, int]] = {}
 
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
-        fut = self._ex._pool.submit(func, task)
+        fut = self._ex._pool.submit(func, task, *self.extra)
         self.pending[fut] = index
         self._jobs[fut] = (func, task, self._ex._generation)
 
@@ -215,8 +220,8 @@ class PoolExecutor(ChunkExecutor):
             self._pool = self._new_pool()
             self._generation += 1
 
-    def batch(self) -> Batch:
-        return _PoolBatch(self)
+    def batch(self, shared: Any = None, *, has_shared: bool = False) -> Batch:
+        return _PoolBatch(self, (shared,) if has_shared else ())
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)
@@ -423,8 +428,11 @@ class DaskExecutor(ChunkExecutor):
                 f"({gearte.__version__}): {listed}; install the same version everywhere"
             )
 
-    def batch(self) -> Batch:
-        return _DaskBatch(self)
+    def batch(self, shared: Any = None, *, has_shared: bool = False) -> Batch:
+        extra: tuple[Any, ...] = ()
+        if has_shared:  # shipped once to every worker, not with each of the tasks
+            extra = (self.client.scatter(shared, broadcast=True, hash=False),)
+        return _DaskBatch(self, extra)
 
     def close(self) -> None:
         for obj in getattr(self, "_owned", []):
@@ -437,15 +445,15 @@ class DaskExecutor(ChunkExecutor):
 
 
 class _DaskBatch(Batch):
-    def __init__(self, executor: DaskExecutor) -> None:
-        super().__init__()
+    def __init__(self, executor: DaskExecutor, extra: tuple[Any, ...]) -> None:
+        super().__init__(extra)
         self._ex = executor
         self._ac: Any = None
 
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
         ex = self._ex
         key = f"gearte-{label}-{ex._token}-{index}"
-        fut = ex.client.submit(func, task, key=key, retries=ex.retries, pure=False)
+        fut = ex.client.submit(func, task, *self.extra, key=key, retries=ex.retries, pure=False)
         self.pending[fut] = index
         if self._ac is None:
             self._ac = _import_distributed().as_completed([fut], loop=ex.client.loop)

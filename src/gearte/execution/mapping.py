@@ -33,6 +33,7 @@ def map_chunks(
     on_result: Callable[[int, R], None] | None = None,
     options: Any = None,
     max_in_flight: int | None = None,
+    shared: Any = _NOTHING,
 ) -> Any:
     """Run ``func(task)`` for every task; hand the results back in task order.
 
@@ -72,6 +73,10 @@ def map_chunks(
     max_in_flight : int, optional
         Chunks submitted ahead of the first unfinished one; bounds the results held while waiting
         for a slow early chunk. Default ``4 × workers`` when reducing, unbounded otherwise.
+    shared : any, optional
+        Data every chunk needs (a model, a compiled system, tables): each chunk then runs as
+        ``func(task, shared)``. On Dask it is sent to every worker once (scattered, broadcast)
+        instead of with each task; locally it is passed as is.
 
     Returns
     -------
@@ -110,7 +115,10 @@ def map_chunks(
                 return max_in_flight
             return None if keep else 4 * max(1, executor.workers)  # follows adaptive clusters
 
-        batch = executor.batch()
+        if shared is _NOTHING:
+            batch = executor.batch()
+        else:
+            batch = executor.batch(shared, has_shared=True)
         buffer: dict[int, Any] = {}
         frontier = 0  # index of the next result to hand back
         submitted = 0
