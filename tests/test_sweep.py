@@ -118,10 +118,16 @@ def test_sweep_results_identical_on_every_backend_and_common_random_numbers():
     for kw in ({"workers": 2}, {"scheduler": "local-cluster", "workers": 2}):
         other = _mc_sweep(**kw)
         assert other.values == ref.values, kw
-    # fewer points than workers: the points run one after another, samples in parallel
-    one = run_sweep(MC, {"mc.sigma_mm": "2"}, seed=11, workers=2, progress=False)
-    assert "samples in parallel" in one.backend
-    assert one.values[0] == ref.values[2]
+    # fewer points than workers: the points run one after another, samples in parallel; an
+    # executor passed in is left open for its owner
+    from gearte.execution import open_executor
+
+    with open_executor("threads", 2) as ex:
+        one = run_sweep(MC, {"mc.sigma_mm": "2"}, seed=11, scheduler=ex, progress=False)
+        assert "samples in parallel" in one.backend
+        assert one.values[0] == ref.values[2]
+        again = run_sweep(MC, {"mc.sigma_mm": "2"}, seed=11, scheduler=ex, progress=False)
+        assert again.values == one.values
     # same seed at every point: sd scales exactly with sigma, mean shifts with the offset
     sd = dict(
         zip(

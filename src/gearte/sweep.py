@@ -420,7 +420,7 @@ def run_sweep(
     CaseFileError
         A point does not validate: the message names the field, the value and the point.
     """
-    from gearte.execution import map_chunks, open_executor
+    from gearte.execution import executor_scope, map_chunks
     from gearte.io.case_file import load_case_dict
     from gearte.studies import get_kind
 
@@ -451,7 +451,7 @@ def run_sweep(
     title = str(validated.case.title)
 
     t0 = time.perf_counter()
-    with open_executor(scheduler, workers) as ex:
+    with executor_scope(scheduler, workers) as ex:
         by_points = len(points) >= ex.workers or ex.workers == 1
         inner = {"progress": False, "seed": seed, "samples": samples}
         if by_points:

@@ -36,6 +36,7 @@ from gearte.execution.backends import (
     DaskExecutor,
     PoolExecutor,
     SequentialExecutor,
+    executor_scope,
     open_executor,
 )
 from gearte.execution.mapping import map_chunks
@@ -59,6 +60,7 @@ __all__ = [
     "RunningStats",
     "default_workers",
     "open_executor",
+    "executor_scope",
     "ChunkExecutor",
     "SequentialExecutor",
     "PoolExecutor",

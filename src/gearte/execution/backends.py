@@ -19,7 +19,7 @@ import socket
 import threading
 import time
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 from urllib.parse import urlsplit
 
@@ -33,6 +33,7 @@ __all__ = [
     "PoolExecutor",
     "DaskExecutor",
     "open_executor",
+    "executor_scope",
     "LOCAL_SCHEDULERS",
     "CONNECT_TIMEOUT_S",
 ]
@@ -538,3 +539,17 @@ def open_executor(
             raise ParameterError("scheduler", scheduler, "empty scheduler address")
         scheduler = s
     return DaskExecutor(scheduler, workers, retries=retries, connect_timeout_s=connect_timeout_s)
+
+
+@contextlib.contextmanager
+def executor_scope(
+    scheduler: Any = None, workers: int | None = None, **kwargs: Any
+) -> Iterator[ChunkExecutor]:
+    """``with executor_scope(scheduler, workers) as ex:`` — :func:`open_executor`, closed at the
+    end only if it was opened here (an executor passed in stays open for its owner)."""
+    ex = open_executor(scheduler, workers, **kwargs)
+    try:
+        yield ex
+    finally:
+        if ex is not scheduler:
+            ex.close()

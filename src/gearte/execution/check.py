@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from gearte.execution.backends import open_executor
+from gearte.execution.backends import executor_scope
 from gearte.execution.mapping import map_chunks
 from gearte.execution.stats import RunningStats
 from gearte.execution.streams import Chunk, seeded_chunks
@@ -67,7 +67,7 @@ def check_backend(
     local = map_chunks(
         func, chunks, scheduler="sequential", reduce=RunningStats.merge, progress=False
     )
-    with open_executor(scheduler, workers) as ex:
+    with executor_scope(scheduler, workers) as ex:
         t0 = time.perf_counter()
         remote = map_chunks(
             func, chunks, scheduler=ex, reduce=RunningStats.merge, description="check"
