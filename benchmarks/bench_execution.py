@@ -154,32 +154,6 @@ def rv_dynamics_batch(runs: int, options: RunOptions, *, seed: int = 6) -> np.nd
     return r["rows"]
 
 
-def _rv_chunk_shared(task: tuple[int, Any], shared: tuple[Any, ...]) -> np.ndarray:
-    from gearte.models.rv_dynamics_sim import _batch_chunk
-
-    model, system, tol, duration, settle, dt = shared
-    n, rng = task
-    return _batch_chunk((model, system, tol, n, rng, duration, settle, dt, {}))
-
-
-def rv_dynamics_batch_shared(runs: int, options: RunOptions, *, seed: int = 6) -> np.ndarray:
-    """The same batch (same chunks, same streams, same rows) with the model and its compiled
-    system sent once per worker through ``map_chunks(shared=...)`` instead of with every chunk
-    (~0.2 MB and ~9 ms of pickling each): what issue 6's ``dte_batch`` gains by adopting it."""
-    from gearte.execution import chunk_sizes, spawn_generators
-    from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED
-    from gearte.models.rv_dynamics import RVDynamicModel, RVDynamicsParameters, RVErrors, ode_system
-    from gearte.models.rv_dynamics_sim import ErrorTolerances, default_step
-
-    params = RVDynamicsParameters(pair=LI2023_PAIR_MODIFIED, cycloid_stiffness="mean")
-    model = RVDynamicModel(params, RVErrors.table3(placement="first"))
-    sizes = chunk_sizes(runs, 4)
-    tasks = list(zip(sizes, spawn_generators(seed, len(sizes)), strict=True))
-    shared = (model, ode_system(model), ErrorTolerances(), 0.5, 0.1, default_step(model))
-    parts = map_chunks(_rv_chunk_shared, tasks, options=options, shared=shared)
-    return np.concatenate(parts)
-
-
 #: The dynamics batch benchmarked: ``f(runs, options) -> summary``; ``standin_dynamics_batch``
 #: runs the stand-in kernel of this file instead.
 DYNAMICS_BATCH = rv_dynamics_batch  # <- the one line to swap
@@ -256,10 +230,6 @@ def main() -> None:
                 b: (lambda fn=fn, ex=ex, n=size: fn(n, RunOptions(scheduler=ex, progress=False)))
                 for b, (ex, _) in backends.items()
             }
-            if fn is rv_dynamics_batch:
-                runs["LocalCluster, model shared"] = lambda n=size: rv_dynamics_batch_shared(
-                    n, RunOptions(scheduler=cluster, progress=False)
-                )
             if fn is tolerance_study:
                 runs["plain numpy (no gearte)"] = lambda n=size: plain_tolerance(n)
             if fn is standin_dynamics_batch:
@@ -294,14 +264,6 @@ def main() -> None:
                 )
             overhead = best["LocalCluster, 2 workers"] - best["local, 2 workers"]
             print(f"  cluster overhead vs local threads: {overhead:+.3f} s per study")
-            if "LocalCluster, model shared" in best:
-                tsh = best["LocalCluster, model shared"]
-                ok = summaries["LocalCluster, model shared"] == ref
-                same = "identical" if ok else "DIFFERENT"
-                print(
-                    f"  {'LocalCluster, model shared':27s} {tsh:7.3f} s   speed-up {t1 / tsh:4.2f}"
-                    f"   efficiency {t1 / tsh / 2:4.2f}   result {same}   (map_chunks(shared=...))"
-                )
             if "plain loop (no gearte)" in best:
                 tp, tb = best["plain loop (no gearte)"], best["bare 2 threads (no gearte)"]
                 same = "identical" if summaries["plain loop (no gearte)"] == ref else "DIFFERENT"

@@ -217,9 +217,14 @@ def draw_errors(
     )
 
 
-def _batch_chunk(task) -> np.ndarray:
-    """Run one chunk of realisations; returns rows (p2p [arcsec], rms [arcsec], mean [arcsec])."""
-    model, system, tol, n, rng, duration, settle, dt, clearances = task
+def _batch_chunk(task, shared) -> np.ndarray:
+    """Run one chunk of realisations; returns rows (p2p [arcsec], rms [arcsec], mean [arcsec]).
+
+    ``task`` is ``(n, rng)``; ``shared`` holds what every chunk needs (model, compiled system,
+    tolerances, spans, step, clearances), sent once per Dask worker rather than with each chunk.
+    """
+    n, rng = task
+    model, system, tol, duration, settle, dt, clearances = shared
     out = np.empty((n, 3))
     for k in range(n):
         err = draw_errors(rng, tol, model.params.crank_count, model.params.disc_count, **clearances)
@@ -276,10 +281,8 @@ def dte_batch(
     gens = spawn_generators(seed, len(sizes))
     cl = clearances or {}
     system = ode_system(model)  # one system (and stability limit) shared by every chunk
-    tasks = [
-        (model, system, tol, n, g, duration_s, settle_s, dt, cl)
-        for n, g in zip(sizes, gens, strict=True)
-    ]
+    tasks = list(zip(sizes, gens, strict=True))
+    shared = (model, system, tol, duration_s, settle_s, dt, cl)
 
     t0 = time.perf_counter()
     rows = np.concatenate(
@@ -290,6 +293,7 @@ def dte_batch(
             scheduler=scheduler,
             progress=progress,
             description="DTE realisations",
+            shared=shared,
         )
     )
     wall = time.perf_counter() - t0

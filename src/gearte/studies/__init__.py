@@ -32,8 +32,11 @@ class RunOptions:
         Overrides the case's random seed.
     samples : int, optional
         Overrides Monte-Carlo sample counts.
-    scheduler : str or distributed.Client, optional
-        Dask scheduler address (``tcp://host:8786``) or client; ``None`` runs locally.
+    scheduler : str, distributed.Client or executor, optional
+        Where sampled work runs: ``None`` or ``"threads"`` (local cores, the default),
+        ``"sequential"``, ``"processes"``, ``"local-cluster"``, a Dask scheduler address
+        (``tcp://host:8786``), a ``distributed.Client``, or an executor from
+        :func:`gearte.execution.open_executor`. Results are identical for a seed on every one.
     workers : int, optional
         Local worker threads; default: the machine's cores.
     """
