@@ -77,21 +77,23 @@ def _dte_figures(a) -> list[Figure]:
     freq, spec, peaks = a.data["freq"], a.data["spec"], a.data["peaks"]
     fig, ax = new_figure(figsize=(8.0, 3.6))
     ax.semilogy(freq[1:], np.maximum(spec[1:], 1e-6), lw=0.8, color=PALETTE[0])
-    for k, pk in enumerate(peaks[:8]):
+    # label the largest peaks; neighbours in frequency get staggered heights so labels don't overlap
+    for k, pk in enumerate(sorted(peaks[:8], key=lambda p: p["frequency [Hz]"])):
         f, amp = pk["frequency [Hz]"], pk["amplitude [arcsec]"]
         ax.annotate(
             f"{pk['source']}\n{f:.1f} Hz",
             (f, amp),
-            xytext=(5, 5 + 12 * (k % 3)),
+            xytext=(6, 8 + 24 * (k % 3)),
             textcoords="offset points",
             fontsize=7,
             color=PALETTE[1],
+            arrowprops={"arrowstyle": "-", "color": PALETTE[1], "lw": 0.5},
         )
         ax.plot([f], [amp], "o", ms=3, color=PALETTE[1])
     ax.set_xlim(0, max(2.5 * max(a.data["sources"]["cycloid mesh"], 1.0), 10.0))
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("amplitude [arcsec] (log)")
-    ax.set_ylim(max(1e-6, 1e-4 * spec[1:].max()), 3 * spec[1:].max())
+    ax.set_ylim(max(1e-6, 1e-4 * spec[1:].max()), 30 * spec[1:].max())
     ax.grid(alpha=0.3)
     out.append(
         Figure(
