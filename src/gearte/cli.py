@@ -91,6 +91,29 @@ def _executor(scheduler: str | None, workers: int | None) -> Iterator[Any]:
         yield ex
 
 
+def _execution_options(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """The options of every command that runs sampled work: --samples, --workers, --scheduler."""
+    fn = click.option(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="Run sampled work on a Dask cluster, e.g. tcp://host:8786 (or a local backend: "
+        "threads, processes, local-cluster). See docs/cluster.md.",
+    )(fn)
+    fn = click.option(
+        "--workers",
+        type=click.IntRange(min=1),
+        default=None,
+        help="Local worker threads (default: all cores).",
+    )(fn)
+    return click.option(
+        "--samples",
+        type=click.IntRange(min=1),
+        default=None,
+        help="Override Monte-Carlo sample counts.",
+    )(fn)
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="gearte", message="gearte %(version)s")
 def main() -> None:
@@ -111,25 +134,7 @@ def main() -> None:
     help="Output folder (default: out/<case name>).",
 )
 @click.option("--seed", type=int, default=None, help="Override the case's random seed.")
-@click.option(
-    "--samples",
-    type=click.IntRange(min=1),
-    default=None,
-    help="Override Monte-Carlo sample counts.",
-)
-@click.option(
-    "--workers",
-    type=click.IntRange(min=1),
-    default=None,
-    help="Local worker threads (default: all cores).",
-)
-@click.option(
-    "--scheduler",
-    default=None,
-    metavar="ADDRESS",
-    help="Run sampled work on a Dask cluster, e.g. tcp://host:8786 (or a local backend: "
-    "threads, processes, local-cluster). See docs/cluster.md.",
-)
+@_execution_options
 @click.option("--no-report", is_flag=True, help="Write results.json only.")
 @click.option("--no-progress", is_flag=True, help="Hide progress bars.")
 @click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
@@ -191,25 +196,7 @@ def run(
     help="Output folder (default: out/sweep_<case name>).",
 )
 @click.option("--seed", type=int, default=None, help="Override the case's seed (all points).")
-@click.option(
-    "--samples",
-    type=click.IntRange(min=1),
-    default=None,
-    help="Override Monte-Carlo sample counts.",
-)
-@click.option(
-    "--workers",
-    type=click.IntRange(min=1),
-    default=None,
-    help="Local worker threads (default: all cores).",
-)
-@click.option(
-    "--scheduler",
-    default=None,
-    metavar="ADDRESS",
-    help="Run the points on a Dask cluster, e.g. tcp://host:8786 (or a local backend: "
-    "threads, processes, local-cluster).",
-)
+@_execution_options
 @click.option("--no-plots", is_flag=True, help="Write the table only.")
 @click.option("--no-progress", is_flag=True, help="Hide the progress bar.")
 @click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
