@@ -43,6 +43,16 @@ from numba import njit
 
 from gearte.errors import ParameterError
 from gearte.geometry.planetary import PlanetarySet
+from gearte.solvers.trig_extremes import (
+    SINCOS_MAX_ARG,
+    _sincos_into,
+    exact_extremes,
+    exact_extremes_numpy,
+    extremes_kernel,
+    grid_extremes_numpy,
+    grid_points,
+    node_tables,
+)
 
 __all__ = [
     "ErrorTerm",
@@ -363,427 +373,6 @@ def group_phasors(
     return c, Z
 
 
-# --------------------------------------------------------------------------- exact extremes
-def _grid_points(harmonics: Sequence[int]) -> int:
-    """Grid size of the dense stage: 8 points per period of the highest harmonic (>= 16; always
-    a multiple of 4, which :func:`_argmax_argmin` relies on)."""
-    return max(16, 8 * int(max(harmonics)) if len(harmonics) else 16)
-
-
-@njit(cache=True, nogil=True)
-def _f_d1_d2(u, c, zr, zi, nh):
-    f = c
-    d1 = 0.0
-    d2 = 0.0
-    for g in range(nh.shape[0]):
-        n = nh[g]
-        s = math.sin(n * u)
-        co = math.cos(n * u)
-        v = zr[g] * s + zi[g] * co
-        f += v
-        d1 += n * (zr[g] * co - zi[g] * s)
-        d2 -= n * n * v
-    return f, d1, d2
-
-
-@njit(cache=True, nogil=True)
-def _f_d123(u, c, zr, zi, nh):
-    """f and its first three derivatives at u.
-
-    One sine/cosine of u; e^{i n_g u} for the sorted harmonics by complex multiplication
-    (w^{n_g} = w^{n_{g-1}} w^{n_g - n_{g-1}}, binary powering), relative error ~ 1e-15.
-    """
-    cu = math.cos(u)
-    su = math.sin(u)
-    pr = 1.0  # running power w^{n_{g-1}}
-    pi_ = 0.0
-    last = 0
-    f = c
-    d1 = 0.0
-    d2 = 0.0
-    d3 = 0.0
-    for g in range(nh.shape[0]):
-        n = nh[g]
-        k = n - last
-        last = n
-        # w^k by binary powering
-        br = cu
-        bi = su
-        qr = 1.0
-        qi = 0.0
-        while k > 0:
-            if k & 1:
-                t = qr * br - qi * bi
-                qi = qr * bi + qi * br
-                qr = t
-            k >>= 1
-            if k:
-                t = br * br - bi * bi
-                bi = 2.0 * br * bi
-                br = t
-        t = pr * qr - pi_ * qi
-        pi_ = pr * qi + pi_ * qr
-        pr = t
-        co = pr
-        s_ = pi_
-        v = zr[g] * s_ + zi[g] * co
-        w = n * (zr[g] * co - zi[g] * s_)
-        f += v
-        d1 += w
-        d2 -= n * n * v
-        d3 -= n * n * w
-    return f, d1, d2, d3
-
-
-@njit(cache=True, nogil=True)
-def _golden(u0, lo, hi, sgn, c, zr, zi, nh):
-    """Golden-section search for a local maximum of sgn*f on [lo, hi] (fallback, rarely used)."""
-    gr = 0.6180339887498949
-    a = lo
-    b = hi
-    x1 = b - gr * (b - a)
-    x2 = a + gr * (b - a)
-    f1 = sgn * _f_d1_d2(x1, c, zr, zi, nh)[0]
-    f2 = sgn * _f_d1_d2(x2, c, zr, zi, nh)[0]
-    for _ in range(200):
-        if b - a <= 1e-12:
-            break
-        if f1 < f2:
-            a = x1
-            x1 = x2
-            f1 = f2
-            x2 = a + gr * (b - a)
-            f2 = sgn * _f_d1_d2(x2, c, zr, zi, nh)[0]
-        else:
-            b = x2
-            x2 = x1
-            f2 = f1
-            x1 = b - gr * (b - a)
-            f1 = sgn * _f_d1_d2(x1, c, zr, zi, nh)[0]
-    best = max(f1, f2)
-    fu = sgn * _f_d1_d2(u0, c, zr, zi, nh)[0]
-    return max(best, fu)
-
-
-@njit(cache=True, nogil=True)
-def _refine(u0, du, lo, hi, sgn, c, zr, zi, nh, stol):
-    """Local maximum of sgn*f in [lo, hi], Halley iteration on f' from u0 + du.
-
-    ``du`` is the parabolic-interpolation guess from the grid. Stops when the step is below
-    ``stol`` and returns the third-order Taylor value at the stepped point, whose error is below
-    Σ|Z| n⁴ stol⁴ / 24; the caller sets stol so that this is 1e-13 Σ|Z| (1e-13 relative to the
-    largest possible |f|). Falls back to golden-section search if the iteration leaves
-    [lo, hi] or meets f'' of the wrong sign.
-    """
-    u = u0 + du
-    for _ in range(30):
-        f, d1, d2, d3 = _f_d123(u, c, zr, zi, nh)
-        d1 *= sgn
-        d2 *= sgn
-        d3 *= sgn
-        if d2 >= 0.0:
-            break
-        den = 2.0 * d2 * d2 - d1 * d3
-        step = -2.0 * d1 * d2 / den if den > 0.0 else -d1 / d2  # Halley, else Newton
-        if abs(step) <= stol:
-            return sgn * f + step * (d1 + step * (0.5 * d2 + step * d3 / 6.0))
-        u = u + step
-        if u < lo or u > hi:
-            break
-    return _golden(u0, lo, hi, sgn, c, zr, zi, nh)
-
-
-@njit(cache=True, nogil=True)
-def _nb(buf, j, sgn):
-    """sgn * (previous, this, next node value), periodic; no integer modulo (slow)."""
-    M = buf.shape[0]
-    jp = j - 1 if j > 0 else M - 1
-    jn = j + 1 if j < M - 1 else 0
-    return sgn * buf[jp], sgn * buf[j], sgn * buf[jn]
-
-
-@njit(cache=True, nogil=True)
-def _parabolic(buf, j, sgn, h):
-    """Offset of the vertex of the parabola through the nodes j-1, j, j+1 [rad]."""
-    vp, v, vn = _nb(buf, j, sgn)
-    den = vp - 2.0 * v + vn
-    return 0.5 * h * (vp - vn) / den if den < 0.0 else 0.0
-
-
-@njit(cache=True, nogil=True)
-def _refine_node(buf, j, sgn, h, c, zr, zi, nh, stol):
-    return _refine(
-        j * h, _parabolic(buf, j, sgn, h), (j - 1) * h, (j + 1) * h, sgn, c, zr, zi, nh, stol
-    )
-
-
-@njit(cache=True, nogil=True)
-def _best_extremum(buf, j0, sgn, h, bound, c, zr, zi, nh, stol):
-    """Global max of sgn*f over the period.
-
-    The best node j0 is refined first (value B). A true maximum elsewhere can exceed its nearest
-    node by at most ``bound``, so only nodes above B - bound can lead to a higher one: the run of
-    such nodes around j0 is searched for further discrete peaks, and the remaining nodes are
-    scanned (almost always all below: a predictable branch); every peak found is refined too.
-    """
-    M = buf.shape[0]
-    best = _refine_node(buf, j0, sgn, h, c, zr, zi, nh, stol)
-    thr = best - bound
-    # the run of nodes above thr around j0: offsets -lo < k < hi
-    lo = 1
-    j = j0 - 1 if j0 > 0 else M - 1
-    while lo < M and sgn * buf[j] > thr:
-        lo += 1
-        j = j - 1 if j > 0 else M - 1
-    hi = 1
-    j = j0 + 1 if j0 < M - 1 else 0
-    while hi < M - lo + 1 and sgn * buf[j] > thr:
-        hi += 1
-        j = j + 1 if j < M - 1 else 0
-    j = j0 - lo + 1
-    if j < 0:
-        j += M
-    for _k in range(lo + hi - 1):  # inside the run: any other discrete peak
-        if j != j0:
-            vp, v, vn = _nb(buf, j, sgn)
-            if v >= vp and v >= vn:
-                r = _refine_node(buf, j, sgn, h, c, zr, zi, nh, stol)
-                if r > best:
-                    best = r
-        j = j + 1 if j < M - 1 else 0
-    above = 0
-    for k in range(M):  # branchless count of nodes above thr (vectorised)
-        above += sgn * buf[k] > thr
-    if above <= lo + hi - 1:  # all of them in the run: nothing outside can win
-        return sgn * best
-    for _k in range(M - lo - hi + 1):  # outside the run: j continues after its right end
-        if sgn * buf[j] > thr:
-            vp, v, vn = _nb(buf, j, sgn)
-            if v >= vp and v >= vn:
-                r = _refine_node(buf, j, sgn, h, c, zr, zi, nh, stol)
-                if r > best:
-                    best = r
-        j = j + 1 if j < M - 1 else 0
-    return sgn * best
-
-
-@njit(cache=True, nogil=True)
-def _argmax_argmin(buf):
-    """Indices of the largest and smallest node; four independent lanes with selects (no
-    data-dependent branches), ~2x faster than the plain loop. len(buf) is a multiple of 4."""
-    M = buf.shape[0]
-    a0 = a1 = a2 = a3 = -np.inf
-    b0 = b1 = b2 = b3 = np.inf
-    i0 = i1 = i2 = i3 = 0
-    k0 = k1 = k2 = k3 = 0
-    for j in range(0, M, 4):
-        v = buf[j]
-        t = v > a0
-        a0 = v if t else a0
-        i0 = j if t else i0
-        t = v < b0
-        b0 = v if t else b0
-        k0 = j if t else k0
-        v = buf[j + 1]
-        t = v > a1
-        a1 = v if t else a1
-        i1 = j + 1 if t else i1
-        t = v < b1
-        b1 = v if t else b1
-        k1 = j + 1 if t else k1
-        v = buf[j + 2]
-        t = v > a2
-        a2 = v if t else a2
-        i2 = j + 2 if t else i2
-        t = v < b2
-        b2 = v if t else b2
-        k2 = j + 2 if t else k2
-        v = buf[j + 3]
-        t = v > a3
-        a3 = v if t else a3
-        i3 = j + 3 if t else i3
-        t = v < b3
-        b3 = v if t else b3
-        k3 = j + 3 if t else k3
-    if a1 > a0:
-        a0 = a1
-        i0 = i1
-    if a3 > a2:
-        a2 = a3
-        i2 = i3
-    if a2 > a0:
-        i0 = i2
-    if b1 < b0:
-        b0 = b1
-        k0 = k1
-    if b3 < b2:
-        b2 = b3
-        k2 = k3
-    if b2 < b0:
-        k0 = k2
-    return i0, k0
-
-
-@njit(cache=True, nogil=True)
-def _extremes_one(c, zr, zi, nh, stab, ctab, buf, h, curv):
-    """max f and min f over one period, exact (dense grid, pruning bound, Newton refinement)."""
-    M = buf.shape[0]
-    G = nh.shape[0]
-    for j in range(M):
-        buf[j] = c
-    for g in range(G):  # contiguous inner loop: vectorised
-        a = zr[g]
-        b = zi[g]
-        for j in range(M):
-            buf[j] += a * stab[g, j] + b * ctab[g, j]
-    jmax, jmin = _argmax_argmin(buf)
-    # the most a true extremum can exceed its nearest node (f' = 0 there): h²/8 max|f''|
-    bound = 0.0
-    s1 = 0.0
-    s4 = 0.0
-    for g in range(G):
-        a = math.sqrt(zr[g] * zr[g] + zi[g] * zi[g])
-        n2 = nh[g] * nh[g]
-        bound += a * n2
-        s1 += a
-        s4 += a * n2 * n2
-    bound *= curv
-    # Taylor-stop step: Σ|Z| n⁴ stol⁴ / 24 <= 1e-13 Σ|Z|, and never above 1e-3 rad
-    stol = min(1e-3, (2.4e-12 * s1 / s4) ** 0.25) if s4 > 0.0 else 1e-3
-    best_max = _best_extremum(buf, jmax, 1.0, h, bound, c, zr, zi, nh, stol)
-    best_min = _best_extremum(buf, jmin, -1.0, h, bound, c, zr, zi, nh, stol)
-    return best_max, best_min
-
-
-@njit(cache=True, nogil=True)
-def _tables(nh, M):
-    G = nh.shape[0]
-    stab = np.empty((G, M))
-    ctab = np.empty((G, M))
-    h = 2.0 * math.pi / M
-    for g in range(G):
-        for j in range(M):
-            stab[g, j] = math.sin(nh[g] * j * h)
-            ctab[g, j] = math.cos(nh[g] * j * h)
-    return stab, ctab, h
-
-
-@njit(cache=True, nogil=True)
-def _extremes_batch(c, zr, zi, nh, M):
-    n = c.shape[0]
-    stab, ctab, h = _tables(nh, M)
-    buf = np.empty(M)
-    curv = h * h / 8.0
-    fmax = np.empty(n)
-    fmin = np.empty(n)
-    for i in range(n):
-        fmax[i], fmin[i] = _extremes_one(c[i], zr[i], zi[i], nh, stab, ctab, buf, h, curv)
-    return fmax, fmin
-
-
-def exact_extremes(
-    c: np.ndarray, Z: np.ndarray, harmonics: Sequence[int]
-) -> tuple[np.ndarray, np.ndarray]:
-    """Exact max and min over one common period of ``f(u) = c + Σ_g Im(Z_g e^{i n_g u})``.
-
-    Parameters
-    ----------
-    c : ndarray, shape (n,)
-        Constant part [mm].
-    Z : ndarray of complex, shape (n, G)
-        Phasors per harmonic [mm].
-    harmonics : sequence of int
-        Harmonic numbers n_g (>= 1).
-
-    Returns
-    -------
-    fmax, fmin : ndarray, shape (n,)
-        [mm]. The coupled-TE *amplitude* is ``max(fmax, -fmin)`` (= max |Σe(t)|, Wang 2013's
-        amplitude of the coupled error) and the peak-to-peak ``fmax - fmin``.
-
-    Notes
-    -----
-    Dense stage on ``M = 8 n_max`` nodes (h = 2 pi / M). The best node is refined by Halley
-    iteration on f' (parabolic start; stop when the step is below a tolerance chosen so that the
-    third-order Taylor value is within 1e-13 Σ|Z| of f there). A true maximum can exceed its
-    nearest node by at most ``h²/8 Σ|Z_g| n_g²`` (f' = 0 there), so every other discrete peak
-    whose node lies within that bound of the refined value is refined too (golden-section
-    fallback if an iteration leaves its bracket). This is exact (to ~1e-13 relative) provided two
-    local maxima of f are never closer than two nodes (a quarter period of the highest harmonic);
-    measured against a 2^15-point grid refined from every local extremum: < 1e-13 relative.
-    Compiled with numba; :func:`exact_extremes_numpy` is the plain twin.
-    """
-    nh = np.ascontiguousarray(np.asarray(harmonics, dtype=np.int64))
-    c = np.ascontiguousarray(np.atleast_1d(np.asarray(c, dtype=float)))
-    Z = np.atleast_2d(np.asarray(Z, dtype=complex))
-    if nh.size == 0:
-        return c.copy(), c.copy()
-    if np.any(nh < 1):
-        raise ParameterError("harmonics", harmonics, "must be integers >= 1")
-    M = _grid_points(nh)
-    return _extremes_batch(c, np.ascontiguousarray(Z.real), np.ascontiguousarray(Z.imag), nh, M)
-
-
-def exact_extremes_numpy(
-    c: np.ndarray,
-    Z: np.ndarray,
-    harmonics: Sequence[int],
-    iterations: int = 30,
-    points: int | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Plain-numpy twin of :func:`exact_extremes`: grid of ``points`` (default 8 n_max) nodes,
-    Newton from *every* discrete local extremum (no pruning), vectorised; used to test the
-    compiled kernel and, with a fine grid, as the reference of the benchmark."""
-    nh = np.asarray(harmonics, dtype=np.int64)
-    c = np.atleast_1d(np.asarray(c, dtype=float))
-    Z = np.atleast_2d(np.asarray(Z, dtype=complex))
-    if nh.size == 0:
-        return c.copy(), c.copy()
-    M = _grid_points(nh) if points is None else int(points)
-    h = 2 * np.pi / M
-    u = np.arange(M) * h
-
-    def fd(rows: np.ndarray, uu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        e = np.exp(1j * nh * uu[..., None]) * Z[rows]
-        f = c[rows] + e.imag.sum(-1)
-        d1 = (nh * e.real).sum(-1)
-        d2 = -(nh**2 * e.imag).sum(-1)
-        return f, d1, d2
-
-    f = c[:, None] + (Z.real @ np.sin(np.outer(nh, u)) + Z.imag @ np.cos(np.outer(nh, u)))
-    out = []
-    for sgn in (1.0, -1.0):
-        g = sgn * f
-        is_ext = (g >= np.roll(g, 1, axis=1)) & (g >= np.roll(g, -1, axis=1))
-        rows, cols = np.nonzero(is_ext)  # Newton from every discrete local extremum
-        u0 = u[cols]
-        uu = u0.copy()
-        for _ in range(iterations):
-            _, d1, d2 = fd(rows, uu)
-            step = np.where(sgn * d2 < 0, -d1 / np.where(d2 == 0, 1.0, d2), 0.0)
-            uu = np.clip(uu + step, u0 - h, u0 + h)
-        fr, _, _ = fd(rows, uu)
-        val = np.maximum(sgn * fr, g[rows, cols])
-        best = np.full(len(c), -np.inf)
-        np.maximum.at(best, rows, val)
-        out.append(sgn * best)
-    return out[0], out[1]
-
-
-def grid_extremes_numpy(
-    c: np.ndarray, Z: np.ndarray, harmonics: Sequence[int], points: int = 2048
-) -> tuple[np.ndarray, np.ndarray]:
-    """Naive fixed-grid max/min over one period (``points`` nodes, no refinement) [mm];
-    the baseline of ``benchmarks/bench_planetary_mc.py``."""
-    nh = np.asarray(harmonics, dtype=np.int64)
-    c = np.atleast_1d(np.asarray(c, dtype=float))
-    Z = np.atleast_2d(np.asarray(Z, dtype=complex))
-    u = np.arange(points) * (2 * np.pi / points)
-    E = np.exp(1j * np.outer(nh, u))  # (G, P)
-    f = c[:, None] + (Z.real @ E.imag + Z.imag @ E.real)
-    return f.max(axis=1), f.min(axis=1)
-
-
 # --------------------------------------------------------------------------- sample kernel
 @njit(cache=True, nogil=True)
 def _sample_kernel(mags, angs, gain, mag_idx, ang_idx, coeff, phase, fsign, group, nh, M):
@@ -792,13 +381,17 @@ def _sample_kernel(mags, angs, gain, mag_idx, ang_idx, coeff, phase, fsign, grou
     G = nh.shape[0]
     K = gain.shape[0]
     V = angs.shape[1]
-    stab, ctab, h = _tables(nh, M)
+    tab = node_tables(nh, M)
     buf = np.empty(M)
-    curv = h * h / 8.0
     zr = np.empty(G)
     zi = np.empty(G)
-    ca = np.empty(V)
-    sa = np.empty(V)
+    wr = np.empty(G)
+    wi = np.empty(G)
+    # one sine/cosine per angle, shared by its terms: a vectorised pass over the whole chunk
+    flat = angs.ravel()
+    sa = np.empty(n * V)
+    ca = np.empty(n * V)
+    _sincos_into(flat, sa, ca)
     c0 = np.empty(K)
     s0 = np.empty(K)
     for k in range(K):
@@ -807,18 +400,17 @@ def _sample_kernel(mags, angs, gain, mag_idx, ang_idx, coeff, phase, fsign, grou
     fmax = np.empty(n)
     fmin = np.empty(n)
     for i in range(n):
-        for v in range(V):  # one sine/cosine per angle, shared by its terms
-            ca[v] = math.cos(angs[i, v])
-            sa[v] = math.sin(angs[i, v])
+        o = i * V
         c = 0.0
         for g in range(G):
             zr[g] = 0.0
             zi[g] = 0.0
         for k in range(K):
             a = gain[k] * mags[i, mag_idx[k]]
-            if ang_idx[k] >= 0:  # phase + coeff * theta, coeff = ±1
-                cp = c0[k] * ca[ang_idx[k]] - coeff[k] * s0[k] * sa[ang_idx[k]]
-                sp = s0[k] * ca[ang_idx[k]] + coeff[k] * c0[k] * sa[ang_idx[k]]
+            v = ang_idx[k]
+            if v >= 0:  # phase + coeff * theta, coeff = ±1
+                cp = c0[k] * ca[o + v] - coeff[k] * s0[k] * sa[o + v]
+                sp = s0[k] * ca[o + v] + coeff[k] * c0[k] * sa[o + v]
             else:
                 cp = c0[k]
                 sp = s0[k]
@@ -835,7 +427,7 @@ def _sample_kernel(mags, angs, gain, mag_idx, ang_idx, coeff, phase, fsign, grou
             fmax[i] = c
             fmin[i] = c
         else:
-            fmax[i], fmin[i] = _extremes_one(c, zr, zi, nh, stab, ctab, buf, h, curv)
+            fmax[i], fmin[i] = extremes_kernel(c, zr, zi, nh, tab, buf, wr, wi)
     return fmax, fmin
 
 
@@ -843,14 +435,23 @@ def sample_extremes(
     terms: TermSet, magnitudes: np.ndarray, angles: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Exact max and min of Σe(t) [mm] for each row of ``magnitudes`` [mm] and ``angles`` [rad]
-    (shapes (n, len(terms.magnitudes)) and (n, len(terms.angles))), in one compiled pass."""
+    (shapes (n, len(terms.magnitudes)) and (n, len(terms.angles))), in one compiled pass.
+
+    The extremes come from :func:`gearte.solvers.trig_extremes.exact_extremes`' kernel; the
+    angles' sines and cosines from its vectorised :func:`~gearte.solvers.trig_extremes.sincos`
+    (|angle| <= 1e5 rad).
+    """
     arr = _term_arrays(terms)
     m = np.ascontiguousarray(np.atleast_2d(np.asarray(magnitudes, dtype=float)))
     th = np.ascontiguousarray(np.atleast_2d(np.asarray(angles, dtype=float)))
     if th.shape[1] == 0:
         th = np.zeros((m.shape[0], 1))
+    if th.size and not np.all(np.abs(th) <= SINCOS_MAX_ARG):
+        raise ParameterError(
+            "angles", float(np.max(np.abs(th))), f"|angle| must be <= {SINCOS_MAX_ARG} rad"
+        )
     nh = arr["harmonics"]
-    M = _grid_points(nh) if nh.size else 16
+    M = grid_points(nh) if nh.size else 16
     return _sample_kernel(
         m,
         th,
