@@ -45,6 +45,19 @@ _FACTOR_HELP = {
     "eccentricity_error": "eccentricity error δa (row i)",
 }
 
+#: Table 2 rows a–h: the factors with an error coefficient of their own (the eccentricity error,
+#: row i, has a derived coefficient of 0 and is neither a reference nor a compensation factor).
+_TableFactor = Literal[
+    "pin_circle_radius_error",
+    "pin_radius_error",
+    "pin_groove_clearance",
+    "radial_runout",
+    "pin_housing_position_error",
+    "equidistant_modification_error",
+    "shifted_modification_error",
+    "cumulative_pitch_error",
+]
+
 _STAGE_FIELD = {
     "z_p": "pins",
     "z_c": "cycloid_teeth",
@@ -131,16 +144,9 @@ class Errors(_Section):
 class GeometricTEOptions(_Section):
     """``[analyses.geometric_te]``: geometric TE, error coefficients and sensitivities."""
 
-    reference_factor: Literal[
-        "pin_circle_radius_error",
-        "pin_radius_error",
-        "pin_groove_clearance",
-        "radial_runout",
-        "pin_housing_position_error",
-        "equidistant_modification_error",
-        "shifted_modification_error",
-        "cumulative_pitch_error",
-    ] = Field(default="pin_circle_radius_error", description="g_0 of the sensitivity index.")
+    reference_factor: _TableFactor = Field(
+        default="pin_circle_radius_error", description="g_0 of the sensitivity index."
+    )
 
 
 class ToothContactOptions(_Section):
@@ -173,18 +179,7 @@ class CompensationOptions(_Section):
         le=600,
         description="Wanted change of the mean geometric TE; default: remove the mean.",
     )
-    factors: list[
-        Literal[
-            "pin_circle_radius_error",
-            "pin_radius_error",
-            "pin_groove_clearance",
-            "radial_runout",
-            "pin_housing_position_error",
-            "equidistant_modification_error",
-            "shifted_modification_error",
-            "cumulative_pitch_error",
-        ]
-    ] = Field(
+    factors: list[_TableFactor] = Field(
         default_factory=lambda: [
             "pin_radius_error",
             "shifted_modification_error",
