@@ -489,21 +489,6 @@ def _count(items: Sequence[str]) -> dict[str, int]:
     return counts
 
 
-def _atomic_write_bytes(path: Path, data: bytes) -> None:
-    import tempfile
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def write_sweep(
     result: SweepResult, out_dir: str | os.PathLike[str], *, plots: bool = True
 ) -> dict[str, Any]:
@@ -525,11 +510,13 @@ def write_sweep(
             buf = io.BytesIO()
             fig.fig.savefig(buf, format="png", dpi=100)
             rendered.append((out / "plots" / f"{stem}.png", buf.getvalue()))
+    from gearte.report.outputs import atomic_write_bytes, atomic_write_text
+
     csv_text, json_text = result.to_csv(), result.to_json()
     paths: dict[str, Any] = {"csv": out / "sweep.csv", "json": out / "sweep.json", "plots": []}
-    _atomic_write_bytes(paths["csv"], csv_text.encode("utf-8"))
-    _atomic_write_bytes(paths["json"], json_text.encode("utf-8"))
+    atomic_write_text(paths["csv"], csv_text)
+    atomic_write_text(paths["json"], json_text)
     for p, data in rendered:
-        _atomic_write_bytes(p, data)
+        atomic_write_bytes(p, data)
         paths["plots"].append(p)
     return paths
