@@ -45,13 +45,13 @@ from gearte.errors import ParameterError
 from gearte.geometry.planetary import PlanetarySet
 from gearte.solvers.trig_extremes import (
     SINCOS_MAX_ARG,
-    _sincos_into,
     exact_extremes,
     exact_extremes_numpy,
     extremes_kernel,
     grid_extremes_numpy,
     grid_points,
     node_tables,
+    sincos_into,
 )
 
 __all__ = [
@@ -391,7 +391,7 @@ def _sample_kernel(mags, angs, gain, mag_idx, ang_idx, coeff, phase, fsign, grou
     flat = angs.ravel()
     sa = np.empty(n * V)
     ca = np.empty(n * V)
-    _sincos_into(flat, sa, ca)
+    sincos_into(flat, sa, ca)
     c0 = np.empty(K)
     s0 = np.empty(K)
     for k in range(K):
