@@ -1,38 +1,73 @@
 # gearte — the two set-up commands of the README live here.
-#   make demo   creates .venv, installs gearte, runs the bundled RV-80E case and writes out/demo/report.html
-#   make test   creates .venv, installs gearte with its test tools, runs lint and the test suite
+#   make demo   creates .venv, installs gearte (runtime dependencies only), runs the bundled RV-80E
+#               case and writes out/demo/report.html
+#   make test   creates .venv, installs gearte with its test tools, runs lint, type checks and tests
+# Both install the exact releases of requirements/constraints.txt, so a red run is told apart from
+# upstream drift. `make test-latest` tests the newest releases in a separate venv (.venv-latest);
+# `make lock` rewrites the constraints from a fresh resolve.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
-STAMP  := $(VENV)/.installed-$(shell cat pyproject.toml | cksum | cut -d' ' -f1)
+CONSTRAINTS := requirements/constraints.txt
+HASH   := $(shell cat pyproject.toml $(CONSTRAINTS) | cksum | cut -d' ' -f1)
+RUN_STAMP := $(VENV)/.installed-run-$(HASH)
+DEV_STAMP := $(VENV)/.installed-dev-$(HASH)
+PIP    := $(BIN)/python -m pip install --disable-pip-version-check -c $(CONSTRAINTS)
 DEMO_CASE ?= hu2020_rv80e_initial
 
-.PHONY: demo test test-slow lint bench clean
+.PHONY: demo test test-slow test-latest lint typecheck bench lock clean
 
-$(STAMP): pyproject.toml
+$(VENV)/bin/python:
+	@echo "==> creating $(VENV) with $(PYTHON)"
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[dev]"
-	rm -f $(VENV)/.installed-*
-	touch $(STAMP)
 
-demo: $(STAMP)
+$(RUN_STAMP): pyproject.toml $(CONSTRAINTS) | $(VENV)/bin/python
+	@echo "==> installing gearte and its runtime dependencies (pinned by $(CONSTRAINTS))"
+	$(PIP) --progress-bar on -e .
+	rm -f $(VENV)/.installed-run-*
+	touch $(RUN_STAMP)
+
+$(DEV_STAMP): $(RUN_STAMP)
+	@echo "==> installing the test tools (pytest, hypothesis, ruff, mypy, dask)"
+	$(PIP) --progress-bar on -e ".[dev]"
+	rm -f $(VENV)/.installed-dev-*
+	touch $(DEV_STAMP)
+
+demo: $(RUN_STAMP)
 	$(BIN)/gearte run $(DEMO_CASE) --out out/demo
 	@echo "report: out/demo/report.html"
 
-test: $(STAMP)
+test: $(DEV_STAMP)
+	@echo "==> ruff"
 	$(BIN)/ruff check src tests benchmarks
+	@echo "==> pytest"
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q
 
-test-slow: $(STAMP)
+test-slow: $(DEV_STAMP)
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q -m slow
 
-lint: $(STAMP)
+# The newest releases of every dependency, resolved now (no constraints): tells upstream drift apart.
+test-latest:
+	rm -rf .venv-latest
+	$(PYTHON) -m venv .venv-latest
+	.venv-latest/bin/python -m pip install --disable-pip-version-check --upgrade -e ".[dev]"
+	.venv-latest/bin/ruff check src tests benchmarks
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_latest .venv-latest/bin/python -m pytest -q
+
+lock:
+	rm -rf .venv-lock
+	$(PYTHON) -m venv .venv-lock
+	.venv-lock/bin/python -m pip install --disable-pip-version-check --upgrade -e ".[dev]"
+	{ sed -n '1,3p' $(CONSTRAINTS); .venv-lock/bin/pip freeze --exclude-editable | grep -vi '^gearte' | sort -f; } > $(CONSTRAINTS).new
+	mv $(CONSTRAINTS).new $(CONSTRAINTS)
+	rm -rf .venv-lock
+
+lint: $(DEV_STAMP)
 	$(BIN)/ruff check src tests benchmarks
 	$(BIN)/ruff format --check src tests benchmarks
 
-bench: $(STAMP)
+bench: $(DEV_STAMP)
 	for b in benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) out .numba_cache_test .pytest_cache
+	rm -rf $(VENV) .venv-latest out .numba_cache_test .numba_cache_latest .pytest_cache
