@@ -216,7 +216,7 @@ def _li2023_reducer(errors=None):
     return RVReducer(
         first_stage=FirstStage(12, 36, 1.5, np.deg2rad(20.0), 1.4e5 * eps, 4.68e4),
         cranks=Cranks(3, 36.0, 1.3, 2.84e5, 5.76e5),
-        discs=Discs(2, 12.0, -0.01, -0.05),
+        discs=Discs(2, 12.0, -0.01, -0.05, 2.06e5, 0.3),
         pins=PinRing(40, 3.0, 85.8),
         supports=Supports(3.15e5),
         rated_torque=450e3,

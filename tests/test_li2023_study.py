@@ -1,4 +1,4 @@
-"""The ``rv_dynamics`` study kind and the bundled li2023 cases (paper 004)."""
+"""The dynamic analyses of the ``rv_reducer`` kind and the bundled li2023 cases (paper 004)."""
 
 import json
 import os
@@ -27,7 +27,8 @@ def _short(name: str, **dte) -> dict:
     data = tomllib.loads(case_path(name).read_text())
     data["case"]["name"] = name
     data["analyses"]["dte"].update(dte)
-    data["analyses"].pop("batch", None)
+    for name in ("batch", "load_sharing", "transmission_error", "catalogue"):
+        data["analyses"].pop(name, None)
     return data
 
 
@@ -91,12 +92,16 @@ def test_outputs_written_with_figures(modified, tmp_path):
 
 def test_bad_case_names_fields():
     data = _short("li2023_rv")
-    data["reducer"]["eccentricity_mm"] = 3.0  # K1 = 3·40/85.8 > 1
-    data["dynamics"]["damping_ratio"] = 0.0
+    data["reducer"]["cranks"]["eccentricity_mm"] = 3.0  # K1 = 3·40/85.8 > 1
     with pytest.raises(CaseFileError) as exc:
         load_case_dict(data)
     text = str(exc.value)
-    assert "reducer" in text and "K1" in text and "dynamics.damping_ratio" in text
+    assert "reducer" in text and "K1" in text
+    data = _short("li2023_rv")
+    data["reducer"]["dynamics"]["damping_ratio"] = 0.0
+    with pytest.raises(CaseFileError) as exc:
+        load_case_dict(data)
+    assert "reducer.dynamics.damping_ratio" in str(exc.value)
 
 
 @pytest.mark.slow
@@ -118,12 +123,20 @@ def test_li2023_rv_errors_cli(tmp_path):
 def test_bad_solver_and_unknown_key():
     data = _short("li2023_rv")
     data["analyses"]["dte"]["method"] = "euler"
-    data["dynamics"]["dampin_ratio"] = 0.1
-    data["errors"] = {"placement": "every", "cam": {"amplitude_mm": -0.01, "phase_deg": 0.0}}
+    data["reducer"]["dynamics"]["dampin_ratio"] = 0.1
+    data["reducer"]["errors"] = [
+        {"part": "every", "value_um": 5.0, "angle_deg": 0.0},
+        {"part": "cam", "crank": 1, "disc": 1, "value_um": -10.0, "angle_deg": 0.0},
+    ]
     with pytest.raises(CaseFileError) as exc:
         load_case_dict(data)
     text = str(exc.value)
-    for field in ("analyses.dte.method", "dynamics.dampin_ratio", "errors.placement", "errors.cam"):
+    for field in (
+        "analyses.dte.method",
+        "reducer.dynamics.dampin_ratio",
+        "reducer.errors.0.part",
+        "reducer.errors.1.value_um",
+    ):
         assert field in text, field
 
 

@@ -66,6 +66,9 @@ __all__ = [
     "Supports",
     "ErrorEntry",
     "ManufacturingErrors",
+    "ERROR_PARTS",
+    "MassProperties",
+    "mass_properties",
     "RVReducer",
     "palmgren_radial_stiffness",
     "iso6336_mesh_stiffness",
@@ -148,6 +151,8 @@ class FirstStage:
         Sun–planet mesh stiffness along the line of action [N/mm].
     sun_support_stiffness : float
         Radial stiffness of the sun (input shaft) support [N/mm]; small = floating sun.
+    face_width : float or None
+        Face width of the sun and planets [mm] (needed only to derive their masses).
     """
 
     sun_teeth: int
@@ -156,6 +161,7 @@ class FirstStage:
     pressure_angle: float
     mesh_stiffness: float
     sun_support_stiffness: float
+    face_width: float | None = None
 
     def __post_init__(self) -> None:
         _check_int("first_stage.sun_teeth", self.sun_teeth, 6)
@@ -167,6 +173,8 @@ class FirstStage:
             )
         _check_pos("first_stage.mesh_stiffness", self.mesh_stiffness)
         _check_pos("first_stage.sun_support_stiffness", self.sun_support_stiffness)
+        if self.face_width is not None:
+            _check_pos("first_stage.face_width", self.face_width)
 
     @property
     def base_radii(self) -> tuple[float, float]:
@@ -195,6 +203,8 @@ class Cranks:
     cam_bearing_clearance, carrier_bearing_clearance : float
         Radial clearance of those bearings [mm] (0: none). A bearing with clearance carries
         ``k (|w| - c)`` along its radial deflection ``w`` and nothing while ``|w| <= c``.
+    shaft_diameter, shaft_length : float or None
+        Crankshaft envelope [mm] (needed only to derive its mass and inertia).
     """
 
     count: int
@@ -204,9 +214,14 @@ class Cranks:
     carrier_bearing_stiffness: float
     cam_bearing_clearance: float = 0.0
     carrier_bearing_clearance: float = 0.0
+    shaft_diameter: float | None = None
+    shaft_length: float | None = None
 
     def __post_init__(self) -> None:
         _check_int("cranks.count", self.count, 2, 6)
+        for name in ("shaft_diameter", "shaft_length"):
+            if getattr(self, name) is not None:
+                _check_pos(f"cranks.{name}", getattr(self, name))
         _check_pos("cranks.circle_radius", self.circle_radius)
         _check_pos("cranks.eccentricity", self.eccentricity)
         _check_pos("cranks.cam_bearing_stiffness", self.cam_bearing_stiffness)
@@ -234,17 +249,25 @@ class Discs:
         ``E`` [MPa] of disc and pins.
     poisson_ratio : float
         ``mu`` [-].
+    crank_bore_diameter, centre_bore_diameter : float or None
+        Diameters of the crank bores and of the central bore [mm] (needed only to derive the
+        disc's mass and inertia; no central bore when None).
     """
 
     count: int
     face_width: float
-    equidistant_modification: float = 0.0
-    shift_modification: float = 0.0
-    youngs_modulus: float = 2.06e5
-    poisson_ratio: float = 0.3
+    equidistant_modification: float
+    shift_modification: float
+    youngs_modulus: float
+    poisson_ratio: float
+    crank_bore_diameter: float | None = None
+    centre_bore_diameter: float | None = None
 
     def __post_init__(self) -> None:
         _check_int("discs.count", self.count, 1, 3)
+        for name in ("crank_bore_diameter", "centre_bore_diameter"):
+            if getattr(self, name) is not None:
+                _check_pos(f"discs.{name}", getattr(self, name))
         _check_pos("discs.face_width", self.face_width)
         for name in ("equidistant_modification", "shift_modification"):
             v = getattr(self, name)
@@ -305,24 +328,40 @@ class Supports:
     ----------
     carrier_radial_stiffness : float
         Radial stiffness of the carrier's main bearings [N/mm].
+    main_bearing_clearance : float
+        Radial clearance of the main bearings [mm] (Li 2023 ``ε_h``; used by the dynamics).
+    carrier_outer_diameter, carrier_length : float or None
+        Envelope of the carrier (output flange + end plate) [mm], needed only to derive its mass.
     """
 
     carrier_radial_stiffness: float
+    main_bearing_clearance: float = 0.0
+    carrier_outer_diameter: float | None = None
+    carrier_length: float | None = None
 
     def __post_init__(self) -> None:
         _check_pos("supports.carrier_radial_stiffness", self.carrier_radial_stiffness)
+        v = self.main_bearing_clearance
+        if not np.isfinite(v) or not 0.0 <= v <= 0.2:
+            raise ParameterError("supports.main_bearing_clearance", v, "must be in [0, 0.2] mm")
+        for name in ("carrier_outer_diameter", "carrier_length"):
+            if getattr(self, name) is not None:
+                _check_pos(f"supports.{name}", getattr(self, name))
 
 
 @dataclass(frozen=True)
 class ErrorEntry:
-    """One measured eccentricity error.
+    """One eccentricity (position) error of one part.
 
     Attributes
     ----------
     part : str
-        ``"planet_base_circle"``, ``"disc_crank_bore"``, ``"cam"`` or ``"carrier_crank_bore"``.
-    crank : int
-        Crank (= planet) index, 1-based as in the paper's tables.
+        One of :data:`ERROR_PARTS`: ``"sun_eccentricity"``, ``"sun_assembly"``,
+        ``"planet_eccentricity"``, ``"cam"``, ``"disc_crank_bore"``, ``"carrier_crank_bore"``,
+        ``"output_assembly"``.
+    crank : int or None
+        Crank (= planet) index, 1-based as in the papers' tables; required for the per-crank
+        parts, omitted for the sun and output parts.
     disc : int or None
         Disc index, 1-based; required for ``disc_crank_bore`` and ``cam``.
     value : float
@@ -332,36 +371,63 @@ class ErrorEntry:
     """
 
     part: str
-    crank: int
+    crank: int | None
     disc: int | None
     value: float
     angle: float
 
 
-_PARTS = ("planet_base_circle", "disc_crank_bore", "cam", "carrier_crank_bore")
+ERROR_PARTS = (
+    "sun_eccentricity",
+    "sun_assembly",
+    "planet_eccentricity",
+    "cam",
+    "disc_crank_bore",
+    "carrier_crank_bore",
+    "output_assembly",
+)
+"""Parts that carry an eccentricity error, in the order of the power flow."""
+
+_NO_CRANK = ("sun_eccentricity", "sun_assembly", "output_assembly")
+_NEEDS_DISC = ("disc_crank_bore", "cam")
+
+
+def _zeros2() -> np.ndarray:
+    return np.zeros(2)
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
 class ManufacturingErrors:
-    """Measured eccentricity errors as arrays of error vectors in the parts' frames [mm].
+    """Eccentricity errors as error vectors ``value (cos angle, sin angle)`` [mm].
 
     Attributes
     ----------
     planet : numpy.ndarray
-        ``(M, 2)`` planet base-circle eccentricity (magnitude, angle) → stored as (x, y) in the
-        planet frame.
+        ``(M, 2)`` planet eccentricity (Han Table 1 base-circle eccentricity; Li Table 3
+        ``E_p``) in the planet frame, from disc 1's eccentric direction.
     disc_bore : numpy.ndarray
-        ``(N, M, 2)`` disc ``j`` crank bore ``i``.
+        ``(N, M, 2)`` disc ``j`` crank bore ``i`` (Han Table 2; Li ``E^H_c``), radial frame.
     cam : numpy.ndarray
-        ``(M, N, 2)`` crank ``i`` cam for disc ``j``.
+        ``(M, N, 2)`` crank ``i`` cam for disc ``j`` (Han Table 3; Li ``E_d``).
     carrier_bore : numpy.ndarray
-        ``(M, 2)``.
+        ``(M, 2)`` carrier (output disc) crank bore (Han Table 4; Li ``E^H_o``), radial frame.
+    sun : numpy.ndarray
+        ``(2,)`` sun eccentricity (Li ``E_s``), rotating with the sun, from its angle 0.
+    sun_seat : numpy.ndarray
+        ``(2,)`` sun assembly error (Li ``E_sa``): fixed offset of the sun's support seat,
+        ground frame.
+    output_seat : numpy.ndarray
+        ``(2,)`` output assembly error (Li ``E_o``): fixed offset of the carrier's main-bearing
+        seat, ground frame.
     """
 
     planet: np.ndarray
     disc_bore: np.ndarray
     cam: np.ndarray
     carrier_bore: np.ndarray
+    sun: np.ndarray = field(default_factory=_zeros2)
+    sun_seat: np.ndarray = field(default_factory=_zeros2)
+    output_seat: np.ndarray = field(default_factory=_zeros2)
 
     @classmethod
     def none(cls, n_cranks: int, n_discs: int) -> ManufacturingErrors:
@@ -389,14 +455,18 @@ class ManufacturingErrors:
         seen: set[tuple] = set()
         for k, e in enumerate(entries):
             f = f"{field_name}[{k}]"
-            if e.part not in _PARTS:
-                raise ParameterError(f"{f}.part", e.part, f"must be one of {_PARTS}")
-            if not 1 <= e.crank <= n_cranks:
+            if e.part not in ERROR_PARTS:
+                raise ParameterError(f"{f}.part", e.part, f"must be one of {ERROR_PARTS}")
+            if e.part in _NO_CRANK:
+                if e.crank is not None:
+                    raise ParameterError(
+                        f"{f}.crank", e.crank, f"must be omitted for part {e.part!r}"
+                    )
+            elif e.crank is None or not 1 <= e.crank <= n_cranks:
                 raise ParameterError(
                     f"{f}.crank", e.crank, f"crank index must be in 1..{n_cranks} (cranks.count)"
                 )
-            needs_disc = e.part in ("disc_crank_bore", "cam")
-            if needs_disc:
+            if e.part in _NEEDS_DISC:
                 if e.disc is None or not 1 <= e.disc <= n_discs:
                     raise ParameterError(
                         f"{f}.disc", e.disc, f"disc index must be in 1..{n_discs} (discs.count)"
@@ -410,15 +480,20 @@ class ManufacturingErrors:
                 raise ParameterError(f, key, "error given twice for the same part and index")
             seen.add(key)
             vec = e.value * np.array([np.cos(e.angle), np.sin(e.angle)])
-            i = e.crank - 1
-            if e.part == "planet_base_circle":
-                out.planet[i] = vec
+            if e.part == "sun_eccentricity":
+                out.sun[:] = vec
+            elif e.part == "sun_assembly":
+                out.sun_seat[:] = vec
+            elif e.part == "output_assembly":
+                out.output_seat[:] = vec
+            elif e.part == "planet_eccentricity":
+                out.planet[e.crank - 1] = vec
             elif e.part == "carrier_crank_bore":
-                out.carrier_bore[i] = vec
+                out.carrier_bore[e.crank - 1] = vec
             elif e.part == "disc_crank_bore":
-                out.disc_bore[e.disc - 1, i] = vec
+                out.disc_bore[e.disc - 1, e.crank - 1] = vec
             else:
-                out.cam[i, e.disc - 1] = vec
+                out.cam[e.crank - 1, e.disc - 1] = vec
         return out
 
     def scaled(self, factor: float) -> ManufacturingErrors:
@@ -428,7 +503,26 @@ class ManufacturingErrors:
             self.disc_bore * factor,
             self.cam * factor,
             self.carrier_bore * factor,
+            self.sun * factor,
+            self.sun_seat * factor,
+            self.output_seat * factor,
         )
+
+    def amplitudes(self) -> dict[str, float]:
+        """Largest magnitude of each part's error [mm] (the tolerance of a random batch)."""
+
+        def mx(v: np.ndarray) -> float:
+            return float(np.max(np.hypot(v[..., 0], v[..., 1]), initial=0.0))
+
+        return {
+            "sun_eccentricity": mx(self.sun),
+            "sun_assembly": mx(self.sun_seat),
+            "planet_eccentricity": mx(self.planet),
+            "cam": mx(self.cam),
+            "disc_crank_bore": mx(self.disc_bore),
+            "carrier_crank_bore": mx(self.carrier_bore),
+            "output_assembly": mx(self.output_seat),
+        }
 
 
 @dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
@@ -440,8 +534,8 @@ class RVReducer:
     first_stage, cranks, discs, pins, supports : see the classes above.
     errors : ManufacturingErrors
         Measured errors (default none).
-    rated_torque : float
-        Rated output torque [N·mm] (catalogue value; used for sweeps and the virtual test).
+    rated_torque : float or None
+        Rated output torque [N·mm] (catalogue value; needed by the virtual torsion test only).
     planets : int, optional
         Number of planets of the first stage; must equal ``cranks.count`` (default: equal).
 
@@ -458,7 +552,7 @@ class RVReducer:
     discs: Discs
     pins: PinRing
     supports: Supports
-    rated_torque: float
+    rated_torque: float | None
     planets: int | None = None
     errors: ManufacturingErrors | None = None
 
@@ -470,7 +564,8 @@ class RVReducer:
                 planets,
                 f"must equal cranks.count = {self.cranks.count} (each planet drives one crank)",
             )
-        _check_pos("rated_torque", self.rated_torque)
+        if self.rated_torque is not None:
+            _check_pos("rated_torque", self.rated_torque)
         k1 = self.K1
         if not 0 < k1 < 1:
             raise ParameterError(
@@ -498,6 +593,9 @@ class RVReducer:
             "errors.disc_bore": (err.disc_bore.shape, (n, m, 2)),
             "errors.cam": (err.cam.shape, (m, n, 2)),
             "errors.carrier_bore": (err.carrier_bore.shape, (m, 2)),
+            "errors.sun": (err.sun.shape, (2,)),
+            "errors.sun_seat": (err.sun_seat.shape, (2,)),
+            "errors.output_seat": (err.output_seat.shape, (2,)),
         }
         for name, (got, want) in shapes.items():
             if got != want:
@@ -559,6 +657,146 @@ class RVReducer:
         )
         kw.update(changes)
         return RVReducer(**kw)
+
+
+@dataclass(frozen=True)
+class MassProperties:
+    """Masses [kg] and polar moments of inertia [kg·m²] of the RV reducer's bodies.
+
+    Attributes
+    ----------
+    mass_kg, inertia_kgm2 : dict
+        Per body (``"sun"``, ``"planet"``, ``"crank"``, ``"disc"``, ``"output"``): one planet,
+        one crank, one disc.
+    derived : tuple of str
+        The bodies whose values were derived from geometry and density (not given).
+    """
+
+    mass_kg: dict[str, float]
+    inertia_kgm2: dict[str, float]
+    derived: tuple[str, ...]
+
+
+_MASS_INPUTS = {
+    "sun": ("first_stage.face_width_mm",),
+    "planet": ("first_stage.face_width_mm",),
+    "crank": ("cranks.shaft_diameter_mm", "cranks.shaft_length_mm"),
+    "disc": ("discs.crank_bore_diameter_mm",),
+    "output": ("supports.carrier_outer_diameter_mm", "supports.carrier_length_mm"),
+}
+
+
+def mass_properties(
+    reducer: RVReducer,
+    density: float | None,
+    given_mass: dict[str, float] | None = None,
+    given_inertia: dict[str, float] | None = None,
+) -> MassProperties:
+    """Masses and inertias of the reducer's bodies: the given ones, the rest from geometry.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The description; its optional envelope dimensions are used for derived bodies.
+    density : float or None
+        Material density [kg/m³]; required when any body is derived.
+    given_mass : dict, optional
+        Masses [kg] given by the case, per body name.
+    given_inertia : dict, optional
+        Polar moments of inertia [kg·m²] given by the case, per body name.
+
+    Returns
+    -------
+    MassProperties
+
+    Raises
+    ------
+    ParameterError
+        Naming the missing key (``density_kg_per_m3`` or the envelope dimension) when a body's
+        mass or inertia is neither given nor derivable.
+
+    Notes
+    -----
+    Solid bodies of revolution (a derivation of gearte, not from a paper): sun and planet are
+    cylinders of their pitch diameter ``m z`` and the first-stage face width; the crank is a
+    cylinder of its shaft envelope; the disc is a cylinder of radius ``r_p + Δr_p − r_rp − Δr_rp``
+    (the radius on which its tooth profile oscillates ±a) and width ``b`` less its ``M`` crank
+    bores (on the crank circle) and central bore; the carrier is a cylinder of its envelope.
+    ``m = rho V``, ``J = m r² / 2`` per cylinder, bores subtracted with the parallel-axis term.
+    Li et al. 2023 Table 2 gives 2.76 kg for its disc; this rule gives 2.0 kg from its
+    Table 1 geometry without bores — good for the order of magnitude of the modes, not better.
+
+    References
+    ----------
+    Li X. et al. (2023), Machines 11(6), 626, Table 2. doi:10.3390/machines11060626
+    """
+    given_mass = dict(given_mass or {})
+    given_inertia = dict(given_inertia or {})
+    fs, cr, di, pins, sup = (
+        reducer.first_stage,
+        reducer.cranks,
+        reducer.discs,
+        reducer.pins,
+        reducer.supports,
+    )
+
+    def cyl(radius: float, length: float) -> tuple[float, float]:
+        v = np.pi * radius**2 * length * 1e-9  # mm^3 -> m^3
+        m = float(density) * v
+        return m, 0.5 * m * (radius * 1e-3) ** 2
+
+    def envelope(body: str) -> tuple[float, float]:
+        if body in ("sun", "planet"):
+            z = fs.sun_teeth if body == "sun" else fs.planet_teeth
+            return cyl(fs.module * z / 2.0, fs.face_width)
+        if body == "crank":
+            return cyl(cr.shaft_diameter / 2.0, cr.shaft_length)
+        if body == "output":
+            return cyl(sup.carrier_outer_diameter / 2.0, sup.carrier_length)
+        r_out = pins.circle_radius + di.shift_modification - pins.pin_radius
+        r_out -= di.equidistant_modification
+        m, j = cyl(r_out, di.face_width)
+        rb = di.crank_bore_diameter / 2.0
+        mb, jb = cyl(rb, di.face_width)
+        m -= cr.count * mb
+        j -= cr.count * (jb + mb * (cr.circle_radius * 1e-3) ** 2)
+        if di.centre_bore_diameter is not None:
+            mc, jc = cyl(di.centre_bore_diameter / 2.0, di.face_width)
+            m, j = m - mc, j - jc
+        return m, j
+
+    values = {
+        "sun": (fs.face_width,),
+        "planet": (fs.face_width,),
+        "crank": (cr.shaft_diameter, cr.shaft_length),
+        "disc": (di.crank_bore_diameter,),
+        "output": (sup.carrier_outer_diameter, sup.carrier_length),
+    }
+    mass, inertia, derived = {}, {}, []
+    for body, keys in _MASS_INPUTS.items():
+        if body in given_mass and body in given_inertia:
+            mass[body], inertia[body] = float(given_mass[body]), float(given_inertia[body])
+            continue
+        missing = [k for k, v in zip(keys, values[body], strict=True) if v is None]
+        if density is None:
+            missing.insert(0, "density_kg_per_m3 (or material)")
+        if missing:
+            what = "mass" if body not in given_mass else "inertia"
+            raise ParameterError(
+                "reducer." + missing[0].split(" ")[0],
+                None,
+                f"needed to derive the {body} {what} (or give {body}_mass_kg and "
+                f"{body}_inertia_kgm2 in [reducer.dynamics]); missing: {', '.join(missing)}",
+            )
+        m, j = envelope(body)
+        if m <= 0 or j <= 0:
+            raise ParameterError(
+                "reducer." + keys[0], values[body][0], f"leaves no material in the {body}"
+            )
+        mass[body] = float(given_mass.get(body, m))
+        inertia[body] = float(given_inertia.get(body, j))
+        derived.append(body)
+    return MassProperties(mass, inertia, tuple(derived))
 
 
 def _check_pos(name: str, v: float) -> None:

@@ -86,6 +86,18 @@ class TorsionTest:
     angle: np.ndarray
 
 
+def _rated(reducer: RVReducer) -> float:
+    """The rated torque [N·mm], which the virtual test needs (a case may leave it out)."""
+    if reducer.rated_torque is None:
+        raise ParameterError(
+            "reducer.rated_torque_Nm",
+            None,
+            "needed by the virtual torsion test (catalogue, backlash, compensation): the torque "
+            "sweep is in fractions of the rated torque",
+        )
+    return float(reducer.rated_torque)
+
+
 def _follow(reducer, theta, torques, law):
     system = assemble(reducer, np.full(torques.size, float(theta)))
     sol = solve_positions(system, torques, law)
@@ -111,10 +123,8 @@ def torsion_test(
     frac_eff = np.where(frac == 0.0, np.where(prev >= 0.0, eps, -eps), frac)
     if frac_eff[0] == 0.0:
         frac_eff[0] = eps
-    torques = frac_eff * reducer.rated_torque
-    return TorsionTest(
-        torque=frac * reducer.rated_torque, angle=_follow(reducer, theta, torques, law)
-    )
+    tr = _rated(reducer)
+    return TorsionTest(torque=frac * tr, angle=_follow(reducer, theta, frac_eff * tr, law))
 
 
 def backlash(reducer: RVReducer, *, theta: ArrayLike = 0.0, law: ContactLaw | None = None) -> float:
@@ -124,7 +134,7 @@ def backlash(reducer: RVReducer, *, theta: ArrayLike = 0.0, law: ContactLaw | No
     """
     law = contact_law(reducer) if law is None else law
     th = np.atleast_1d(np.asarray(theta, dtype=float))
-    eps = 1e-4 * reducer.rated_torque
+    eps = 1e-4 * _rated(reducer)
     system = assemble(reducer, th)
     out = system.layout.output_rotation
     pos = -solve_positions(system, eps, law).q[:, out]
@@ -164,7 +174,7 @@ def catalogue_values(
         reducer, turning_points, theta=theta, steps_per_segment=steps_per_segment, law=law
     )
     levels = np.array([1e-4, lost_motion_fraction, 0.5, 1.0])
-    tr = reducer.rated_torque
+    tr = _rated(reducer)
     pos = _follow(reducer, theta, levels * tr, law)
     neg = _follow(reducer, theta, -levels * tr, law)
     k_pos = 0.5 * tr / (pos[3] - pos[2])

@@ -22,13 +22,14 @@ constraint enters as an exact penalty.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
 from gearte.errors import ParameterError
-from gearte.geometry.rv import Discs, PinRing, RVReducer
+from gearte.geometry.rv import PinRing, RVReducer
 from gearte.models.rv_catalogue import backlash
 from gearte.models.rv_load_sharing import LoadSharing, output_positions, transmission_error
 
@@ -43,13 +44,11 @@ def apply_changes(reducer: RVReducer, changes: dict[str, float]) -> RVReducer:
     if bad:
         raise ParameterError("variables", bad, f"unknown design variable(s); allowed {VARIABLES}")
     d, p = reducer.discs, reducer.pins
-    discs = Discs(
-        d.count,
-        d.face_width,
-        d.equidistant_modification + changes.get("equidistant_modification", 0.0),
-        d.shift_modification + changes.get("shift_modification", 0.0),
-        d.youngs_modulus,
-        d.poisson_ratio,
+    discs = dataclasses.replace(
+        d,
+        equidistant_modification=d.equidistant_modification
+        + changes.get("equidistant_modification", 0.0),
+        shift_modification=d.shift_modification + changes.get("shift_modification", 0.0),
     )
     pins = PinRing(
         p.count,

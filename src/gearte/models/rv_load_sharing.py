@@ -235,20 +235,20 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
         ks.append(k)
         cs.append(c)
 
-    # sun support (2 rows)
+    # sun support (2 rows): w = u_sun - seat offset (sun assembly error, ground frame)
     start = len(rows)
     for d in (ex, ey):
         r = np.zeros((P, nd))
         _point_row(r, lay.sun, zero2, np.broadcast_to(d, (P, 2)), 1.0, rot=False)
-        add(r, np.zeros(P), reducer.first_stage.sun_support_stiffness)
+        add(r, np.full(P, -err.sun_seat @ d), reducer.first_stage.sun_support_stiffness)
     labels["sun_support"] = slice(start, len(rows))
 
-    # carrier main bearings (2 rows)
+    # carrier main bearings (2 rows): w = u_carrier - seat offset (output assembly error)
     start = len(rows)
     for d in (ex, ey):
         r = np.zeros((P, nd))
         _point_row(r, lay.carrier, zero2, np.broadcast_to(d, (P, 2)), 1.0)
-        add(r, np.zeros(P), reducer.supports.carrier_radial_stiffness)
+        add(r, np.full(P, -err.output_seat @ d), reducer.supports.carrier_radial_stiffness)
     labels["main_bearing"] = slice(start, len(rows))
 
     crank_ang = th[:, None] + 2.0 * np.pi * np.arange(M)[None, :] / M  # (P, M)
@@ -310,7 +310,8 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
         _point_row(r, lay.sun, zero2, n, 1.0, rot=False)
         _point_row(r, lay.crank(i), tp - cp, n, -1.0)
         eps_pl = _rot(np.broadcast_to(err.planet[i], (P, 2)), ecc1)
-        add(r, -np.sum(eps_pl * n, axis=-1), reducer.first_stage.mesh_stiffness)
+        eps_sun = _rot(np.broadcast_to(err.sun, (P, 2)), reducer.ratio * th)
+        add(r, np.sum((eps_sun - eps_pl) * n, axis=-1), reducer.first_stage.mesh_stiffness)
     labels["mesh"] = slice(start, len(rows))
 
     spring_B = np.stack(rows, axis=1)

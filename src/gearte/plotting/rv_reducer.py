@@ -145,4 +145,11 @@ def figures(result) -> list[Figure]:
         out.append(_hysteresis(cat, result["catalogue"]["rated_torque [N*m]"] * 1e3))
     if "compensation" in result:
         out.append(_compensation(result["compensation"].data["compensation"]))
+    if "geometry" in result:  # the cycloid stage's analyses (run by the cycloid_stage kind)
+        from gearte.plotting import cycloid_stage
+
+        out += cycloid_stage.figures(result)
+    from gearte.plotting import rv_dynamics
+
+    out += rv_dynamics.figures(result)
     return out

@@ -1,25 +1,53 @@
-"""Study kind ``rv_reducer``: a whole RV reducer — load sharing with measured errors, total TE,
-catalogue quantities and compensation (Han et al. 2023; Hu et al. 2020 sections 3 and 5).
+"""Study kind ``rv_reducer``: every analysis of a whole RV reducer from one description.
 
-Case file layout::
+One case schema for the whole RV reducer (issue 11): the quasi-static load sharing with measured
+errors, total TE, catalogue quantities and compensation (Han et al. 2023; Hu et al. 2020 sections
+3 and 5), the cycloid stage's geometric TE with Hu's nine factors, sensitivities, loaded tooth
+contact and compensation (Hu et al. 2020 sections 2-4, through the same
+:class:`~gearte.geometry.cycloid.CycloidStage` the ``cycloid_stage`` kind builds), and the
+dynamics (Li et al. 2023: loaded contact, modes, dynamic TE and its spectrum, speed sweeps, error
+batches). Every analysis reads the same :class:`~gearte.geometry.rv.RVReducer` and the same
+errors; an analysis whose input the case lacks is an error naming the key.
+
+Case file layout (units in the keys)::
 
     [case]  kind = "rv_reducer"
-    [reducer]                  rated_torque_Nm
+    [reducer]                  rated_torque_Nm (catalogue, backlash), contact_law,
+                               material = "steel" | density_kg_per_m3 (derived masses)
     [reducer.first_stage]      sun_teeth, planet_teeth, planets, module_mm, pressure_angle_deg,
-                               mesh_stiffness_N_per_mm | face_width_mm,
+                               mesh_stiffness_N_per_mm and/or face_width_mm,
                                sun_support_stiffness_N_per_mm
-    [reducer.cranks]           count, circle_radius_mm, eccentricity_mm,
-                               cam_bearing = {stiffness_N_per_mm | rollers, roller_length_mm,
-                               reference_load_N}, carrier_bearing = {...}
+    [reducer.cranks]           count, circle_radius_mm, eccentricity_mm, shaft_diameter_mm,
+                               shaft_length_mm, cam_bearing = {stiffness_N_per_mm | rollers,
+                               roller_length_mm, reference_load_N; radial_clearance_um},
+                               carrier_bearing = {...}
     [reducer.discs]            count, face_width_mm, equidistant_modification_mm,
-                               shift_modification_mm, youngs_modulus_MPa, poisson_ratio
-    [reducer.pins]             count, pin_radius_mm, circle_radius_mm, *_errors_um (per pin)
-    [reducer.supports]         carrier_radial_stiffness_N_per_mm
-    [[reducer.errors]]         part, crank, disc, value_um, angle_deg   (one per measured error)
+                               shift_modification_mm, youngs_modulus_MPa, poisson_ratio,
+                               crank_bore_diameter_mm, centre_bore_diameter_mm
+    [reducer.pins]             count, pin_radius_mm, circle_radius_mm, radius_errors_um,
+                               radial_position_errors_um, tangential_position_errors_um (per pin)
+    [reducer.supports]         carrier_radial_stiffness_N_per_mm, main_bearing_clearance_um,
+                               carrier_outer_diameter_mm, carrier_length_mm
+    [[reducer.errors]]         part, crank, disc, value_um, angle_deg (one per eccentricity error:
+                               sun_eccentricity, sun_assembly, planet_eccentricity, cam,
+                               disc_crank_bore, carrier_crank_bore, output_assembly)
+    [reducer.cycloid_errors]   the nine factors of Hu 2020 Table 2: {mean_um, tolerance_um}
+    [reducer.dynamics]         masses/inertias (derived from geometry when left out), input and
+                               crank torsional stiffness, crank bending stiffness, damping ratio
+    [operation]                input_speed_rpm, output_torque_Nm (dynamic analyses)
     [analyses.load_sharing]    torque_Nm, positions, compare_without_errors
     [analyses.transmission_error]  torque_Nm, positions, zero_load_fraction
     [analyses.catalogue]       position_deg, torque_sweep, steps_per_segment, lost_motion_fraction
     [analyses.compensation]    torque_Nm, objective, min_backlash_arcmin, positions, bounds_um
+    [analyses.geometric_te]    reference_factor
+    [analyses.tooth_contact]   torque_Nm, disc_share, mesh_positions, start_force_N,
+                               clearance_model
+    [analyses.cycloid_compensation]  target_te_change_arcmin, factors, rule
+    [analyses.contact]         positions, load_sweep_Nm
+    [analyses.modal]           speed_min_rpm, speed_max_rpm, resonance_margin
+    [analyses.dte]             duration_s, settle_s, method, step_fraction, record_dt_s
+    [analyses.speed_sweep]     speed_min_rpm, speed_max_rpm, count, duration_s, settle_s
+    [analyses.batch]           samples, duration_s, settle_s, seed, chunk_size, tolerance_scale
 """
 
 from __future__ import annotations
@@ -31,6 +59,7 @@ from pydantic import Field, model_validator
 
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.rv import (
+    ERROR_PARTS,
     Cranks,
     Discs,
     ErrorEntry,
@@ -44,6 +73,10 @@ from gearte.geometry.rv import (
 )
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.results import AnalysisResult, StudyResult
+from gearte.studies import _rv_dynamics as dyn
+from gearte.studies.cycloid_stage import CompensationOptions as CycloidCompensationOptions
+from gearte.studies.cycloid_stage import Errors as CycloidErrors
+from gearte.studies.cycloid_stage import GeometricTEOptions
 from gearte.units import (
     Nm_to_Nmm,
     arcmin_to_rad,
@@ -54,10 +87,13 @@ from gearte.units import (
 )
 
 KIND = "rv_reducer"
-REFERENCES = ["han2023", "hu2020"]
+REFERENCES = ["han2023", "hu2020", "li2023"]
 FIGURES = "gearte.plotting.rv_reducer"
 
-__all__ = ["KIND", "REFERENCES", "FIGURES", "Case", "run", "build_reducer"]
+__all__ = ["KIND", "REFERENCES", "FIGURES", "Case", "run", "build_reducer", "build_stage_case"]
+
+#: Densities of the materials a case may name [kg/m³] (physical constants).
+MATERIAL_DENSITY_KG_PER_M3 = {"steel": 7850.0}
 
 
 # ------------------------------------------------------------------------------------------
@@ -93,21 +129,29 @@ class Bearing(StrictModel):
 
 
 class FirstStageSection(StrictModel):
+    """Involute first stage: sun and planets (an RV first stage has no ring)."""
+
     sun_teeth: int = Field(ge=6, le=400)
     planet_teeth: int = Field(ge=6, le=400)
     planets: int = Field(ge=2, le=6, description="must equal cranks.count")
     module_mm: float = Field(gt=0, le=20)
-    pressure_angle_deg: float = Field(default=20.0, gt=0, lt=45)
-    mesh_stiffness_N_per_mm: float | None = Field(default=None, gt=0, le=1e9)
-    face_width_mm: float | None = Field(
-        default=None, gt=0, le=200, description="ISO 6336 mesh stiffness c_gamma = 20 N/(mm um)"
+    pressure_angle_deg: float = Field(gt=0, lt=45)
+    mesh_stiffness_N_per_mm: float | None = Field(
+        default=None, gt=0, le=1e9, description="mean mesh stiffness; default ISO 6336 from b"
     )
-    sun_support_stiffness_N_per_mm: float = Field(default=1e4, gt=0, le=1e9)
+    face_width_mm: float | None = Field(
+        default=None,
+        gt=0,
+        le=200,
+        description="ISO 6336 mesh stiffness c_gamma = 20 N/(mm um) when no mesh stiffness is "
+        "given; sun and planet masses",
+    )
+    sun_support_stiffness_N_per_mm: float = Field(gt=0, le=1e9)
 
     @model_validator(mode="after")
     def _mesh(self):
-        if (self.mesh_stiffness_N_per_mm is None) == (self.face_width_mm is None):
-            raise ValueError("give exactly one of mesh_stiffness_N_per_mm and face_width_mm")
+        if self.mesh_stiffness_N_per_mm is None and self.face_width_mm is None:
+            raise ValueError("give mesh_stiffness_N_per_mm or face_width_mm (or both)")
         return self
 
 
@@ -117,15 +161,19 @@ class CranksSection(StrictModel):
     eccentricity_mm: float = Field(gt=0, le=50)
     cam_bearing: Bearing
     carrier_bearing: Bearing
+    shaft_diameter_mm: float | None = Field(default=None, gt=0, le=500, description="mass only")
+    shaft_length_mm: float | None = Field(default=None, gt=0, le=2000, description="mass only")
 
 
 class DiscsSection(StrictModel):
-    count: int = Field(default=2, ge=1, le=3)
+    count: int = Field(ge=1, le=3)
     face_width_mm: float = Field(gt=0, le=200)
     equidistant_modification_mm: float = Field(default=0.0, ge=-0.5, le=0.5)
     shift_modification_mm: float = Field(default=0.0, ge=-0.5, le=0.5)
-    youngs_modulus_MPa: float = Field(default=2.06e5, gt=0, le=1e6)
-    poisson_ratio: float = Field(default=0.3, ge=0, lt=0.5)
+    youngs_modulus_MPa: float = Field(gt=0, le=1e6)  # noqa: N815
+    poisson_ratio: float = Field(ge=0, lt=0.5)
+    crank_bore_diameter_mm: float | None = Field(default=None, gt=0, le=500, description="mass")
+    centre_bore_diameter_mm: float | None = Field(default=None, gt=0, le=2000, description="mass")
 
 
 class PinsSection(StrictModel):
@@ -148,28 +196,99 @@ class PinsSection(StrictModel):
 
 class SupportsSection(StrictModel):
     carrier_radial_stiffness_N_per_mm: float = Field(gt=0, le=1e10)
+    main_bearing_clearance_um: float = Field(default=0.0, ge=0, le=200)
+    carrier_outer_diameter_mm: float | None = Field(default=None, gt=0, le=5000, description="mass")
+    carrier_length_mm: float | None = Field(default=None, gt=0, le=5000, description="mass")
+
+
+_Part = Literal[
+    "sun_eccentricity",
+    "sun_assembly",
+    "planet_eccentricity",
+    "cam",
+    "disc_crank_bore",
+    "carrier_crank_bore",
+    "output_assembly",
+]
+assert set(ERROR_PARTS) == set(_Part.__args__)  # noqa: S101 - one list of parts
 
 
 class ErrorSection(StrictModel):
-    part: Literal["planet_base_circle", "disc_crank_bore", "cam", "carrier_crank_bore"]
-    crank: int = Field(ge=1, description="1-based crank (= planet) index")
+    """One eccentricity error: its part, where it sits, magnitude and angle in the part's frame."""
+
+    part: _Part
+    crank: int | None = Field(default=None, ge=1, description="1-based crank (= planet) index")
     disc: int | None = Field(default=None, ge=1, description="1-based disc index")
     value_um: float = Field(ge=0, le=500)
     angle_deg: float = Field(ge=-360, le=360)
 
 
+class DynamicsSection(StrictModel):
+    """What only the dynamics needs; masses and inertias left out are derived from geometry."""
+
+    sun_mass_kg: float | None = Field(default=None, gt=0, le=1e3)
+    planet_mass_kg: float | None = Field(default=None, gt=0, le=1e3)
+    crank_mass_kg: float | None = Field(default=None, gt=0, le=1e3)
+    disc_mass_kg: float | None = Field(default=None, gt=0, le=1e3)
+    output_mass_kg: float | None = Field(default=None, gt=0, le=1e4)
+    sun_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e3)
+    planet_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e3)
+    crank_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e3)
+    disc_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e3)
+    output_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e4)
+    input_torsional_stiffness_Nm_per_rad: float = Field(gt=0, le=1e9)  # noqa: N815
+    crank_torsional_stiffness_Nm_per_rad: float = Field(gt=0, le=1e9)  # noqa: N815
+    crank_bending_stiffness_N_per_mm: float = Field(gt=0, le=1e10)  # noqa: N815
+    damping_ratio: float = Field(gt=0, lt=1, description="ζ of the lowest elastic mode")
+    cycloid_stiffness: Literal["fourier", "mean"] = Field(
+        "fourier", description="time-varying k_cr (Fourier) or its mean (as Li 2023 §4.1)"
+    )
+    cycloid_mesh_stiffness_N_per_mm: float | None = Field(  # noqa: N815
+        None, gt=0, le=1e10, description="override of the mean k_cr from the loaded contact"
+    )
+    cycloid_pressure_angle_deg: float | None = Field(
+        None, ge=0, lt=90, description="override of the equivalent pressure angle β"
+    )
+    involute_harmonics: int = Field(10, ge=1, le=60)
+    cycloid_harmonics: int = Field(8, ge=1, le=30)
+
+    def given(self, what: str) -> dict[str, float]:
+        """Given masses (``what="mass"``, [kg]) or inertias (``"inertia"``, [kg·m²]) by body."""
+        suffix = "_mass_kg" if what == "mass" else "_inertia_kgm2"
+        out = {}
+        for body in ("sun", "planet", "crank", "disc", "output"):
+            v = getattr(self, body + suffix)
+            if v is not None:
+                out[body] = v
+        return out
+
+
 class ReducerSection(StrictModel):
-    rated_torque_Nm: float = Field(gt=0, le=1e6)
+    rated_torque_Nm: float | None = Field(
+        default=None, gt=0, le=1e6, description="catalogue rated torque (virtual torsion test)"
+    )
+    contact_law: Literal["line_contact", "hu2020"] = Field(
+        default="line_contact",
+        description="pin-contact law: textbook line contact, or Hu 2020 eq 38-39 as printed",
+    )
+    material: Literal["steel"] | None = Field(
+        default=None, description="names the density of derived masses (steel: 7850 kg/m³)"
+    )
+    density_kg_per_m3: float | None = Field(default=None, gt=100, le=30000)
     first_stage: FirstStageSection
     cranks: CranksSection
     discs: DiscsSection
     pins: PinsSection
     supports: SupportsSection
     errors: list[ErrorSection] = Field(default_factory=list)
+    cycloid_errors: CycloidErrors | None = None
+    dynamics: DynamicsSection | None = None
 
     @model_validator(mode="after")
     def _build(self):
         problems = []
+        if self.material is not None and self.density_kg_per_m3 is not None:
+            problems.append("give material or density_kg_per_m3, not both")
         if self.first_stage.planets != self.cranks.count:
             problems.append(
                 f"first_stage.planets = {self.first_stage.planets}: must equal cranks.count = "
@@ -191,6 +310,20 @@ class ReducerSection(StrictModel):
         if problems:
             raise ValueError("; ".join(problems))
         return self
+
+    @property
+    def density(self) -> float | None:
+        """Density of derived masses [kg/m³], from ``density_kg_per_m3`` or ``material``."""
+        if self.density_kg_per_m3 is not None:
+            return self.density_kg_per_m3
+        return None if self.material is None else MATERIAL_DENSITY_KG_PER_M3[self.material]
+
+
+class OperationSection(StrictModel):
+    """Operating point of the dynamic analyses."""
+
+    input_speed_rpm: float = Field(gt=0, le=2e4)
+    output_torque_Nm: float = Field(gt=0, le=1e6)  # noqa: N815
 
 
 class LoadSharingSection(StrictModel):
@@ -255,16 +388,64 @@ class CompensationSection(StrictModel):
     bounds_um: Bounds
 
 
+class ToothContactSection(StrictModel):
+    """Loaded tooth contact of one disc (Hu 2020 section 4); material from ``[reducer.discs]``."""
+
+    torque_Nm: float = Field(gt=0, le=1e6, description="output torque of the stage T [N·m]")
+    disc_share: float = Field(gt=0, le=1, description="share of T carried by the analysed disc")
+    mesh_positions: int = Field(default=1, ge=1, le=100000)
+    start_force_N: float | None = Field(default=None, gt=0, le=1e9)
+    clearance_model: Literal["eq32", "envelope"] = "eq32"
+
+
 class Analyses(StrictModel):
     load_sharing: LoadSharingSection | None = None
     transmission_error: TESection | None = None
     catalogue: CatalogueSection | None = None
     compensation: CompensationSection | None = None
+    geometric_te: GeometricTEOptions | None = None
+    tooth_contact: ToothContactSection | None = None
+    cycloid_compensation: CycloidCompensationOptions | None = None
+    contact: dyn.ContactOptions | None = None
+    modal: dyn.ModalOptions | None = None
+    dte: dyn.DTEOptions | None = None
+    speed_sweep: dyn.SpeedSweepOptions | None = None
+    batch: dyn.BatchOptions | None = None
+
+
+#: The inputs each analysis needs beyond the reducer's required sections.
+_NEEDS = {
+    "catalogue": ("reducer.rated_torque_Nm",),
+    "compensation": ("reducer.rated_torque_Nm",),
+    "geometric_te": ("reducer.cycloid_errors",),
+    "cycloid_compensation": ("reducer.cycloid_errors",),
+    **{k: ("reducer.dynamics", "operation") for k in dyn.ANALYSES},
+}
 
 
 class Case(CaseBase):
     reducer: ReducerSection
+    operation: OperationSection | None = None
     analyses: Analyses
+
+    @model_validator(mode="after")
+    def _inputs(self):
+        have = {
+            "reducer.rated_torque_Nm": self.reducer.rated_torque_Nm is not None,
+            "reducer.cycloid_errors": self.reducer.cycloid_errors is not None,
+            "reducer.dynamics": self.reducer.dynamics is not None,
+            "operation": self.operation is not None,
+        }
+        problems = [
+            f"analyses.{name} needs {key}, which the case does not give"
+            for name, keys in _NEEDS.items()
+            if getattr(self.analyses, name) is not None
+            for key in keys
+            if not have[key]
+        ]
+        if problems:
+            raise ValueError("; ".join(problems))
+        return self
 
 
 # ------------------------------------------------------------------------------------------
@@ -285,6 +466,7 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         deg_to_rad(fs.pressure_angle_deg),
         mesh,
         fs.sun_support_stiffness_N_per_mm,
+        fs.face_width_mm,
     )
     c = sec.cranks
     cranks = Cranks(
@@ -295,6 +477,8 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         c.carrier_bearing.stiffness(),
         um_to_mm(c.cam_bearing.radial_clearance_um),
         um_to_mm(c.carrier_bearing.radial_clearance_um),
+        c.shaft_diameter_mm,
+        c.shaft_length_mm,
     )
     d = sec.discs
     discs = Discs(
@@ -304,6 +488,8 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         d.shift_modification_mm,
         d.youngs_modulus_MPa,
         d.poisson_ratio,
+        d.crank_bore_diameter_mm,
+        d.centre_bore_diameter_mm,
     )
     p = sec.pins
 
@@ -318,6 +504,13 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         arr(p.radial_position_errors_um),
         arr(p.tangential_position_errors_um),
     )
+    s = sec.supports
+    supports = Supports(
+        s.carrier_radial_stiffness_N_per_mm,
+        um_to_mm(s.main_bearing_clearance_um),
+        s.carrier_outer_diameter_mm,
+        s.carrier_length_mm,
+    )
     entries = [
         ErrorEntry(e.part, e.crank, e.disc, um_to_mm(e.value_um), deg_to_rad(e.angle_deg))
         for e in sec.errors
@@ -330,8 +523,8 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         cranks,
         discs,
         pins,
-        Supports(sec.supports.carrier_radial_stiffness_N_per_mm),
-        Nm_to_Nmm(sec.rated_torque_Nm),
+        supports,
+        None if sec.rated_torque_Nm is None else Nm_to_Nmm(sec.rated_torque_Nm),
         planets=fs.planets,
         errors=errors,
     )
@@ -341,16 +534,60 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
     return red
 
 
+def build_stage_case(case: Case):
+    """The ``cycloid_stage`` case of the reducer's cycloid–pin stage (same geometry, same errors).
+
+    The reducer's cycloid analyses (geometric TE, sensitivity, tooth contact, compensation) run
+    through the ``cycloid_stage`` kind on this case, so both kinds build the same
+    :class:`~gearte.geometry.cycloid.CycloidStage` from the same numbers.
+    """
+    from gearte.studies import cycloid_stage as cs
+
+    r, a = case.reducer, case.analyses
+    stage = cs.Stage(
+        pins=r.pins.count,
+        cycloid_teeth=r.pins.count - 1,
+        pin_circle_radius_mm=r.pins.circle_radius_mm,
+        pin_radius_mm=r.pins.pin_radius_mm,
+        eccentricity_mm=r.cranks.eccentricity_mm,
+        face_width_mm=r.discs.face_width_mm,
+        equidistant_modification_mm=r.discs.equidistant_modification_mm,
+        shifted_modification_mm=r.discs.shift_modification_mm,
+    )
+    tc = None
+    if a.tooth_contact is not None:
+        t = a.tooth_contact
+        tc = cs.ToothContactOptions(
+            torque_Nm=t.torque_Nm,
+            disc_share=t.disc_share,
+            youngs_modulus_MPa=r.discs.youngs_modulus_MPa,
+            poisson_ratio=r.discs.poisson_ratio,
+            mesh_positions=t.mesh_positions,
+            start_force_N=t.start_force_N,
+            clearance_model=t.clearance_model,
+        )
+    return cs.Case(
+        case=case.case.model_copy(update={"kind": "cycloid_stage"}),
+        stage=stage,
+        errors=r.cycloid_errors if r.cycloid_errors is not None else cs.Errors(),
+        analyses=cs.Analyses(
+            geometric_te=a.geometric_te,
+            tooth_contact=tc,
+            compensation=a.cycloid_compensation,
+        ),
+    )
+
+
 # ------------------------------------------------------------------------------------------
 # Run
 # ------------------------------------------------------------------------------------------
-def _load_sharing(red, red0, sec: LoadSharingSection) -> AnalysisResult:
+def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
     from gearte.models.cycloid_contact import tooth_contact
     from gearte.models.rv_load_sharing import cycloid_stage, load_sharing, output_positions
 
     th = output_positions(sec.positions)
     T = Nm_to_Nmm(sec.torque_Nm)
-    ls = load_sharing(red, T, th)
+    ls = load_sharing(red, T, th, law=law)
     has_errors = red0 is not None
     p_peak = np.unravel_index(np.argmax(ls.pin_force), ls.pin_force.shape)
     values = {
@@ -373,7 +610,7 @@ def _load_sharing(red, red0, sec: LoadSharingSection) -> AnalysisResult:
         "contacts with the Hu 2020 load-dependent stiffness), one output revolution.",
     ]
     if has_errors and sec.compare_without_errors:
-        ls0 = load_sharing(red0, T, th)
+        ls0 = load_sharing(red0, T, th, law=law)
         values.update(
             {
                 "peak_pin_load_without_errors [N]": ls0.peak_pin_load,
@@ -417,12 +654,12 @@ def _pin_csv(ls) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _transmission_error(red, sec: TESection) -> AnalysisResult:
+def _transmission_error(red, sec: TESection, law) -> AnalysisResult:
     from gearte.models.rv_load_sharing import output_positions, transmission_error
 
     th = output_positions(sec.positions)
     te = transmission_error(
-        red, Nm_to_Nmm(sec.torque_Nm), th, zero_load_fraction=sec.zero_load_fraction
+        red, Nm_to_Nmm(sec.torque_Nm), th, zero_load_fraction=sec.zero_load_fraction, law=law
     )
     pp = te.peak_to_peak
     values = {
@@ -468,7 +705,7 @@ def _te_csv(te) -> str:
     return "\n".join(rows) + "\n"
 
 
-def _catalogue(red, sec: CatalogueSection) -> AnalysisResult:
+def _catalogue(red, sec: CatalogueSection, law) -> AnalysisResult:
     from gearte.models.rv_catalogue import catalogue_values
 
     cat = catalogue_values(
@@ -477,6 +714,7 @@ def _catalogue(red, sec: CatalogueSection) -> AnalysisResult:
         turning_points=sec.torque_sweep,
         steps_per_segment=sec.steps_per_segment,
         lost_motion_fraction=sec.lost_motion_fraction,
+        law=law,
     )
     values = {
         "torsional_rigidity [N*m/arcmin]": cat.torsional_rigidity / 1e3 / rad_to_arcmin(1.0),
@@ -544,22 +782,57 @@ def _compensation(red, sec: CompensationSection) -> AnalysisResult:
     )
 
 
+def _cycloid_analyses(case: Case, options) -> tuple[list[AnalysisResult], list[str]]:
+    """Geometry, geometric TE, tooth contact and compensation of the cycloid stage.
+
+    Run by the ``cycloid_stage`` kind on :func:`build_stage_case`; the stage's compensation is
+    reported as ``cycloid_compensation`` beside the whole reducer's ``compensation``.
+    """
+    from dataclasses import replace
+
+    from gearte.studies import cycloid_stage as cs
+
+    res = cs.run(build_stage_case(case), options)
+    out = []
+    for a in res.analyses:
+        if a.name == "compensation":
+            a = replace(a, name="cycloid_compensation")
+        out.append(a)
+    return out, list(res.warnings)
+
+
 def run(case: Case, options=None) -> StudyResult:
-    """Run the analyses a case asks for."""
+    """Run the analyses a case asks for; every one reads the same :class:`RVReducer`."""
+    from gearte.models.rv_load_sharing import contact_law
+
     red = build_reducer(case.reducer)
-    has_errors = len(case.reducer.errors) > 0
+    has_errors = bool(case.reducer.errors)
     red0 = build_reducer(case.reducer, with_errors=False) if has_errors else None
+    law = contact_law(red, kind=case.reducer.contact_law)
     a = case.analyses
     out: list[AnalysisResult] = []
+    warnings: list[str] = []
     if a.load_sharing is not None:
-        out.append(_load_sharing(red, red0, a.load_sharing))
+        out.append(_load_sharing(red, red0, a.load_sharing, law))
     if a.transmission_error is not None:
-        out.append(_transmission_error(red, a.transmission_error))
+        out.append(_transmission_error(red, a.transmission_error, law))
     if a.catalogue is not None:
-        out.append(_catalogue(red, a.catalogue))
+        out.append(_catalogue(red, a.catalogue, law))
     if a.compensation is not None:
         out.append(_compensation(red, a.compensation))
-    warnings = []
+    if any(getattr(a, k) is not None for k in ("geometric_te", "tooth_contact")) or (
+        a.cycloid_compensation is not None
+    ):
+        got, w = _cycloid_analyses(case, options)
+        out += got
+        warnings += w
+    if any(getattr(a, k) is not None for k in dyn.ANALYSES):
+        got, w = dyn.run_dynamics(case, red, options)
+        out += got
+        warnings += w
+    for r in out:
+        if r.name in ("load_sharing", "transmission_error", "catalogue", "compensation"):
+            r.values["contact_law"] = case.reducer.contact_law
     if not out:
         warnings.append("no analyses requested: add [analyses.load_sharing] etc.")
     return StudyResult(case=case, analyses=out, warnings=warnings)

@@ -1,4 +1,11 @@
-"""Study kind ``rv_dynamics``: RV reducer dynamics after Li et al. (2023), paper 004.
+"""The dynamic analyses of the ``rv_reducer`` kind (Li et al. 2023, paper 004).
+
+Not a kind of its own: :mod:`gearte.studies.rv_reducer` validates the case and calls
+:func:`run_dynamics`, which builds the lumped dynamic model from the same
+:class:`~gearte.geometry.rv.RVReducer` (geometry, stiffnesses, clearances, errors) every other
+RV analysis reads, plus what only the dynamics needs (``[reducer.dynamics]``: masses and inertias
+— derived from geometry and density when left out —, torsional and bending stiffnesses, damping;
+``[operation]``: speed and torque).
 
 Analyses:
 * ``contact``   loaded contact of the cycloid–pin pair over one mesh period (and vs load):
@@ -17,113 +24,23 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gearte.io.schema import CaseBase, StrictModel
-from gearte.results import AnalysisResult, StudyResult
+from gearte.geometry.rv import RVReducer, mass_properties
+from gearte.io.schema import StrictModel
+from gearte.results import AnalysisResult
 
-KIND = "rv_dynamics"
-REFERENCES = ["li2023"]
-FIGURES = "gearte.plotting.rv_dynamics"
+__all__ = [
+    "ANALYSES",
+    "ContactOptions",
+    "ModalOptions",
+    "DTEOptions",
+    "SpeedSweepOptions",
+    "BatchOptions",
+    "build_dynamic_model",
+    "run_dynamics",
+]
 
-
-class Reducer(StrictModel):
-    """Geometry of the RV reducer (paper 004 Table 1)."""
-
-    sun_teeth: int = Field(12, ge=6, le=200, description="z_s")
-    planet_teeth: int = Field(36, ge=6, le=400, description="z_pl")
-    module_mm: float = Field(1.5, gt=0, le=20, description="involute module [mm]")
-    pressure_angle_deg: float = Field(20.0, gt=10, lt=35, description="α [deg]")
-    crank_count: int = Field(3, ge=2, le=6, description="M, cranks/planets")
-    disc_count: int = Field(2, ge=1, le=3, description="N, cycloid discs")
-    pin_count: int = Field(40, ge=6, le=200, description="z_p; the disc has z_p − 1 teeth")
-    pin_radius_mm: float = Field(3.0, gt=0, le=50, description="r_rp [mm]")
-    pin_circle_radius_mm: float = Field(85.8, gt=0, le=2000, description="r_p [mm]")
-    eccentricity_mm: float = Field(1.3, gt=0, le=50, description="e [mm]")
-    face_width_mm: float = Field(12.0, gt=0, le=500, description="B [mm]")
-    youngs_modulus_MPa: float = Field(2.06e5, gt=1e3, le=1e6, description="E [MPa]")  # noqa: N815
-    poisson_ratio: float = Field(0.3, ge=0, lt=0.5, description="ν")
-
-    @model_validator(mode="after")
-    def _k1(self):
-        k1 = self.eccentricity_mm * self.pin_count / self.pin_circle_radius_mm
-        if not k1 < 1:
-            raise ValueError(
-                f"K1 = eccentricity_mm·pin_count/pin_circle_radius_mm = {k1:.4f} must be < 1"
-            )
-        return self
-
-
-class Modification(StrictModel):
-    """Cycloid profile modification (paper 004 §4.1: −0.01 radius, −0.05 position)."""
-
-    pin_radius_mm: float = Field(0.0, ge=-0.5, le=0.5, description="Δr_rp [mm]")
-    pin_position_mm: float = Field(0.0, ge=-0.5, le=0.5, description="Δr_p [mm]")
-
-
-class Dynamics(StrictModel):
-    """Table 2 masses, inertias and stiffnesses; assumed values where the paper gives none."""
-
-    sun_mass_kg: float = Field(1.3, gt=0, le=1e3)
-    planet_mass_kg: float = Field(0.88, gt=0, le=1e3)
-    crank_mass_kg: float = Field(0.4, gt=0, le=1e3)
-    disc_mass_kg: float = Field(2.76, gt=0, le=1e3)
-    output_mass_kg: float = Field(15.33, gt=0, le=1e4)
-    sun_inertia_kgm2: float = Field(4.44e-4, gt=0, le=1e3)
-    planet_inertia_kgm2: float = Field(1.01e-3, gt=0, le=1e3)
-    crank_inertia_kgm2: float = Field(7.56e-5, gt=0, le=1e3)
-    disc_inertia_kgm2: float = Field(0.0209, gt=0, le=1e3)
-    output_inertia_kgm2: float = Field(0.106, gt=0, le=1e4)
-    input_torsional_stiffness_Nm_per_rad: float = Field(1.16e4, gt=0, le=1e9)  # noqa: N815
-    sun_support_stiffness_N_per_m: float = Field(4.68e7, gt=0, le=1e12)  # noqa: N815
-    crank_torsional_stiffness_Nm_per_rad: float = Field(6.99e4, gt=0, le=1e9)  # noqa: N815
-    crank_bending_stiffness_N_per_m: float = Field(5.55e8, gt=0, le=1e12)  # noqa: N815
-    crank_bearing_stiffness_N_per_m: float = Field(5.76e8, gt=0, le=1e12)  # noqa: N815
-    turning_arm_bearing_stiffness_N_per_m: float = Field(2.84e8, gt=0, le=1e12)  # noqa: N815
-    output_support_stiffness_N_per_m: float = Field(3.15e8, gt=0, le=1e12)  # noqa: N815
-    involute_single_pair_stiffness_N_per_m: float = Field(  # noqa: N815
-        1.4e8, gt=0, le=1e12, description="assumed (ISO 6336 c' × 10 mm face width)"
-    )
-    damping_ratio: float = Field(0.03, gt=0, lt=1, description="ζ of the lowest elastic mode")
-    cycloid_stiffness: Literal["fourier", "mean"] = Field(
-        "fourier", description="time-varying k_cr (Fourier) or its mean (as the paper)"
-    )
-    cycloid_mesh_stiffness_N_per_m: float | None = Field(  # noqa: N815
-        None, gt=0, le=1e12, description="override of the mean k_cr (paper prints 2.62e8)"
-    )
-    cycloid_pressure_angle_deg: float | None = Field(
-        None, ge=0, lt=90, description="override of the equivalent pressure angle β"
-    )
-    involute_harmonics: int = Field(10, ge=1, le=60)
-    cycloid_harmonics: int = Field(8, ge=1, le=30)
-
-
-class Operation(StrictModel):
-    input_speed_rpm: float = Field(1500.0, gt=0, le=2e4)
-    output_torque_Nm: float = Field(450.0, gt=0, le=1e5)  # noqa: N815
-
-
-class ErrorValue(StrictModel):
-    amplitude_mm: float = Field(ge=0, le=1.0)
-    phase_deg: float = Field(ge=-360, le=360)
-
-
-class Errors(StrictModel):
-    """Table 3 errors and bearing clearances; ``placement`` says which crank/disc carries them."""
-
-    placement: Literal["first", "all"] = Field(
-        "first",
-        description="'first': per-crank errors on crank 1, per-disc errors on disc 1 of crank 1; "
-        "'all': the same error on every crank and disc",
-    )
-    sun_eccentricity: ErrorValue = ErrorValue(amplitude_mm=0.005, phase_deg=45)
-    planet_eccentricity: ErrorValue = ErrorValue(amplitude_mm=0.006, phase_deg=30)
-    sun_assembly: ErrorValue = ErrorValue(amplitude_mm=0.005, phase_deg=100)
-    disc_hole: ErrorValue = ErrorValue(amplitude_mm=0.008, phase_deg=140)
-    cam: ErrorValue = ErrorValue(amplitude_mm=0.008, phase_deg=90)
-    carrier_hole: ErrorValue = ErrorValue(amplitude_mm=0.035, phase_deg=270)
-    output_assembly: ErrorValue = ErrorValue(amplitude_mm=0.038, phase_deg=90)
-    turning_arm_clearance_mm: float = Field(0.0, ge=0, le=0.1)
-    crank_bearing_clearance_mm: float = Field(0.0, ge=0, le=0.1)
-    output_bearing_clearance_mm: float = Field(0.0, ge=0, le=0.1)
+#: The analyses of this module, in the order they run.
+ANALYSES = ("contact", "modal", "dte", "speed_sweep", "batch")
 
 
 class ContactOptions(StrictModel):
@@ -185,106 +102,73 @@ class BatchOptions(StrictModel):
     tolerance_scale: float = Field(1.0, gt=0, le=10, description="× Table 3 amplitudes")
 
 
-class Analyses(StrictModel):
-    contact: ContactOptions | None = None
-    modal: ModalOptions | None = None
-    dte: DTEOptions | None = None
-    speed_sweep: SpeedSweepOptions | None = None
-    batch: BatchOptions | None = None
+# --- building the dynamic model from the one description -------------------------------------
+def build_dynamic_model(case, red: RVReducer):
+    """The :class:`~gearte.models.rv_dynamics.RVDynamicModel` of an ``rv_reducer`` case.
 
+    Geometry, stiffnesses, clearances and errors come from ``red`` (the description every RV
+    analysis reads); masses and inertias from ``[reducer.dynamics]`` or, when left out, from
+    geometry and density (:func:`gearte.geometry.rv.mass_properties`).
 
-class Case(CaseBase):
-    reducer: Reducer = Reducer()
-    modification: Modification = Modification()
-    dynamics: Dynamics = Dynamics()
-    operation: Operation = Operation()
-    errors: Errors | None = None
-    analyses: Analyses = Analyses(contact=ContactOptions(), modal=ModalOptions(), dte=DTEOptions())
-
-
-# --- building the domain objects -----------------------------------------------------------
-def build_parameters(case: Case, **overrides):
-    """RVDynamicsParameters of a case (the CLI and the API build the same object)."""
-    from gearte.models.cycloid_loaded_contact import CycloidPinPair
-    from gearte.models.rv_dynamics import RVDynamicsParameters
-
-    r, mo, d, op = case.reducer, case.modification, case.dynamics, case.operation
-    pair = CycloidPinPair(
-        pin_count=r.pin_count,
-        pin_radius_mm=r.pin_radius_mm,
-        pin_circle_radius_mm=r.pin_circle_radius_mm,
-        eccentricity_mm=r.eccentricity_mm,
-        face_width_mm=r.face_width_mm,
-        youngs_modulus_MPa=r.youngs_modulus_MPa,
-        poisson_ratio=r.poisson_ratio,
-        pin_radius_modification_mm=mo.pin_radius_mm,
-        pin_position_modification_mm=mo.pin_position_mm,
+    Returns
+    -------
+    (RVDynamicModel, MassProperties)
+    """
+    from gearte.models.rv_dynamics import (
+        RVDynamicModel,
+        errors_from_reducer,
+        parameters_from_reducer,
     )
-    kw = dict(
-        sun_teeth=r.sun_teeth,
-        planet_teeth=r.planet_teeth,
-        module_mm=r.module_mm,
-        pressure_angle_deg=r.pressure_angle_deg,
-        crank_count=r.crank_count,
-        disc_count=r.disc_count,
-        pair=pair,
+
+    d, op = case.reducer.dynamics, case.operation
+    mp = mass_properties(red, case.reducer.density, d.given("mass"), d.given("inertia"))
+    kw = {f"{b}_mass_kg": v for b, v in mp.mass_kg.items()}
+    kw.update({f"{b}_inertia_kgm2": v for b, v in mp.inertia_kgm2.items()})
+    kw.update(
+        input_torsional_stiffness_Nm_per_rad=d.input_torsional_stiffness_Nm_per_rad,
+        crank_torsional_stiffness_Nm_per_rad=d.crank_torsional_stiffness_Nm_per_rad,
+        crank_bending_stiffness_N_per_m=d.crank_bending_stiffness_N_per_mm * 1e3,
+        damping_ratio=d.damping_ratio,
+        cycloid_stiffness=d.cycloid_stiffness,
+        cycloid_mesh_stiffness_N_per_m=None
+        if d.cycloid_mesh_stiffness_N_per_mm is None
+        else d.cycloid_mesh_stiffness_N_per_mm * 1e3,
+        cycloid_pressure_angle_deg=d.cycloid_pressure_angle_deg,
+        involute_harmonics=d.involute_harmonics,
+        cycloid_harmonics=d.cycloid_harmonics,
         input_speed_rpm=op.input_speed_rpm,
         output_torque_Nm=op.output_torque_Nm,
-        **d.model_dump(),
     )
     if case.analyses.contact is not None:
         kw["contact_positions"] = case.analyses.contact.positions
-    kw.update(overrides)
-    return RVDynamicsParameters(**kw)
+    params = parameters_from_reducer(red, **kw)
+    e = red.errors
 
+    def polar(v):
+        return (float(np.hypot(v[0], v[1])), float(np.arctan2(v[1], v[0])))
 
-def build_errors(case: Case, scale: float = 1.0):
-    """RVErrors of a case (None section → no errors)."""
-    from gearte.models.rv_dynamics import RVErrors
-
-    m, n = case.reducer.crank_count, case.reducer.disc_count
-    e = case.errors
-    if e is None:
-        return RVErrors(crank_count=m, disc_count=n)
-    mask_m = np.zeros(m)
-    mask_mn = np.zeros((m, n))
-    if e.placement == "first":
-        mask_m[0], mask_mn[0, 0] = 1.0, 1.0
-    else:
-        mask_m[:], mask_mn[:] = 1.0, 1.0
-
-    def one(v):
-        return (scale * v.amplitude_mm, np.deg2rad(v.phase_deg))
-
-    def arr(v, mask):
-        return np.stack(
-            [scale * v.amplitude_mm * mask, np.full(mask.shape, np.deg2rad(v.phase_deg))], -1
-        )
-
-    return RVErrors(
-        crank_count=m,
-        disc_count=n,
-        sun_eccentricity=one(e.sun_eccentricity),
-        sun_assembly=one(e.sun_assembly),
-        output_assembly=one(e.output_assembly),
-        planet_eccentricity=arr(e.planet_eccentricity, mask_m),
-        carrier_hole=arr(e.carrier_hole, mask_m),
-        disc_hole=arr(e.disc_hole, mask_mn),
-        cam=arr(e.cam, mask_mn),
-        turning_arm_clearance_mm=e.turning_arm_clearance_mm,
-        crank_bearing_clearance_mm=e.crank_bearing_clearance_mm,
-        output_bearing_clearance_mm=e.output_bearing_clearance_mm,
+    errors = errors_from_reducer(
+        red,
+        sun_eccentricity=polar(e.sun),
+        sun_assembly=polar(e.sun_seat),
+        output_assembly=polar(e.output_seat),
+        output_bearing_clearance_mm=red.supports.main_bearing_clearance,
     )
+    return RVDynamicModel(params, errors), mp
+
+
+def _has_errors(red: RVReducer) -> bool:
+    return any(v > 0 for v in red.errors.amplitudes().values())
 
 
 # --- analyses --------------------------------------------------------------------------------
-def _contact(case: Case, model) -> AnalysisResult:
+def _contact(case, model) -> AnalysisResult:
     from gearte.models.cycloid_loaded_contact import mesh_period_contact
 
     c = model.contact
     pair = model.params.pair
     opts = case.analyses.contact
-    t_disc = case.operation.output_torque_Nm / case.reducer.disc_count
+    t_disc = case.operation.output_torque_Nm / case.reducer.discs.count
     sweep = []
     for tq in opts.load_sweep_Nm:
         mp = mesh_period_contact(pair, tq * 1e3, min(opts.positions, 24))
@@ -338,7 +222,7 @@ def _contact(case: Case, model) -> AnalysisResult:
     )
 
 
-def _modal(case: Case, model, warnings: list[str]) -> AnalysisResult:
+def _modal(case, model, mp, warnings: list[str]) -> AnalysisResult:
     opts = case.analyses.modal
     modal = model.modal()
     free = model.modal(input_shaft=False)
@@ -376,6 +260,9 @@ def _modal(case: Case, model, warnings: list[str]) -> AnalysisResult:
         "mesh_frequencies [Hz]": model.params.frequencies(),
         "damping_coefficient [s]": model.damping_coefficient,
         "resonance_warnings": res_msgs,
+        "mass [kg]": mp.mass_kg,
+        "inertia [kg*m^2]": mp.inertia_kgm2,
+        "derived_mass_properties": list(mp.derived),
     }
     return AnalysisResult(
         name="modal",
@@ -389,6 +276,10 @@ def _modal(case: Case, model, warnings: list[str]) -> AnalysisResult:
             "ratio and the disc must rotate with the output.",
             f"Stiffness-proportional damping c = β_R k with β_R = 2ζ/ω_1, ζ = "
             f"{model.params.damping_ratio:g}.",
+            "Masses and inertias of "
+            + (", ".join(mp.derived) if mp.derived else "no body")
+            + " derived from geometry and density (solid bodies of revolution, "
+            "gearte.geometry.rv.mass_properties); the others as the case gives them.",
         ],
         data={
             "modal": modal,
@@ -399,7 +290,7 @@ def _modal(case: Case, model, warnings: list[str]) -> AnalysisResult:
     )
 
 
-def _dte(case: Case, model, warnings: list[str]) -> AnalysisResult:
+def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
     from gearte.models.rv_dynamics_sim import default_step, dte_spectrum, simulate_dte
 
     opts = case.analyses.dte
@@ -440,11 +331,11 @@ def _dte(case: Case, model, warnings: list[str]) -> AnalysisResult:
         "harmonic of a rotation or mesh frequency, or a mesh ± rotation sideband.",
         "Paper 004 Fig 11: 0.78″ without errors, 17.25″ with errors (bench 22.56″/23.37″).",
     ]
-    if case.errors is not None:
+    if _has_errors(red):
         notes.append(
-            f"Table 3 errors placed '{case.errors.placement}' (see the case's [errors] section)."
+            "Errors: the case's [[reducer.errors]], the same the quasi-static model reads."
         )
-    if opts.duration_s * sources["output rotation"] < 0.99 and case.errors is not None:
+    if opts.duration_s * sources["output rotation"] < 0.99 and _has_errors(red):
         warnings.append(
             "dte: the simulated span is shorter than one output revolution; errors that rotate "
             "with the output are not fully sampled by the peak-to-peak"
@@ -467,7 +358,7 @@ def _sweep_one(task) -> float:
     return simulate_dte(m, duration, settle_s=settle, record_dt=None).peak_to_peak
 
 
-def _speed_sweep(case: Case, model, options) -> AnalysisResult:
+def _speed_sweep(case, model, options) -> AnalysisResult:
     from gearte.execution import map_chunks
 
     o = case.analyses.speed_sweep
@@ -517,30 +408,28 @@ def _speed_sweep(case: Case, model, options) -> AnalysisResult:
     )
 
 
-def _batch(case: Case, model, options) -> AnalysisResult:
+def _batch(case, red, model, options) -> AnalysisResult:
     from gearte.models.rv_dynamics_sim import ErrorTolerances, dte_batch
 
     b = case.analyses.batch
-    e = case.errors or Errors()
+    amp = red.errors.amplitudes()
     s = b.tolerance_scale
     tol = ErrorTolerances(
-        sun_eccentricity=s * e.sun_eccentricity.amplitude_mm,
-        planet_eccentricity=s * e.planet_eccentricity.amplitude_mm,
-        sun_assembly=s * e.sun_assembly.amplitude_mm,
-        disc_hole=s * e.disc_hole.amplitude_mm,
-        cam=s * e.cam.amplitude_mm,
-        carrier_hole=s * e.carrier_hole.amplitude_mm,
-        output_assembly=s * e.output_assembly.amplitude_mm,
+        sun_eccentricity=s * amp["sun_eccentricity"],
+        planet_eccentricity=s * amp["planet_eccentricity"],
+        sun_assembly=s * amp["sun_assembly"],
+        disc_hole=s * amp["disc_crank_bore"],
+        cam=s * amp["cam"],
+        carrier_hole=s * amp["carrier_crank_bore"],
+        output_assembly=s * amp["output_assembly"],
     )
     samples = options.samples or b.samples
     seed = options.seed if options.seed is not None else b.seed
-    clear = {}
-    if case.errors is not None:
-        clear = dict(
-            turning_arm_clearance_mm=e.turning_arm_clearance_mm,
-            crank_bearing_clearance_mm=e.crank_bearing_clearance_mm,
-            output_bearing_clearance_mm=e.output_bearing_clearance_mm,
-        )
+    clear = dict(
+        turning_arm_clearance_mm=red.cranks.cam_bearing_clearance,
+        crank_bearing_clearance_mm=red.cranks.carrier_bearing_clearance,
+        output_bearing_clearance_mm=red.supports.main_bearing_clearance,
+    )
     res = dte_batch(
         model,
         samples,
@@ -569,31 +458,29 @@ def _batch(case: Case, model, options) -> AnalysisResult:
         values=values,
         references=["li2023"],
         notes=[
-            "Each part's error amplitude uniform in [0, tolerance] (Table 3 amplitudes × "
-            f"{s:g}), phase uniform in [0, 2π), independently per crank and disc; seed {seed}.",
+            "Each part's error amplitude uniform in [0, tolerance] (the largest of the case's "
+            f"errors of that part × {s:g}), phase uniform in [0, 2π), independently per crank "
+            f"and disc; seed {seed}.",
             "Peak-to-peak over the simulated span after settling, reduced inside the kernel.",
         ],
         data={"rows": res["rows"]},
     )
 
 
-def run(case: Case, options) -> StudyResult:
-    """Run the analyses the case asks for."""
-    from gearte.models.rv_dynamics import RVDynamicModel
-
-    params = build_parameters(case)
-    model = RVDynamicModel(params, build_errors(case))
+def run_dynamics(case, red: RVReducer, options) -> tuple[list[AnalysisResult], list[str]]:
+    """Run the dynamic analyses an ``rv_reducer`` case asks for."""
+    model, mp = build_dynamic_model(case, red)
     warnings: list[str] = []
     analyses = []
     a = case.analyses
     if a.contact is not None:
         analyses.append(_contact(case, model))
     if a.modal is not None:
-        analyses.append(_modal(case, model, warnings))
+        analyses.append(_modal(case, model, mp, warnings))
     if a.dte is not None:
-        analyses.append(_dte(case, model, warnings))
+        analyses.append(_dte(case, red, model, warnings))
     if a.speed_sweep is not None:
         analyses.append(_speed_sweep(case, model, options))
     if a.batch is not None:
-        analyses.append(_batch(case, model, options))
-    return StudyResult(case=case, analyses=analyses, warnings=warnings)
+        analyses.append(_batch(case, red, model, options))
+    return analyses, warnings
