@@ -189,3 +189,63 @@ def test_same_cycloid_stage_in_every_analysis():
     for attr in ("K1", "rho0", "phi0", "backlash_per_flank", "r_c"):
         assert getattr(st_rv, attr) == getattr(st_kind, attr), attr
     assert red.K1 == st_rv.K1
+
+
+def _han_errors(extra: list[dict], **discs) -> dict:
+    data = _data("han2023_rv110e_no_errors")
+    data["reducer"]["errors"] = extra
+    data["reducer"]["discs"].update(discs)
+    return data
+
+
+def test_disc_profile_errors_change_the_pin_clearances_as_derived():
+    """Run-out acts like a translation of the disc's profile, the cumulative pitch deviation
+    s(ψ) like a local rotation s/r_c, a modification error like the modification itself."""
+    from gearte.models.rv_load_sharing import assemble
+    from gearte.studies.rv_reducer import build_reducer
+
+    th = np.array([0.0, 0.7])
+    base = assemble(build_reducer(load_case_dict(_han_errors([])).reducer), th)
+    runout = {"part": "disc_radial_runout", "disc": 1, "value_um": 10.0, "angle_deg": 0.0}
+    sys_r = assemble(build_reducer(load_case_dict(_han_errors([runout])).reducer), th)
+    n_pins = 40
+    dgap = sys_r.contact_gap - base.contact_gap
+    # disc 1 only; its change is -n . (10 um along the disc's x axis turned by th)
+    assert np.all(dgap[:, n_pins:] == 0)
+    u = 0.010 * np.stack([np.cos(th), np.sin(th)], -1)
+    dof = base.layout.disc(0)
+    normal = base.contact_B[:, :n_pins, dof : dof + 2]
+    np.testing.assert_allclose(dgap[:, :n_pins], -np.sum(normal * u[:, None, :], -1), atol=1e-15)
+    pitch = {"part": "disc_cumulative_pitch", "disc": 2, "value_um": 20.0, "angle_deg": 30.0}
+    sys_p = assemble(build_reducer(load_case_dict(_han_errors([pitch])).reducer), th)
+    dgap = sys_p.contact_gap - base.contact_gap
+    assert np.all(dgap[:, :n_pins] == 0) and np.any(dgap[:, n_pins:] != 0)
+    # at most the peak deviation (10 um) times the lever/pitch-radius ratio
+    assert np.max(np.abs(dgap)) <= 0.010 * 1.1
+    mod = build_reducer(
+        load_case_dict(_han_errors([], equidistant_modification_errors_um=[5.0, 0.0])).reducer
+    )
+    dgap = assemble(mod, th).contact_gap - base.contact_gap
+    np.testing.assert_allclose(dgap[:, :n_pins], 0.005, atol=1e-15)
+    assert np.all(dgap[:, n_pins:] == 0)
+
+
+def test_disc_profile_errors_raise_peak_pin_load():
+    from gearte.models.rv_load_sharing import load_sharing
+    from gearte.studies.rv_reducer import build_reducer
+
+    th = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    red0 = build_reducer(load_case_dict(_han_errors([])).reducer)
+    runout = {"part": "disc_radial_runout", "disc": 1, "value_um": 15.0, "angle_deg": 0.0}
+    red = build_reducer(load_case_dict(_han_errors([runout])).reducer)
+    assert (
+        load_sharing(red, 1.078e6, th).peak_pin_load > load_sharing(red0, 1.078e6, th).peak_pin_load
+    )
+
+
+def test_dynamics_refuse_disc_profile_errors_they_cannot_hold():
+    data = _han_errors([{"part": "disc_radial_runout", "disc": 1, "value_um": 5.0, "angle_deg": 0}])
+    data["analyses"] = {"modal": {}}
+    with pytest.raises(ParameterError) as exc:
+        run_case(load_case_dict(data), RunOptions(progress=False))
+    assert "disc_radial_runout" in str(exc.value)

@@ -52,6 +52,7 @@ unilateral pin-contact rows at any output angles, over the 3M + 3N + 5 displacem
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -383,13 +384,16 @@ ERROR_PARTS = (
     "planet_eccentricity",
     "cam",
     "disc_crank_bore",
+    "disc_radial_runout",
+    "disc_cumulative_pitch",
     "carrier_crank_bore",
     "output_assembly",
 )
 """Parts that carry an eccentricity error, in the order of the power flow."""
 
-_NO_CRANK = ("sun_eccentricity", "sun_assembly", "output_assembly")
-_NEEDS_DISC = ("disc_crank_bore", "cam")
+_DISC_ONLY = ("disc_radial_runout", "disc_cumulative_pitch")
+_NO_CRANK = ("sun_eccentricity", "sun_assembly", "output_assembly", *_DISC_ONLY)
+_NEEDS_DISC = ("disc_crank_bore", "cam", *_DISC_ONLY)
 
 
 def _zeros2() -> np.ndarray:
@@ -419,6 +423,16 @@ class ManufacturingErrors:
     output_seat : numpy.ndarray
         ``(2,)`` output assembly error (Li ``E_o``): fixed offset of the carrier's main-bearing
         seat, ground frame.
+    disc_runout : numpy.ndarray
+        ``(N, 2)`` radial run-out of disc ``j``'s tooth profile (Hu 2020 ``F_r``): offset of the
+        profile centre from the crank-bore pattern's centre, disc frame.
+    disc_pitch : numpy.ndarray
+        ``(N, 2)`` cumulative pitch error of disc ``j`` (Hu 2020 ``ΔF_p``): magnitude = the
+        peak-to-peak cumulative pitch deviation along the pitch circle [mm], read as one sine per
+        revolution ``s(ψ) = ΔF_p/2 · sin(ψ − angle)`` at the disc-frame angle ``ψ``.
+    disc_modification : numpy.ndarray
+        ``(N, 2)`` errors of disc ``j``'s equidistant and shifted modifications
+        ``(δΔr_rp, δΔr_p)`` [mm] (Hu 2020 Table 2 rows f, g per disc), added to the nominal ones.
     """
 
     planet: np.ndarray
@@ -428,6 +442,15 @@ class ManufacturingErrors:
     sun: np.ndarray = field(default_factory=_zeros2)
     sun_seat: np.ndarray = field(default_factory=_zeros2)
     output_seat: np.ndarray = field(default_factory=_zeros2)
+    disc_runout: np.ndarray | None = None
+    disc_pitch: np.ndarray | None = None
+    disc_modification: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        n = self.disc_bore.shape[0]
+        for name in ("disc_runout", "disc_pitch", "disc_modification"):
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, np.zeros((n, 2)))
 
     @classmethod
     def none(cls, n_cranks: int, n_discs: int) -> ManufacturingErrors:
@@ -486,6 +509,10 @@ class ManufacturingErrors:
                 out.sun_seat[:] = vec
             elif e.part == "output_assembly":
                 out.output_seat[:] = vec
+            elif e.part == "disc_radial_runout":
+                out.disc_runout[e.disc - 1] = vec
+            elif e.part == "disc_cumulative_pitch":
+                out.disc_pitch[e.disc - 1] = vec
             elif e.part == "planet_eccentricity":
                 out.planet[e.crank - 1] = vec
             elif e.part == "carrier_crank_bore":
@@ -506,7 +533,14 @@ class ManufacturingErrors:
             self.sun * factor,
             self.sun_seat * factor,
             self.output_seat * factor,
+            self.disc_runout * factor,
+            self.disc_pitch * factor,
+            self.disc_modification * factor,
         )
+
+    def with_disc_modification(self, errors: np.ndarray) -> ManufacturingErrors:
+        """Copy with per-disc modification errors ``(N, 2)`` = ``(δΔr_rp, δΔr_p)`` [mm]."""
+        return dataclasses.replace(self, disc_modification=np.asarray(errors, dtype=float))
 
     def amplitudes(self) -> dict[str, float]:
         """Largest magnitude of each part's error [mm] (the tolerance of a random batch)."""
@@ -520,6 +554,8 @@ class ManufacturingErrors:
             "planet_eccentricity": mx(self.planet),
             "cam": mx(self.cam),
             "disc_crank_bore": mx(self.disc_bore),
+            "disc_radial_runout": mx(self.disc_runout),
+            "disc_cumulative_pitch": mx(self.disc_pitch),
             "carrier_crank_bore": mx(self.carrier_bore),
             "output_assembly": mx(self.output_seat),
         }
@@ -596,6 +632,9 @@ class RVReducer:
             "errors.sun": (err.sun.shape, (2,)),
             "errors.sun_seat": (err.sun_seat.shape, (2,)),
             "errors.output_seat": (err.output_seat.shape, (2,)),
+            "errors.disc_runout": (err.disc_runout.shape, (n, 2)),
+            "errors.disc_pitch": (err.disc_pitch.shape, (n, 2)),
+            "errors.disc_modification": (err.disc_modification.shape, (n, 2)),
         }
         for name, (got, want) in shapes.items():
             if got != want:

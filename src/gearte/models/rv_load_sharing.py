@@ -343,15 +343,28 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
         cB[:, sl, dof + 1] = n[..., 1]
         cB[:, sl, dof + 2] = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
         phi = alpha_k[None, :] - ecc[:, j][:, None]
+        d_rp, d_p = err.disc_modification[j]
         gap = normal_clearance_unclosed(
             phi,
             z_p=zp,
             r_p=pins.circle_radius,
             a=a,
-            dr_rp=reducer.discs.equidistant_modification,
-            dr_p=reducer.discs.shift_modification,
+            dr_rp=reducer.discs.equidistant_modification + d_rp,
+            dr_p=reducer.discs.shift_modification + d_p,
         )
         gap = gap - pins.radius_errors[None, :] + np.sum(n * pin_err[None], axis=-1)
+        # disc profile errors (disc frame; the disc turns with the carrier, angle th):
+        # radial run-out moves the whole profile like a disc translation,
+        runout = _rot(np.broadcast_to(err.disc_runout[j], (P, 2)), th)
+        gap = gap - np.sum(n * runout[:, None, :], axis=-1)
+        # the cumulative pitch deviation s(psi) turns the flank at the contact like a local
+        # rotation s / r_c of the disc (psi: disc-frame angle of the contact point)
+        fp = np.hypot(*err.disc_pitch[j])
+        if fp > 0.0:
+            psi = np.arctan2(lever[..., 1], lever[..., 0]) - th[:, None]
+            ang = np.arctan2(err.disc_pitch[j, 1], err.disc_pitch[j, 0])
+            s_dev = 0.5 * fp * np.sin(psi - ang)
+            gap = gap - cB[:, sl, dof + 2] * s_dev / (a * zc)
         cg[:, sl] = gap
 
     unit = np.zeros(nd)

@@ -24,6 +24,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
+from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer, mass_properties
 from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult
@@ -121,6 +122,7 @@ def build_dynamic_model(case, red: RVReducer):
     )
 
     d, op = case.reducer.dynamics, case.operation
+    _check_representable(red)
     mp = mass_properties(red, case.reducer.density, d.given("mass"), d.given("inertia"))
     kw = {f"{b}_mass_kg": v for b, v in mp.mass_kg.items()}
     kw.update({f"{b}_inertia_kgm2": v for b, v in mp.inertia_kgm2.items()})
@@ -155,6 +157,27 @@ def build_dynamic_model(case, red: RVReducer):
         output_bearing_clearance_mm=red.supports.main_bearing_clearance,
     )
     return RVDynamicModel(params, errors), mp
+
+
+def _check_representable(red: RVReducer) -> None:
+    """The disc profile errors the quasi-static model reads but the dynamics cannot hold."""
+    amp = red.errors.amplitudes()
+    for part in ("disc_radial_runout", "disc_cumulative_pitch"):
+        if amp[part] > 0:
+            raise ParameterError(
+                "reducer.errors",
+                part,
+                "disc profile errors are read by the quasi-static analyses only: the dynamic "
+                "model has one equivalent cycloid–pin spring per disc and cannot hold them; "
+                "leave them out of a case that asks for dynamic analyses",
+            )
+    if np.any(red.errors.disc_modification != 0):
+        raise ParameterError(
+            "reducer.discs.equidistant_modification_errors_um/shift_modification_errors_um",
+            red.errors.disc_modification.tolist(),
+            "per-disc modification errors are read by the quasi-static analyses only (the "
+            "dynamic model's discs share one cycloid–pin pair)",
+        )
 
 
 def _has_errors(red: RVReducer) -> bool:

@@ -23,14 +23,18 @@ Case file layout (units in the keys)::
                                carrier_bearing = {...}
     [reducer.discs]            count, face_width_mm, equidistant_modification_mm,
                                shift_modification_mm, youngs_modulus_MPa, poisson_ratio,
-                               crank_bore_diameter_mm, centre_bore_diameter_mm
+                               crank_bore_diameter_mm, centre_bore_diameter_mm,
+                               equidistant_modification_errors_um,
+                               shift_modification_errors_um (one per disc)
     [reducer.pins]             count, pin_radius_mm, circle_radius_mm, radius_errors_um,
                                radial_position_errors_um, tangential_position_errors_um (per pin)
     [reducer.supports]         carrier_radial_stiffness_N_per_mm, main_bearing_clearance_um,
                                carrier_outer_diameter_mm, carrier_length_mm
-    [[reducer.errors]]         part, crank, disc, value_um, angle_deg (one per eccentricity error:
+    [[reducer.errors]]         part, crank, disc, value_um, angle_deg (one per error:
                                sun_eccentricity, sun_assembly, planet_eccentricity, cam,
-                               disc_crank_bore, carrier_crank_bore, output_assembly)
+                               disc_crank_bore,
+                               disc_radial_runout, disc_cumulative_pitch, carrier_crank_bore,
+                               output_assembly)
     [reducer.cycloid_errors]   the nine factors of Hu 2020 Table 2: {mean_um, tolerance_um}
     [reducer.dynamics]         masses/inertias (derived from geometry when left out), input and
                                crank torsional stiffness, crank bending stiffness, damping ratio
@@ -174,6 +178,32 @@ class DiscsSection(StrictModel):
     poisson_ratio: float = Field(ge=0, lt=0.5)
     crank_bore_diameter_mm: float | None = Field(default=None, gt=0, le=500, description="mass")
     centre_bore_diameter_mm: float | None = Field(default=None, gt=0, le=2000, description="mass")
+    equidistant_modification_errors_um: list[float] | None = Field(
+        default=None, description="error of each disc's equidistant modification δΔr_rp [um]"
+    )
+    shift_modification_errors_um: list[float] | None = Field(
+        default=None, description="error of each disc's shifted modification δΔr_p [um]"
+    )
+
+    @model_validator(mode="after")
+    def _per_disc(self):
+        for name in ("equidistant_modification_errors_um", "shift_modification_errors_um"):
+            v = getattr(self, name)
+            if v is not None and (len(v) != self.count or any(abs(x) > 200 for x in v)):
+                raise ValueError(
+                    f"{name} needs one value per disc ({self.count}) within +-200 um, got {v}"
+                )
+        return self
+
+    def modification_errors_mm(self) -> np.ndarray:
+        """``(N, 2)`` per-disc (δΔr_rp, δΔr_p) [mm]."""
+        out = np.zeros((self.count, 2))
+        for col, v in enumerate(
+            (self.equidistant_modification_errors_um, self.shift_modification_errors_um)
+        ):
+            if v is not None:
+                out[:, col] = um_to_mm(np.asarray(v, dtype=float))
+        return out
 
 
 class PinsSection(StrictModel):
@@ -207,6 +237,8 @@ _Part = Literal[
     "planet_eccentricity",
     "cam",
     "disc_crank_bore",
+    "disc_radial_runout",
+    "disc_cumulative_pitch",
     "carrier_crank_bore",
     "output_assembly",
 ]
@@ -516,6 +548,7 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         for e in sec.errors
     ]
     errors = ManufacturingErrors.from_entries(entries, c.count, d.count, field_name="errors")
+    errors = errors.with_disc_modification(d.modification_errors_mm())
     if not with_errors:
         errors = errors.scaled(0.0)
     red = RVReducer(
