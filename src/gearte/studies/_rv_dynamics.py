@@ -314,7 +314,7 @@ def _modal(case, model, mp, warnings: list[str]) -> AnalysisResult:
 
 
 def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
-    from gearte.models.rv_dynamics_sim import default_step, dte_spectrum, simulate_dte
+    from gearte.runners.rv_dynamics_sim import default_step, dte_spectrum, simulate_dte
 
     opts = case.analyses.dte
     dt = default_step(model, opts.step_fraction) if opts.method == "rk4" else None
@@ -375,7 +375,7 @@ def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
 
 def _sweep_one(task) -> float:
     model, rpm, duration, settle = task
-    from gearte.models.rv_dynamics_sim import simulate_dte
+    from gearte.runners.rv_dynamics_sim import simulate_dte
 
     m = model.with_params(input_speed_rpm=float(rpm))
     return simulate_dte(m, duration, settle_s=settle, record_dt=None).peak_to_peak
@@ -432,7 +432,7 @@ def _speed_sweep(case, model, options) -> AnalysisResult:
 
 
 def _batch(case, red, model, options) -> AnalysisResult:
-    from gearte.models.rv_dynamics_sim import ErrorTolerances, dte_batch
+    from gearte.runners.rv_dynamics_sim import ErrorTolerances, dte_batch
 
     b = case.analyses.batch
     amp = red.errors.amplitudes()
