@@ -142,14 +142,18 @@ N_STEPS = 100_000
 def rv_dynamics_batch(runs: int, options: RunOptions, *, seed: int = 6) -> np.ndarray:
     """Issue 6's batch: DTE of the Li et al. (2023) RV prototype over random error realisations;
     returns the per-run rows (peak-to-peak, rms, mean DTE [arcsec])."""
-    from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED
-    from gearte.models.rv_dynamics import RVDynamicModel, RVDynamicsParameters, RVErrors
     from gearte.runners.rv_dynamics_sim import dte_batch
+    from gearte.studies._rv_dynamics import batch_tolerances, load_dynamic_model
 
-    params = RVDynamicsParameters(pair=LI2023_PAIR_MODIFIED, cycloid_stiffness="mean")
-    model = RVDynamicModel(params, RVErrors.table3(placement="first"))
+    model, red = load_dynamic_model("li2023_rv_errors")
     r = dte_batch(
-        model, runs, seed=seed, chunk_size=4, scheduler=options.scheduler, workers=options.workers
+        model,
+        runs,
+        tolerances=batch_tolerances(red),
+        seed=seed,
+        chunk_size=4,
+        scheduler=options.scheduler,
+        workers=options.workers,
     )
     return r["rows"]
 

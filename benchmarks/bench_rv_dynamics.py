@@ -22,16 +22,10 @@ import time
 import numpy as np
 from numba import njit
 
-from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED
-from gearte.models.rv_dynamics import (
-    RHS_WORK_SIZE,
-    RVDynamicModel,
-    RVDynamicsParameters,
-    RVErrors,
-    rv_rhs,
-)
+from gearte.models.rv_dynamics import RHS_WORK_SIZE, rv_rhs
 from gearte.runners.rv_dynamics_sim import default_step, dte_batch, ode_system
 from gearte.solvers.ode import integrate, kernels
+from gearte.studies._rv_dynamics import batch_tolerances, load_dynamic_model
 from gearte.units import ARCSEC_PER_RAD
 
 
@@ -54,8 +48,7 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     a = ap.parse_args()
 
-    params = RVDynamicsParameters(pair=LI2023_PAIR_MODIFIED, cycloid_stiffness="mean")
-    model = RVDynamicModel(params, RVErrors.table3(placement="first"))
+    model, red = load_dynamic_model("li2023_rv_errors")  # Li 2023 Tables 1-3, mean k_cr
     system = ode_system(model)
     dt = default_step(model)
     q0 = model.static_equilibrium(0.0)
@@ -129,6 +122,7 @@ def main() -> None:
 
     # batch of error realisations
     kw = dict(seed=1, duration_s=a.batch_duration, settle_s=settle, chunk_size=4, dt=dt)
+    kw["tolerances"] = batch_tolerances(red)
     dte_batch(model, 2, workers=1, **kw)  # warm the threads' first call
     r1 = dte_batch(model, a.samples, workers=1, **kw)
     r2 = dte_batch(model, a.samples, workers=a.workers, **kw)

@@ -11,11 +11,9 @@ import numpy as np
 import pytest
 
 from gearte.errors import DivergenceError, ParameterError
-from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED
 from gearte.models.rv_dynamics import (
     RHS_WORK_SIZE,
     RVDynamicModel,
-    RVDynamicsParameters,
     RVErrors,
     rv_rhs,
 )
@@ -27,17 +25,18 @@ from gearte.runners.rv_dynamics_sim import (
     simulate_dte,
 )
 from gearte.solvers.ode import integrate, rk4_stability_limit
+from li2023_data import li2023_parameters, table3_errors, table3_tolerances
 
 
 @pytest.fixture(scope="module")
 def model():
     """The paper's prototype: modified profile, mean cycloid stiffness as in §4.1."""
-    return RVDynamicModel(RVDynamicsParameters(pair=LI2023_PAIR_MODIFIED, cycloid_stiffness="mean"))
+    return RVDynamicModel(li2023_parameters(modified=True, cycloid_stiffness="mean"))
 
 
 @pytest.fixture(scope="module")
 def unmod():
-    return RVDynamicModel(RVDynamicsParameters())
+    return RVDynamicModel(li2023_parameters())
 
 
 def test_dof_count(model):
@@ -125,7 +124,7 @@ def test_li2023_fig11a_dte_without_errors(model, unmod):
 
 def test_li2023_fig11b_dte_with_table3_errors(model):
     """Table 3 errors, each on crank 1 / disc 1, one output revolution: paper 17.25″."""
-    m = model.with_errors(RVErrors.table3(placement="first"))
+    m = model.with_errors(table3_errors("first"))
     r = simulate_dte(m, 4.84, settle_s=0.1, record_dt=1e-3)
     print(f"DTE p2p with Table 3 errors ('first'): {r.peak_to_peak:.2f}″ (paper 17.25″)")
     assert 5.0 <= r.peak_to_peak <= 50.0
@@ -136,9 +135,7 @@ def test_li2023_fig11b_dte_with_table3_errors(model):
 def test_identical_errors_on_all_parts_cancel(model):
     """Same error on every crank/disc: a rotationally symmetric pattern, no DTE ripple added."""
     r0 = simulate_dte(model, 0.05, settle_s=0.05, record_dt=None)
-    r1 = simulate_dte(
-        model.with_errors(RVErrors.table3(placement="all")), 0.05, settle_s=0.05, record_dt=None
-    )
+    r1 = simulate_dte(model.with_errors(table3_errors("all")), 0.05, settle_s=0.05, record_dt=None)
     assert r1.peak_to_peak == pytest.approx(r0.peak_to_peak, rel=1e-4)
 
 
@@ -182,7 +179,7 @@ def test_divergence_raised_not_returned(unmod):
 
 
 def test_batch_independent_of_workers(model):
-    kw = dict(seed=7, duration_s=0.01, settle_s=0.01, chunk_size=1)
+    kw = dict(seed=7, duration_s=0.01, settle_s=0.01, chunk_size=1, tolerances=table3_tolerances())
     a = dte_batch(model, 3, workers=1, **kw)
     b = dte_batch(model, 3, workers=2, **kw)
     np.testing.assert_array_equal(a["rows"], b["rows"])
@@ -191,19 +188,19 @@ def test_batch_independent_of_workers(model):
 
 def test_bad_parameters():
     with pytest.raises(ParameterError, match="damping_ratio"):
-        RVDynamicsParameters(damping_ratio=1.5)
+        li2023_parameters(damping_ratio=1.5)
     with pytest.raises(ParameterError, match="cycloid_stiffness"):
-        RVDynamicsParameters(cycloid_stiffness="spline")
+        li2023_parameters(cycloid_stiffness="spline")
     with pytest.raises(ParameterError, match="disc_hole"):
-        RVErrors(disc_hole=np.zeros((2, 2, 2)))
+        RVErrors(crank_count=3, disc_count=2, disc_hole=np.zeros((2, 2, 2)))
 
 
 def test_paper_stiffness_puts_first_mode_near_cycloid_mesh():
     """With the paper's printed k_cr = 2.62e8 N/m and β = 3.8° the output's torsional mode
     falls near the cycloid mesh frequency (322 Hz at 1500 rpm): the model must warn."""
     m = RVDynamicModel(
-        RVDynamicsParameters(
-            pair=LI2023_PAIR_MODIFIED,
+        li2023_parameters(
+            modified=True,
             cycloid_stiffness="mean",
             cycloid_mesh_stiffness_N_per_m=2.62e8,
             cycloid_pressure_angle_deg=3.8,
@@ -263,7 +260,7 @@ def test_model_from_shared_rv_description(model):
 def test_spectrum_labels():
     from gearte.runners.rv_dynamics_sim import label_frequency
 
-    src = RVDynamicsParameters().frequencies()
+    src = li2023_parameters().frequencies()
     assert label_frequency(8.26, src, 0.1) == "crank rotation"
     assert label_frequency(595.04, src, 0.1) == "2× involute mesh"
     assert "sideband" in label_frequency(322.31 + 8.264, src, 0.05)
@@ -271,7 +268,7 @@ def test_spectrum_labels():
 
 
 def test_static_equilibrium_compiled_equals_plain(model):
-    err = RVErrors.table3(placement="first", turning_arm_clearance_mm=0.001)
+    err = table3_errors("first", turning_arm_clearance_mm=0.001)
     m = model.with_errors(err)
     a = m.static_equilibrium(0.0)
     b = m.static_equilibrium(0.0, compiled=False)
@@ -281,7 +278,7 @@ def test_static_equilibrium_compiled_equals_plain(model):
 def test_dte_amplified_when_cycloid_mesh_meets_first_mode():
     """Modified profile with its stiffness ripple: at the speed where the cycloid mesh frequency
     equals the first (output torsion) mode the DTE grows several-fold (ζ = 0.03)."""
-    m = RVDynamicModel(RVDynamicsParameters(pair=LI2023_PAIR_MODIFIED))
+    m = RVDynamicModel(li2023_parameters(modified=True))
     f1 = m.modal().frequencies[0]
     per_rpm = m.params.frequencies()["cycloid mesh"] / m.params.input_speed_rpm
     off = simulate_dte(m, 0.1, settle_s=0.1, record_dt=None).peak_to_peak

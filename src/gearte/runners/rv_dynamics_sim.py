@@ -213,13 +213,13 @@ class ErrorTolerances:
     uniformly in [0, tolerance] and its phase uniformly in [0, 2π), independently per crank/disc.
     """
 
-    sun_eccentricity: float = 0.005
-    planet_eccentricity: float = 0.006
-    sun_assembly: float = 0.005
-    disc_hole: float = 0.008
-    cam: float = 0.008
-    carrier_hole: float = 0.035
-    output_assembly: float = 0.038
+    sun_eccentricity: float
+    planet_eccentricity: float
+    sun_assembly: float
+    disc_hole: float
+    cam: float
+    carrier_hole: float
+    output_assembly: float
 
 
 def draw_errors(
@@ -303,7 +303,11 @@ def dte_batch(
 
     if samples < 1:
         raise ParameterError("samples", samples, "must be ≥ 1")
-    tol = tolerances or ErrorTolerances()
+    if tolerances is None:
+        raise ParameterError(
+            "tolerances", None, "give the error tolerances (ErrorTolerances) of the batch"
+        )
+    tol = tolerances
     dt = default_step(model) if dt is None else dt
     sizes = chunk_sizes(samples, chunk_size)
     gens = spawn_generators(seed, len(sizes))

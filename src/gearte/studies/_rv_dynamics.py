@@ -37,6 +37,8 @@ __all__ = [
     "SpeedSweepOptions",
     "BatchOptions",
     "build_dynamic_model",
+    "load_dynamic_model",
+    "batch_tolerances",
     "run_dynamics",
 ]
 
@@ -157,6 +159,34 @@ def build_dynamic_model(case, red: RVReducer):
         output_bearing_clearance_mm=red.supports.main_bearing_clearance,
     )
     return RVDynamicModel(params, errors), mp
+
+
+def load_dynamic_model(name: str):
+    """The dynamic model and the reducer of a bundled or given ``rv_reducer`` case (benchmarks,
+    tests): ``(RVDynamicModel, RVReducer)``."""
+    from gearte.io.case_file import load_case
+    from gearte.studies.rv_reducer import build_reducer
+
+    case = load_case(name)
+    red = build_reducer(case.reducer)
+    return build_dynamic_model(case, red)[0], red
+
+
+def batch_tolerances(red: RVReducer, scale: float = 1.0):
+    """Error tolerances of a random batch: ``scale`` × the largest of the reducer's errors of each
+    part (:class:`gearte.runners.rv_dynamics_sim.ErrorTolerances`, [mm])."""
+    from gearte.runners.rv_dynamics_sim import ErrorTolerances
+
+    amp = red.errors.amplitudes()
+    return ErrorTolerances(
+        sun_eccentricity=scale * amp["sun_eccentricity"],
+        planet_eccentricity=scale * amp["planet_eccentricity"],
+        sun_assembly=scale * amp["sun_assembly"],
+        disc_hole=scale * amp["disc_crank_bore"],
+        cam=scale * amp["cam"],
+        carrier_hole=scale * amp["carrier_crank_bore"],
+        output_assembly=scale * amp["output_assembly"],
+    )
 
 
 def _check_representable(red: RVReducer) -> None:
@@ -432,20 +462,11 @@ def _speed_sweep(case, model, options) -> AnalysisResult:
 
 
 def _batch(case, red, model, options) -> AnalysisResult:
-    from gearte.runners.rv_dynamics_sim import ErrorTolerances, dte_batch
+    from gearte.runners.rv_dynamics_sim import dte_batch
 
     b = case.analyses.batch
-    amp = red.errors.amplitudes()
     s = b.tolerance_scale
-    tol = ErrorTolerances(
-        sun_eccentricity=s * amp["sun_eccentricity"],
-        planet_eccentricity=s * amp["planet_eccentricity"],
-        sun_assembly=s * amp["sun_assembly"],
-        disc_hole=s * amp["disc_crank_bore"],
-        cam=s * amp["cam"],
-        carrier_hole=s * amp["carrier_crank_bore"],
-        output_assembly=s * amp["output_assembly"],
-    )
+    tol = batch_tolerances(red, s)
     samples = options.samples or b.samples
     seed = options.seed if options.seed is not None else b.seed
     clear = dict(

@@ -15,7 +15,7 @@ doi:10.3390/machines11060626
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -48,44 +48,49 @@ class RVDynamicsParameters:
     (its mean only, as paper 004 §4.1 does). ``cycloid_mesh_stiffness_N_per_m`` and
     ``cycloid_pressure_angle_deg`` override the contact analysis' mean k_cr (the ripple is scaled
     with it) and β, e.g. to feed the paper's printed 2.62e8 N/m and 3.8°.
-    Operating point: ``input_speed_rpm``, ``output_torque_Nm`` (450 N·m, split equally over the
-    discs for the contact analysis).
+    Operating point: ``input_speed_rpm``, ``output_torque_Nm`` (split equally over the discs for
+    the contact analysis).
+    No field that is data has a default (issue 11): Li 2023's values live in the example cases
+    ``examples/li2023_rv*.toml``; build from a case with
+    :func:`gearte.studies._rv_dynamics.build_dynamic_model` or from an
+    :class:`~gearte.geometry.rv.RVReducer` with :func:`parameters_from_reducer`.
     """
 
-    sun_teeth: int = 12
-    planet_teeth: int = 36
-    module_mm: float = 1.5
-    pressure_angle_deg: float = 20.0
-    crank_count: int = 3
-    disc_count: int = 2
-    pair: CycloidPinPair = field(default_factory=CycloidPinPair)
-    sun_mass_kg: float = 1.3
-    planet_mass_kg: float = 0.88
-    crank_mass_kg: float = 0.4
-    disc_mass_kg: float = 2.76
-    output_mass_kg: float = 15.33
-    sun_inertia_kgm2: float = 4.44e-4
-    planet_inertia_kgm2: float = 1.01e-3
-    crank_inertia_kgm2: float = 7.56e-5
-    disc_inertia_kgm2: float = 0.0209
-    output_inertia_kgm2: float = 0.106
-    input_torsional_stiffness_Nm_per_rad: float = 1.16e4  # noqa: N815
-    sun_support_stiffness_N_per_m: float = 4.68e7  # noqa: N815
-    crank_torsional_stiffness_Nm_per_rad: float = 6.99e4  # noqa: N815
-    crank_bending_stiffness_N_per_m: float = 5.55e8  # noqa: N815
-    crank_bearing_stiffness_N_per_m: float = 5.76e8  # noqa: N815
-    turning_arm_bearing_stiffness_N_per_m: float = 2.84e8  # noqa: N815
-    output_support_stiffness_N_per_m: float = 3.15e8  # noqa: N815
-    involute_single_pair_stiffness_N_per_m: float = 1.4e8  # noqa: N815
+    sun_teeth: int
+    planet_teeth: int
+    module_mm: float
+    pressure_angle_deg: float
+    crank_count: int
+    disc_count: int
+    pair: CycloidPinPair
+    sun_mass_kg: float
+    planet_mass_kg: float
+    crank_mass_kg: float
+    disc_mass_kg: float
+    output_mass_kg: float
+    sun_inertia_kgm2: float
+    planet_inertia_kgm2: float
+    crank_inertia_kgm2: float
+    disc_inertia_kgm2: float
+    output_inertia_kgm2: float
+    input_torsional_stiffness_Nm_per_rad: float  # noqa: N815
+    sun_support_stiffness_N_per_m: float  # noqa: N815
+    crank_torsional_stiffness_Nm_per_rad: float  # noqa: N815
+    crank_bending_stiffness_N_per_m: float  # noqa: N815
+    crank_bearing_stiffness_N_per_m: float  # noqa: N815
+    turning_arm_bearing_stiffness_N_per_m: float  # noqa: N815
+    output_support_stiffness_N_per_m: float  # noqa: N815
+    involute_single_pair_stiffness_N_per_m: float  # noqa: N815
+    damping_ratio: float
+    input_speed_rpm: float
+    output_torque_Nm: float  # noqa: N815
+    # modelling options (not data)
     involute_harmonics: int = 10
     cycloid_harmonics: int = 8
     contact_positions: int = 48
-    damping_ratio: float = 0.03
     cycloid_stiffness: str = "fourier"
     cycloid_mesh_stiffness_N_per_m: float | None = None  # noqa: N815
     cycloid_pressure_angle_deg: float | None = None
-    input_speed_rpm: float = 1500.0
-    output_torque_Nm: float = 450.0  # noqa: N815
     crank_phase_deg: float = 0.0
 
     def __post_init__(self) -> None:
@@ -158,7 +163,7 @@ class RVDynamicsParameters:
 
 @dataclass(frozen=True)
 class RVErrors:
-    """Errors of paper 004 Table 3 placed on explicit cranks/discs, and bearing clearances.
+    """Eccentricity errors (the kinds of paper 004 Table 3) on explicit cranks/discs, clearances.
 
     Each error is an (amplitude [mm], phase [rad]) pair; arrays give one per crank i (shape (M,)),
     or per crank and disc (shape (M, N)); an amplitude of 0 means "not on this one".
@@ -176,8 +181,8 @@ class RVErrors:
     disc ε_oH, output main bearing ε_h; radial dead zone of the bearing spring.
     """
 
-    crank_count: int = 3
-    disc_count: int = 2
+    crank_count: int
+    disc_count: int
     sun_eccentricity: tuple[float, float] = (0.0, 0.0)
     sun_assembly: tuple[float, float] = (0.0, 0.0)
     output_assembly: tuple[float, float] = (0.0, 0.0)
@@ -220,52 +225,6 @@ class RVErrors:
             v = getattr(self, name)
             if not (np.isfinite(v) and v >= 0):
                 raise ParameterError(name, v, "must be finite and ≥ 0")
-
-    @classmethod
-    def table3(
-        cls,
-        crank_count: int = 3,
-        disc_count: int = 2,
-        placement: str = "first",
-        **clearances: float,
-    ) -> RVErrors:
-        """Paper 004 Table 3 with an explicit placement of the per-crank/per-disc errors.
-
-        placement = "first": each per-crank error sits on crank 1 and each per-disc error on
-        disc 1 (a single faulty part, the other parts nominal); "all": identical on every crank
-        and disc (the patterns then largely cancel, see docs). Angles of Table 3 in degrees.
-        """
-        if placement not in ("first", "all"):
-            raise ParameterError("placement", placement, "must be 'first' or 'all'")
-        d = np.deg2rad
-        m, n = crank_count, disc_count
-        mask_m = np.zeros(m)
-        mask_mn = np.zeros((m, n))
-        if placement == "first":
-            mask_m[0] = 1.0
-            mask_mn[0, 0] = 1.0
-        else:
-            mask_m[:] = 1.0
-            mask_mn[:] = 1.0
-
-        def per_m(e: float, b: float) -> np.ndarray:
-            return np.stack([e * mask_m, np.full(m, d(b))], axis=-1)
-
-        def per_mn(e: float, b: float) -> np.ndarray:
-            return np.stack([e * mask_mn, np.full((m, n), d(b))], axis=-1)
-
-        return cls(
-            crank_count=m,
-            disc_count=n,
-            sun_eccentricity=(0.005, d(45.0)),
-            planet_eccentricity=per_m(0.006, 30.0),
-            sun_assembly=(0.005, d(100.0)),
-            disc_hole=per_mn(0.008, 140.0),
-            cam=per_mn(0.008, 90.0),
-            carrier_hole=per_m(0.035, 270.0),
-            output_assembly=(0.038, d(90.0)),
-            **clearances,
-        )
 
 
 # --- building the dynamic model from the shared RV description (gearte.geometry.rv) ----------
