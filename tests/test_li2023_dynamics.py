@@ -230,14 +230,16 @@ def test_model_from_shared_rv_description(model):
     """The dynamics reuse gearte.geometry.rv.RVReducer: same parameters, same errors."""
     from gearte.geometry.rv import ErrorEntry, ManufacturingErrors
     from gearte.models.rv_dynamics import (
+        DYNAMIC_ONLY,
         errors_from_reducer,
         involute_contact_ratio,
         parameters_from_reducer,
     )
 
     assert involute_contact_ratio(12, 36, 1.5, np.deg2rad(20)) == pytest.approx(1.556394, abs=1e-6)
-    p = parameters_from_reducer(_li2023_reducer(), cycloid_stiffness="mean")
     ref = model.params
+    dynamic = {k: getattr(ref, k) for k in DYNAMIC_ONLY}
+    p = parameters_from_reducer(_li2023_reducer(), cycloid_stiffness="mean", **dynamic)
     assert p.pair == ref.pair
     assert p.involute_single_pair_stiffness_N_per_m == pytest.approx(
         ref.involute_single_pair_stiffness_N_per_m, rel=1e-3
@@ -251,6 +253,8 @@ def test_model_from_shared_rv_description(model):
     ]
     red = _li2023_reducer(ManufacturingErrors.from_entries(entries, 3, 2))
     err = errors_from_reducer(red)
+    with pytest.raises(ParameterError, match="sun_mass_kg"):
+        parameters_from_reducer(_li2023_reducer())
     np.testing.assert_allclose(err.cam[0, 0], [0.008, np.deg2rad(90)])
     np.testing.assert_allclose(err.disc_hole[1, 0], [0.008, np.deg2rad(140)])
     np.testing.assert_allclose(err.carrier_hole[2], [0.035, np.deg2rad(-90)])

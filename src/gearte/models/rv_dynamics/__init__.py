@@ -58,6 +58,7 @@ from gearte.models.rv_dynamics.mesh_stiffness import (
 )
 from gearte.models.rv_dynamics.modal import ModalResult
 from gearte.models.rv_dynamics.parameters import (
+    DYNAMIC_ONLY,
     RVDynamicsParameters,
     RVErrors,
     errors_from_reducer,
@@ -79,4 +80,5 @@ __all__ = [
     "RHS_WORK_SIZE",
     "parameters_from_reducer",
     "errors_from_reducer",
+    "DYNAMIC_ONLY",
 ]

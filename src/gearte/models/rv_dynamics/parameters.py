@@ -15,6 +15,7 @@ doi:10.3390/machines11060626
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +30,7 @@ __all__ = [
     "RVErrors",
     "parameters_from_reducer",
     "errors_from_reducer",
+    "DYNAMIC_ONLY",
 ]
 
 
@@ -232,8 +234,9 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
     """RVDynamicsParameters from an :class:`gearte.geometry.rv.RVReducer` description.
 
     The description supplies geometry, modification, material, mesh/bearing/support stiffnesses
-    (its N/mm → N/m here); ``dynamic`` supplies what only the dynamics needs (masses, inertias,
-    torsional and bending stiffnesses, damping, operating point), defaulting to paper 004 Table 2.
+    (its N/mm → N/m here); ``dynamic`` supplies what only the dynamics needs (:data:`DYNAMIC_ONLY`:
+    masses, inertias, torsional and bending stiffnesses, damping, operating point); nothing
+    defaults (a missing one raises :class:`~gearte.errors.ParameterError` naming it).
     The description's mean involute mesh stiffness k̄ becomes the single-pair stiffness k̄/ε_α of
     the rectangular wave.
 
@@ -288,7 +291,40 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
         / N_PER_M_TO_N_PER_MM,
     )
     kw.update(dynamic)
+    missing = [
+        f.name
+        for f in dataclasses.fields(RVDynamicsParameters)
+        if f.default is dataclasses.MISSING and f.name not in kw
+    ]
+    if missing:
+        raise ParameterError(
+            "dynamic",
+            missing,
+            "the dynamics need these beyond the reducer description (masses [kg], inertias "
+            "[kg·m²], torsional/bending stiffnesses, damping ratio, operating point)",
+        )
     return RVDynamicsParameters(**kw)
+
+
+#: What :func:`parameters_from_reducer` needs beyond the reducer description.
+DYNAMIC_ONLY = (
+    "sun_mass_kg",
+    "planet_mass_kg",
+    "crank_mass_kg",
+    "disc_mass_kg",
+    "output_mass_kg",
+    "sun_inertia_kgm2",
+    "planet_inertia_kgm2",
+    "crank_inertia_kgm2",
+    "disc_inertia_kgm2",
+    "output_inertia_kgm2",
+    "input_torsional_stiffness_Nm_per_rad",
+    "crank_torsional_stiffness_Nm_per_rad",
+    "crank_bending_stiffness_N_per_m",
+    "damping_ratio",
+    "input_speed_rpm",
+    "output_torque_Nm",
+)
 
 
 def errors_from_reducer(reducer, **paper004) -> RVErrors:
