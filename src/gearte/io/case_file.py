@@ -71,7 +71,7 @@ def load_case_dict(
     """
     from pydantic import ValidationError
 
-    from gearte.studies import available_kinds, get_kind
+    from gearte.io.kinds import available_kinds, get_kind
 
     if not isinstance(data, dict):
         got = type(data).__name__
