@@ -176,9 +176,15 @@ def drive_from_case(case: Any, *, name: str | None = None) -> Drive:
         from gearte.units import deg_to_rad
 
         red = build_reducer(case.reducer)
+        law_name = getattr(case.reducer, "contact_law", None)  # the case's pin-contact law
+        law = None
+        if law_name is not None:
+            from gearte.models.rv_load_sharing import contact_law
+
+            law = contact_law(red, kind=law_name)
         cat = getattr(case.analyses, "catalogue", None)
         if cat is None:
-            return RVDrive(red, name=label)
+            return RVDrive(red, name=label, law=law)
         return RVDrive(
             red,
             name=label,
@@ -186,6 +192,7 @@ def drive_from_case(case: Any, *, name: str | None = None) -> Drive:
             turning_points=tuple(cat.torque_sweep),
             steps_per_segment=cat.steps_per_segment,
             lost_motion_fraction=cat.lost_motion_fraction,
+            law=law,
         )
     raise ValueError(
         f"case kind {kind!r} does not describe one drive; drive kinds: {list(DRIVE_CASE_KINDS)}"
