@@ -143,7 +143,8 @@ def rv_dynamics_batch(runs: int, options: RunOptions, *, seed: int = 6) -> np.nd
     """Issue 6's batch: DTE of the Li et al. (2023) RV prototype over random error realisations;
     returns the per-run rows (peak-to-peak, rms, mean DTE [arcsec])."""
     from gearte.runners.rv_dynamics_sim import dte_batch
-    from gearte.studies._rv_dynamics import batch_tolerances, load_dynamic_model
+    from gearte.studies._rv_dynamics import batch_tolerances
+    from gearte.studies.rv_reducer import load_dynamic_model
 
     model, red = load_dynamic_model("li2023_rv_errors")
     r = dte_batch(

@@ -25,7 +25,8 @@ from numba import njit
 from gearte.models.rv_dynamics import RHS_WORK_SIZE, rv_rhs
 from gearte.runners.rv_dynamics_sim import default_step, dte_batch, ode_system
 from gearte.solvers.ode import integrate, kernels
-from gearte.studies._rv_dynamics import batch_tolerances, load_dynamic_model
+from gearte.studies._rv_dynamics import batch_tolerances
+from gearte.studies.rv_reducer import load_dynamic_model
 from gearte.units import ARCSEC_PER_RAD
 
 

@@ -37,7 +37,6 @@ __all__ = [
     "SpeedSweepOptions",
     "BatchOptions",
     "build_dynamic_model",
-    "load_dynamic_model",
     "batch_tolerances",
     "run_dynamics",
 ]
@@ -159,17 +158,6 @@ def build_dynamic_model(case, red: RVReducer):
         output_bearing_clearance_mm=red.supports.main_bearing_clearance,
     )
     return RVDynamicModel(params, errors), mp
-
-
-def load_dynamic_model(name: str):
-    """The dynamic model and the reducer of a bundled or given ``rv_reducer`` case (benchmarks,
-    tests): ``(RVDynamicModel, RVReducer)``."""
-    from gearte.io.case_file import load_case
-    from gearte.studies.rv_reducer import build_reducer
-
-    case = load_case(name)
-    red = build_reducer(case.reducer)
-    return build_dynamic_model(case, red)[0], red
 
 
 def batch_tolerances(red: RVReducer, scale: float = 1.0):

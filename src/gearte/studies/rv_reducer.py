@@ -94,7 +94,16 @@ KIND = "rv_reducer"
 REFERENCES = ["han2023", "hu2020", "li2023"]
 FIGURES = "gearte.plotting.rv_reducer"
 
-__all__ = ["KIND", "REFERENCES", "FIGURES", "Case", "run", "build_reducer", "build_stage_case"]
+__all__ = [
+    "KIND",
+    "REFERENCES",
+    "FIGURES",
+    "Case",
+    "run",
+    "build_reducer",
+    "build_stage_case",
+    "load_dynamic_model",
+]
 
 #: Densities of the materials a case may name [kg/m³] (physical constants).
 MATERIAL_DENSITY_KG_PER_M3 = {"steel": 7850.0}
@@ -813,6 +822,16 @@ def _compensation(red, sec: CompensationSection) -> AnalysisResult:
         ],
         data={"compensation": comp},
     )
+
+
+def load_dynamic_model(name: str):
+    """The dynamic model and the reducer of a bundled or given ``rv_reducer`` case (benchmarks,
+    tests): ``(RVDynamicModel, RVReducer)``."""
+    from gearte.io.case_file import load_case
+
+    case = load_case(name)
+    red = build_reducer(case.reducer)
+    return dyn.build_dynamic_model(case, red)[0], red
 
 
 def _cycloid_analyses(case: Case, options) -> tuple[list[AnalysisResult], list[str]]:
