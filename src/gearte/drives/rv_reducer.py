@@ -102,12 +102,20 @@ class RVDrive:
         """
         if torque is None:
             return self.catalogue().lost_motion
-        frac = abs(float(torque)) / self.reducer.rated_torque
+        frac = abs(float(torque)) / self._rated()
         if not 0.0 < frac < 0.5:
             raise ParameterError(
                 "torque", torque, "lost-motion torque must be within (0, 0.5) x rated torque"
             )
         return self.catalogue(frac).lost_motion
+
+    def _rated(self) -> float:
+        """Rated torque [N·mm]; a case may leave it out, the catalogue definitions need it."""
+        if self.reducer.rated_torque is None:
+            raise ParameterError(
+                "reducer.rated_torque_Nm", None, "the RV drive's catalogue quantities need it"
+            )
+        return float(self.reducer.rated_torque)
 
     def torsional_stiffness(self) -> float:
         """Catalogue torsional rigidity [N·mm/rad] (between 50 % and 100 % rated torque)."""
@@ -120,7 +128,7 @@ class RVDrive:
         from gearte.models.rv_load_sharing import transmission_error
 
         th = np.atleast_1d(np.asarray(output_angle, dtype=float))
-        t_ref = self.reducer.rated_torque if torque is None else float(torque)
+        t_ref = self._rated() if torque is None else float(torque)
         te = transmission_error(
             self.reducer,
             t_ref,

@@ -400,6 +400,10 @@ def _zeros2() -> np.ndarray:
     return np.zeros(2)
 
 
+def _empty_per_disc() -> np.ndarray:
+    return np.zeros((0, 2))  # replaced by zeros((N, 2)) once N is known
+
+
 @dataclass(frozen=True, eq=False)  # holds arrays: compare fields explicitly
 class ManufacturingErrors:
     """Eccentricity errors as error vectors ``value (cos angle, sin angle)`` [mm].
@@ -442,14 +446,14 @@ class ManufacturingErrors:
     sun: np.ndarray = field(default_factory=_zeros2)
     sun_seat: np.ndarray = field(default_factory=_zeros2)
     output_seat: np.ndarray = field(default_factory=_zeros2)
-    disc_runout: np.ndarray | None = None
-    disc_pitch: np.ndarray | None = None
-    disc_modification: np.ndarray | None = None
+    disc_runout: np.ndarray = field(default_factory=_empty_per_disc)
+    disc_pitch: np.ndarray = field(default_factory=_empty_per_disc)
+    disc_modification: np.ndarray = field(default_factory=_empty_per_disc)
 
     def __post_init__(self) -> None:
         n = self.disc_bore.shape[0]
         for name in ("disc_runout", "disc_pitch", "disc_modification"):
-            if getattr(self, name) is None:
+            if getattr(self, name).size == 0:
                 object.__setattr__(self, name, np.zeros((n, 2)))
 
     @classmethod
@@ -641,6 +645,12 @@ class RVReducer:
                 raise ParameterError(name, got, f"shape must be {want} for {m} cranks, {n} discs")
         object.__setattr__(self, "errors", err)
         object.__setattr__(self, "planets", planets)
+
+    @property
+    def error_set(self) -> ManufacturingErrors:
+        """The reducer's errors (never None after construction: none given = no errors)."""
+        assert self.errors is not None  # noqa: S101 - set in __post_init__
+        return self.errors
 
     # ---- derived quantities -------------------------------------------------------------
     @property

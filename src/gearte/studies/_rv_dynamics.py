@@ -19,7 +19,7 @@ Analyses:
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -125,7 +125,7 @@ def build_dynamic_model(case, red: RVReducer):
     d, op = case.reducer.dynamics, case.operation
     _check_representable(red)
     mp = mass_properties(red, case.reducer.density, d.given("mass"), d.given("inertia"))
-    kw = {f"{b}_mass_kg": v for b, v in mp.mass_kg.items()}
+    kw: dict[str, Any] = {f"{b}_mass_kg": v for b, v in mp.mass_kg.items()}
     kw.update({f"{b}_inertia_kgm2": v for b, v in mp.inertia_kgm2.items()})
     kw.update(
         input_torsional_stiffness_Nm_per_rad=d.input_torsional_stiffness_Nm_per_rad,
@@ -145,7 +145,7 @@ def build_dynamic_model(case, red: RVReducer):
     if case.analyses.contact is not None:
         kw["contact_positions"] = case.analyses.contact.positions
     params = parameters_from_reducer(red, **kw)
-    e = red.errors
+    e = red.error_set
 
     def polar(v):
         return (float(np.hypot(v[0], v[1])), float(np.arctan2(v[1], v[0])))
@@ -165,7 +165,7 @@ def batch_tolerances(red: RVReducer, scale: float = 1.0):
     part (:class:`gearte.runners.rv_dynamics_sim.ErrorTolerances`, [mm])."""
     from gearte.runners.rv_dynamics_sim import ErrorTolerances
 
-    amp = red.errors.amplitudes()
+    amp = red.error_set.amplitudes()
     return ErrorTolerances(
         sun_eccentricity=scale * amp["sun_eccentricity"],
         planet_eccentricity=scale * amp["planet_eccentricity"],
@@ -179,7 +179,7 @@ def batch_tolerances(red: RVReducer, scale: float = 1.0):
 
 def _check_representable(red: RVReducer) -> None:
     """The disc profile errors the quasi-static model reads but the dynamics cannot hold."""
-    amp = red.errors.amplitudes()
+    amp = red.error_set.amplitudes()
     for part in ("disc_radial_runout", "disc_cumulative_pitch"):
         if amp[part] > 0:
             raise ParameterError(
@@ -189,17 +189,17 @@ def _check_representable(red: RVReducer) -> None:
                 "model has one equivalent cycloid–pin spring per disc and cannot hold them; "
                 "leave them out of a case that asks for dynamic analyses",
             )
-    if np.any(red.errors.disc_modification != 0):
+    if np.any(red.error_set.disc_modification != 0):
         raise ParameterError(
             "reducer.discs.equidistant_modification_errors_um/shift_modification_errors_um",
-            red.errors.disc_modification.tolist(),
+            red.error_set.disc_modification.tolist(),
             "per-disc modification errors are read by the quasi-static analyses only (the "
             "dynamic model's discs share one cycloid–pin pair)",
         )
 
 
 def _has_errors(red: RVReducer) -> bool:
-    return any(v > 0 for v in red.errors.amplitudes().values())
+    return any(v > 0 for v in red.error_set.amplitudes().values())
 
 
 # --- analyses --------------------------------------------------------------------------------
