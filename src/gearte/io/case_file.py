@@ -14,7 +14,33 @@ from typing import Any
 
 from gearte.errors import CaseFileError
 
-__all__ = ["load_case", "load_case_dict", "validate_case", "format_validation_errors"]
+__all__ = [
+    "load_case",
+    "load_case_dict",
+    "validate_case",
+    "format_validation_errors",
+    "MAX_NESTING",
+    "MAX_FILE_BYTES",
+]
+
+#: Deepest nesting of tables/arrays a case file may have (the deepest bundled case has 4).
+MAX_NESTING = 32
+#: Largest case file read [bytes] (the largest bundled case is < 10 kB).
+MAX_FILE_BYTES = 1_000_000
+
+
+def _too_deep(data: Any, limit: int = MAX_NESTING) -> str | None:
+    """Dotted path of the first value nested deeper than ``limit``, or ``None`` (iterative)."""
+    stack: list[tuple[Any, tuple[str, ...]]] = [(data, ())]
+    while stack:
+        value, path = stack.pop()
+        if len(path) > limit:
+            return ".".join(path[:4]) + ".…"
+        if isinstance(value, dict):
+            stack.extend((v, (*path, str(k))) for k, v in value.items())
+        elif isinstance(value, list):
+            stack.extend((v, (*path, str(i))) for i, v in enumerate(value))
+    return None
 
 
 def _short(value: Any, limit: int = 60) -> str:
@@ -71,6 +97,11 @@ def load_case_dict(data: Any, *, source: str = "<dict>", name: str | None = None
     if not isinstance(data, dict):
         got = type(data).__name__
         raise CaseFileError(source, [("(case)", f"a case must be a table, got {got}")])
+    deep = _too_deep(data)
+    if deep is not None:
+        raise CaseFileError(
+            source, [(deep, f"nested deeper than {MAX_NESTING} levels (tables or arrays)")]
+        )
     meta = data.get("case")
     if not isinstance(meta, dict):
         raise CaseFileError(
@@ -106,6 +137,10 @@ def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
 
     path = case_path(case)
     try:
+        size = os.stat(path).st_size
+        if size > MAX_FILE_BYTES:
+            reason = f"{size} bytes; a case file is at most {MAX_FILE_BYTES} bytes"
+            raise CaseFileError(str(path), [("(file)", reason)])
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise CaseFileError(str(path), [("(file)", f"cannot read: {exc}")]) from None
@@ -113,6 +148,9 @@ def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise CaseFileError(str(path), [("(file)", f"TOML syntax error: {exc}")]) from None
+    except RecursionError:
+        reason = f"nested deeper than {MAX_NESTING} levels (arrays or inline tables)"
+        raise CaseFileError(str(path), [("(file)", reason)]) from None
     return load_case_dict(data, source=str(path), name=Path(path).stem)
 
 
