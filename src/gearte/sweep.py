@@ -75,6 +75,9 @@ def _range_values(key: str, spec: str) -> tuple[Any, ...]:
     if not _NUM_RE.match(n_text) or int(n_text) < 1:
         raise ParameterError(f"--vary {key}", spec, f"N = {n_text!r} must be an integer ≥ 1")
     n = int(n_text)
+    from gearte.limits import check_sweep_points
+
+    check_sweep_points(n)
     try:
         a, b = float(start), float(stop)
     except ValueError:
@@ -434,6 +437,9 @@ def run_sweep(
     if dup:
         raise ParameterError("vary", dup[0], "key given more than once")
 
+    from gearte.limits import check_sweep_points
+
+    check_sweep_points(math.prod(len(v.values) for v in varies))
     base, source, name = _base_case(case)
     points = grid_points(varies)
     cases: list[dict[str, Any]] = []
@@ -446,6 +452,9 @@ def run_sweep(
         validated = load_case_dict(data, source=f"{source} at {where}")
         cases.append(data)
     assert validated is not None
+    from gearte.studies import check_samples_override
+
+    check_samples_override(validated, samples)
     kind = str(validated.case.kind)
     kind_module = get_kind(kind).__name__
     title = str(validated.case.title)

@@ -1220,8 +1220,19 @@ class RVDynamicModel:
         return RVDynamicModel(new, self.errors, contact=self.contact if same else None)
 
 
+def _dte_python(t: float, y: np.ndarray, n_dof: int, ratio: float) -> float:
+    """Plain twin of :func:`rv_dte` (a module-level function, so the system pickles)."""
+    return float(y[n_dof - 1] - y[2] / ratio)
+
+
 def ode_system(model: RVDynamicModel, errors: RVErrors | None = None):
-    """The model as a :class:`gearte.solvers.ode.ODESystem` with DTE [rad] as output."""
+    """The model as a :class:`gearte.solvers.ode.ODESystem` with DTE [rad] as output.
+
+    Everything in it pickles (no local closures), so it crosses process boundaries
+    (``--scheduler processes``, Dask workers).
+    """
+    from functools import partial
+
     from gearte.solvers.ode import ODESystem
 
     args = model.kernel_args(errors)
@@ -1232,7 +1243,7 @@ def ode_system(model: RVDynamicModel, errors: RVErrors | None = None):
         args=args,
         key=RHS_SOURCE_KEY,
         rhs_python=m.rhs_numpy,
-        output_python=lambda t, y: float(y[m.n_dof - 1] - y[2] / m.params.ratio),
+        output_python=partial(_dte_python, n_dof=m.n_dof, ratio=m.params.ratio),
         stability_eigenvalues=model.damped_eigenvalues(mesh="max"),
         work_size=RHS_WORK_SIZE,
     )
