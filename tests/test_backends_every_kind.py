@@ -57,7 +57,8 @@ def test_reproducer_rv_dynamics_batch_pickles_for_processes():
 
     import numpy as np
 
-    from gearte.models.rv_dynamics import RVDynamicModel, ode_system
+    from gearte.models.rv_dynamics import RVDynamicModel
+    from gearte.runners.rv_dynamics_sim import ode_system
     from gearte.studies.rv_dynamics import build_errors, build_parameters
 
     case = load_case_dict(_small("li2023_rv_errors"))

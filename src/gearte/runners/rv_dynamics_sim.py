@@ -8,15 +8,24 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 from gearte.errors import ParameterError
-from gearte.models.rv_dynamics import RVDynamicModel, RVErrors, ode_system
-from gearte.solvers.ode import ODEResult, integrate, rk4_stability_limit
+from gearte.models.rv_dynamics import (
+    RHS_SOURCE_KEY,
+    RHS_WORK_SIZE,
+    RVDynamicModel,
+    RVErrors,
+    rv_dte,
+    rv_rhs,
+)
+from gearte.solvers.ode import ODEResult, ODESystem, integrate, rk4_stability_limit
 from gearte.units import ARCSEC_PER_RAD
 
 __all__ = [
+    "ode_system",
     "DTEResult",
     "simulate_dte",
     "dte_spectrum",
@@ -26,6 +35,33 @@ __all__ = [
     "dte_batch",
     "default_step",
 ]
+
+
+def _dte_python(t: float, y: np.ndarray, n_dof: int, ratio: float) -> float:
+    """Plain twin of :func:`rv_dte` [rad] (module level, so the system pickles)."""
+    return float(y[n_dof - 1] - y[2] / ratio)
+
+
+def ode_system(model: RVDynamicModel, errors: RVErrors | None = None) -> ODESystem:
+    """The model as a :class:`gearte.solvers.ode.ODESystem` with DTE [rad] as output.
+
+    Compiled right-hand side :func:`~gearte.models.rv_dynamics.rhs.rv_rhs` with its plain twin
+    :meth:`RVDynamicModel.rhs_numpy`; ``errors`` [mm, rad] replace the model's errors.
+    Everything in it pickles (no local closures), so it crosses process boundaries
+    (``--scheduler processes``, Dask workers).
+    """
+    args = model.kernel_args(errors)
+    m = model if errors is None else model.with_errors(errors)
+    return ODESystem(
+        rhs=rv_rhs,
+        output=rv_dte,
+        args=args,
+        key=RHS_SOURCE_KEY,
+        rhs_python=m.rhs_numpy,
+        output_python=partial(_dte_python, n_dof=m.n_dof, ratio=m.params.ratio),
+        stability_eigenvalues=model.damped_eigenvalues(mesh="max"),
+        work_size=RHS_WORK_SIZE,
+    )
 
 
 @dataclass(frozen=True)
