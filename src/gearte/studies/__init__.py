@@ -82,8 +82,8 @@ def check_samples_override(case: Any, samples: int | None) -> None:
         return
     from gearte.errors import ParameterError
 
-    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
-        raise ParameterError("--samples", samples, "must be an integer >= 1")
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 0:
+        raise ParameterError("--samples", samples, "must be an integer >= 0 (0: skip)")
     for path, cap in _sample_caps(case):
         if samples > cap:
             raise ParameterError("--samples", samples, f"over the cap of {path} (<= {cap})")
