@@ -48,11 +48,116 @@ def _short(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def format_validation_errors(exc: Any) -> list[tuple[str, str]]:
-    """Turn a pydantic ``ValidationError`` into ``(field, message)`` pairs, one per problem."""
+_UNITS = {
+    "mm": "mm",
+    "um": "µm",
+    "m": "m",
+    "Nm": "N·m",
+    "Nmm": "N·mm",
+    "N": "N",
+    "kN": "kN",
+    "MPa": "MPa",
+    "GPa": "GPa",
+    "deg": "degrees",
+    "rad": "rad",
+    "arcmin": "arcmin",
+    "arcsec": "arcsec",
+    "rpm": "rpm",
+    "s": "s",
+    "Hz": "Hz",
+}
+
+
+def _model_classes(annotation: Any) -> list[Any]:
+    """The pydantic model classes an annotation may hold (through Optional, lists, dicts)."""
+    import typing
+
+    from pydantic import BaseModel
+
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    out: list[Any] = []
+    for arg in typing.get_args(annotation):
+        out += _model_classes(arg)
+    return out
+
+
+def _user_loc(root: Any, loc: tuple[Any, ...]) -> tuple[Any, ...]:
+    """``loc`` as the user wrote it: without the tags pydantic adds for tagged unions
+    (``pair.spur.module_mm`` → ``pair.module_mm``)."""
+    if root is None:
+        return loc
+    models, out = [root], []
+    for i, part in enumerate(loc):
+        if isinstance(part, int):
+            out.append(part)
+            continue
+        nxt: list[Any] = []
+        for m in models:
+            info = m.model_fields.get(part)
+            if info is not None:
+                nxt += _model_classes(info.annotation)
+        if any(part in m.model_fields for m in models):
+            out.append(part)
+            models = nxt or models
+            continue
+        tagged = [m for m in models if part in _tags(m)]
+        if len(models) > 1 and tagged and i + 1 < len(loc):
+            models = tagged  # a union tag: not part of the file's keys
+            continue
+        out.append(part)  # a dict key (a source name, a pair name): keep
+    return tuple(out)
+
+
+def _tags(model: Any) -> set[str]:
+    """Literal values of the model's fields (candidates for a union's discriminator)."""
+    import typing
+
+    tags: set[str] = set()
+    for info in model.model_fields.values():
+        if typing.get_origin(info.annotation) is typing.Literal:
+            tags |= {str(a) for a in typing.get_args(info.annotation)}
+    return tags
+
+
+def _fields_at(root: Any, loc: tuple[Any, ...]) -> set[str]:
+    """Field names of the section at ``loc`` (a pydantic error location) of ``root``."""
+    models = [root]
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        nxt: list[Any] = []
+        for m in models:
+            info = m.model_fields.get(part)
+            if info is not None:
+                nxt += _model_classes(info.annotation)
+        if not nxt:  # a dict key (e.g. a pair name) or a discriminator tag: stay
+            continue
+        models = nxt
+    return {name for m in models for name in m.model_fields}
+
+
+def did_you_mean(key: str, known: set[str]) -> str:
+    """A hint for an unknown key: the field with another unit suffix, or a close spelling."""
+    import difflib
+
+    stem, _, unit = key.rpartition("_")
+    if stem:
+        same_stem = sorted(k for k in known if k.rpartition("_")[0] == stem and k != key)
+        if same_stem:
+            k = same_stem[0]
+            given = _UNITS.get(k.rpartition("_")[2], k.rpartition("_")[2])
+            return f"did you mean {k!r}? (this field is given in {given}, not {unit})"
+    close = difflib.get_close_matches(key, sorted(known), n=1, cutoff=0.6)
+    return f"did you mean {close[0]!r}?" if close else ""
+
+
+def format_validation_errors(exc: Any, root: Any = None) -> list[tuple[str, str]]:
+    """Turn a pydantic ``ValidationError`` into ``(field, message)`` pairs, one per problem;
+    with ``root`` (the ``Case`` class), unknown keys get a "did you mean" hint."""
     out: list[tuple[str, str]] = []
     for err in exc.errors(include_url=False):
-        loc = ".".join(str(p) for p in err.get("loc", ())) or "(case)"
+        loc = ".".join(str(p) for p in _user_loc(root, tuple(err.get("loc", ())))) or "(case)"
         msg = str(err.get("msg", "invalid"))
         for prefix in ("Value error, ", "Assertion failed, "):
             if msg.startswith(prefix):
@@ -62,6 +167,11 @@ def format_validation_errors(exc: Any) -> list[tuple[str, str]]:
             msg = "required field is missing"
         elif kind == "extra_forbidden":
             msg = "unknown key (not allowed here; check spelling and section)"
+            loc_t = _user_loc(root, tuple(err.get("loc", ())))
+            if root is not None and loc_t:
+                hint = did_you_mean(str(loc_t[-1]), _fields_at(root, loc_t[:-1]))
+                if hint:
+                    msg = f"unknown key; {hint}"
         if "input" in err and kind not in ("missing",) and not isinstance(err["input"], dict):
             msg = f"{msg} (got {_short(err['input'])})"
         out.append((loc, msg))
@@ -119,7 +229,7 @@ def load_case_dict(data: Any, *, source: str = "<dict>", name: str | None = None
     try:
         return module.Case.model_validate(data)
     except ValidationError as exc:
-        raise CaseFileError(source, format_validation_errors(exc)) from None
+        raise CaseFileError(source, format_validation_errors(exc, module.Case)) from None
 
 
 def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
