@@ -279,8 +279,49 @@ def check_text(text: str, tmp: Path) -> Outcome:
     return Outcome("coerced", "; ".join(found)[:300]) if found else Outcome("accepted")
 
 
-def run(count: int, seed: int, tmp: Path, verbose: bool = False) -> Counter[str]:
-    """Fuzz ``count`` mutants; returns the tally of outcomes (examples printed if verbose)."""
+#: Memory limit of one fuzzed ``gearte run`` (address space) [bytes]: the memory bound.
+RUN_MEMORY_LIMIT = 6 * 2**30
+
+
+def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
+    """``gearte run`` of an accepted mutant in a subprocess under a memory limit: exit 0, 1
+    (analysis failed) or 2 (bad input) are fine; 3 (bug), a kill or a timeout are not."""
+    import resource
+    import subprocess
+
+    path = tmp / "run.toml"
+    path.write_text(text, encoding="utf-8")
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (RUN_MEMORY_LIMIT, RUN_MEMORY_LIMIT))
+
+    args = ["run", str(path), "--out", str(tmp / "out"), "--no-report", "--no-progress"]
+    args += ["--samples", "20", "--workers", "1"]
+    try:
+        p = subprocess.run(
+            [sys.executable, "-m", "gearte", *args],
+            capture_output=True,
+            text=True,
+            timeout=timeout_s,
+            preexec_fn=limit,
+        )
+    except subprocess.TimeoutExpired:
+        return Outcome("run_timeout", f"over {timeout_s} s")
+    if p.returncode in (0, 1, 2):
+        return Outcome(f"run_exit_{p.returncode}", p.stderr.strip().splitlines()[-1:].__str__())
+    return Outcome("run_bug", f"exit {p.returncode}: {p.stderr.strip()[-300:]}")
+
+
+def run(
+    count: int,
+    seed: int,
+    tmp: Path,
+    verbose: bool = False,
+    runs: int = 0,
+    run_timeout_s: float = 120.0,
+) -> Counter[str]:
+    """Fuzz ``count`` mutants; returns the tally of outcomes (examples printed if verbose).
+    The first ``runs`` accepted mutants also go through ``gearte run`` (:func:`run_cli`)."""
     rng = random.Random(seed)
     bases = corpus()
     names = sorted(bases)
@@ -292,6 +333,12 @@ def run(count: int, seed: int, tmp: Path, verbose: bool = False) -> Counter[str]
         tally[out.status] += 1
         if verbose and out.status in ("crash", "coerced", "bad_message"):
             print(f"[{out.status}] {name}: {done}\n    {out.detail}", file=sys.stderr)
+        if out.status == "accepted" and tally["run_total"] < runs:
+            tally["run_total"] += 1
+            r = run_cli(text, tmp, run_timeout_s)
+            tally[r.status] += 1
+            if verbose and r.status in ("run_bug", "run_timeout"):
+                print(f"[{r.status}] {name}: {done}\n    {r.detail}", file=sys.stderr)
     return tally
 
 
@@ -302,16 +349,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--count", type=int, default=10_000)
     ap.add_argument("--seed", type=int, default=13)
     ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--runs", type=int, default=0, help="accepted mutants also run (gearte run)")
+    ap.add_argument("--run-timeout", type=float, default=120.0)
     a = ap.parse_args(argv)
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as d:
-        tally = run(a.count, a.seed, Path(d), verbose=not a.quiet)
+        tally = run(a.count, a.seed, Path(d), not a.quiet, a.runs, a.run_timeout)
     wall = time.perf_counter() - t0
     print(
         f"{a.count} fuzzed case files in {wall:.1f} s (seed {a.seed}): "
         f"{dict(sorted(tally.items()))}"
     )
-    bad = tally["crash"] + tally["coerced"] + tally["bad_message"]
+    bad = sum(tally[k] for k in ("crash", "coerced", "bad_message", "run_bug", "run_timeout"))
     return 1 if bad else 0
 
 

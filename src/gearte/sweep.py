@@ -298,6 +298,8 @@ class SweepResult:
     samples: int | None = None
     elapsed_s: float = 0.0
     point_elapsed_s: list[float] = field(default_factory=list)
+    #: True when the sweep was interrupted: only the points that finished are here.
+    partial: bool = False
     backend: str = ""
 
     @property
@@ -356,6 +358,7 @@ class SweepResult:
                 "source": self.source,
             },
             "vary": {v.key: list(v.values) for v in self.vary},
+            "partial": self.partial,
             "seed": self.seed,
             "samples": self.samples,
             "backend": self.backend,
@@ -460,26 +463,40 @@ def run_sweep(
     title = str(validated.case.title)
 
     t0 = time.perf_counter()
-    with executor_scope(scheduler, workers) as ex:
-        by_points = len(points) >= ex.workers or ex.workers == 1
-        inner = {"progress": False, "seed": seed, "samples": samples}
-        if by_points:
-            inner |= {"scheduler": None, "workers": 1}
-            tasks = [(i, c, kind, kind_module, inner) for i, c in enumerate(cases)]
-            out = map_chunks(
-                _run_point, tasks, scheduler=ex, progress=progress, description=f"sweep {name}"
-            )
-        else:  # few points: one after another, each spreading its samples over the workers
-            inner |= {"scheduler": ex, "workers": workers}
-            out = [_run_point((i, c, kind, kind_module, inner)) for i, c in enumerate(cases)]
-        backend = ex.name
-    return SweepResult(
+    done: dict[int, dict[str, Any]] = {}
+    interrupted: KeyboardInterrupt | None = None
+    by_points, backend = False, "?"
+    try:
+        with executor_scope(scheduler, workers) as ex:
+            backend = ex.name
+            by_points = len(points) >= ex.workers or ex.workers == 1
+            inner = {"progress": False, "seed": seed, "samples": samples}
+            if by_points:
+                inner |= {"scheduler": None, "workers": 1}
+                tasks = [(i, c, kind, kind_module, inner) for i, c in enumerate(cases)]
+                map_chunks(
+                    _run_point,
+                    tasks,
+                    scheduler=ex,
+                    progress=progress,
+                    description=f"sweep {name}",
+                    on_result=done.__setitem__,
+                )
+            else:  # few points: one after another, each spreading its samples over the workers
+                inner |= {"scheduler": ex, "workers": workers}
+                for i, c in enumerate(cases):
+                    done[i] = _run_point((i, c, kind, kind_module, inner))
+    except KeyboardInterrupt as exc:  # keep what finished, marked partial
+        interrupted = exc
+    order = sorted(done)
+    out = [done[i] for i in order]
+    result = SweepResult(
         name=name,
         kind=kind,
         title=title,
         source=source,
         vary=varies,
-        points=points,
+        points=[points[i] for i in order],
         values=[o["values"] for o in out],
         errors=[o["error"] for o in out],
         warnings=[o["warnings"] for o in out],
@@ -488,7 +505,14 @@ def run_sweep(
         elapsed_s=time.perf_counter() - t0,
         point_elapsed_s=[o["elapsed"] for o in out],
         backend=f"{backend} ({'points' if by_points else 'samples'} in parallel)",
+        partial=interrupted is not None,
     )
+    if interrupted is not None:
+        from gearte.errors import Interrupted
+
+        signum = getattr(interrupted, "signum", 2)
+        raise Interrupted(signum, partial=result) from None
+    return result
 
 
 def _count(items: Sequence[str]) -> dict[str, int]:
