@@ -90,9 +90,11 @@ def test_validate_checks_every_file_it_is_given(tmp_path):
     deep.write_text("x = " + "[" * 3000 + "]" * 3000 + "\n")
     wrong = tmp_path / "wrong.toml"
     wrong.write_text('[case]\nkind = "foundation_test"\n[demo]\nlength_mm = true\n')
-    r = CliRunner().invoke(main, ["validate", str(good), str(deep), str(wrong), str(good)])
+    missing = tmp_path / "missing.toml"
+    args = ["validate", str(good), str(deep), str(missing), "a\x00b", str(wrong), str(good)]
+    r = CliRunner().invoke(main, args)
     assert r.exit_code == EXIT_BAD_INPUT, r.output
-    assert r.output.count("good.toml: ok") == 2
+    assert r.output.count("good.toml: ok") == 2 and "missing.toml" in r.output
     assert "deep.toml" in r.output and "demo.length_mm" in r.output
     assert "Traceback" not in r.output
 

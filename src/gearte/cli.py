@@ -312,6 +312,12 @@ def validate(cases: tuple[str, ...]) -> None:
                 bad += 1
                 click.echo(str(exc), err=True)
                 continue
+            except FileNotFoundError as exc:  # report it and go on with the next file
+                bad += 1
+                click.echo(
+                    f"{c}: 1 error(s)\n  (file): {str(exc).strip(chr(39) + chr(34))}", err=True
+                )
+                continue
             click.echo(f"{c}: ok ({case.case.kind})")
         if bad:
             sys.exit(EXIT_BAD_INPUT)
