@@ -57,12 +57,12 @@ def test_reproducer_rv_dynamics_batch_pickles_for_processes():
 
     import numpy as np
 
-    from gearte.models.rv_dynamics import RVDynamicModel
     from gearte.runners.rv_dynamics_sim import ode_system
-    from gearte.studies.rv_dynamics import build_errors, build_parameters
+    from gearte.studies._rv_dynamics import build_dynamic_model
+    from gearte.studies.rv_reducer import build_reducer
 
     case = load_case_dict(_small("li2023_rv_errors"))
-    model = RVDynamicModel(build_parameters(case), build_errors(case))
+    model, _ = build_dynamic_model(case, build_reducer(case.reducer))
     system = ode_system(model)
     again = pickle.loads(pickle.dumps((model, system)))[1]
     y = np.linspace(0.1, 1.0, model.n_dof * 2)

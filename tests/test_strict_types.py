@@ -27,12 +27,13 @@ def _one_error(data: dict) -> tuple[str, str]:
 
 @pytest.mark.parametrize("bad", [True, "0.005"])
 def test_reproducer_amplitude_mm_true_is_not_a_number(bad):
-    """Issue 13 reproducer: ``amplitude_mm = true`` ran as a 1 mm error; ``"0.005"`` as 0.005."""
+    """Issue 13 reproducer: ``amplitude_mm = true`` ran as a 1 mm error; ``"0.005"`` as 0.005
+    (the error magnitude is ``value_um`` of a ``[[reducer.errors]]`` entry since issue 11)."""
     data = _bundled("li2023_rv_errors")
-    errors = next(v for k, v in data.items() if isinstance(v, dict) and "cam" in v)
-    errors["cam"]["amplitude_mm"] = bad
+    cam = next(e for e in data["reducer"]["errors"] if e["part"] == "cam")
+    cam["value_um"] = bad
     field, msg = _one_error(data)
-    assert field.endswith("cam.amplitude_mm") and "valid number" in msg
+    assert field.endswith("value_um") and "valid number" in msg
 
 
 def test_true_is_not_a_count_and_a_float_is_not_an_integer():
