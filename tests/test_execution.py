@@ -251,9 +251,9 @@ def test_client_passed_in_stays_open_and_internal_ones_are_closed(client):
 
 
 def test_workers_with_another_gearte_version_are_refused(client, monkeypatch):
-    import gearte
+    import gearte._version
 
-    monkeypatch.setattr(gearte, "__version__", "0.0.0+other")
+    monkeypatch.setattr(gearte._version, "__version__", "0.0.0+other")
     with pytest.raises(SchedulerError, match="same version"):
         open_executor(client)
 
@@ -297,7 +297,8 @@ def test_cli_prints_an_unreachable_scheduler_without_traceback(tmp_path):
     case.write_text('[case]\nkind = "foundation_test"\n[demo]\nlength_mm = 4.0\n')
     port = _closed_port()
     r = CliRunner().invoke(
-        main, ["run", str(case), "--scheduler", f"tcp://127.0.0.1:{port}", "--out", str(tmp_path)]
+        main,
+        ["run", str(case), "--scheduler", f"tcp://127.0.0.1:{port}", "--out", str(tmp_path / "o")],
     )
     assert r.exit_code == 2, r.output
     assert "scheduler" in r.output and f"127.0.0.1:{port}" in r.output
