@@ -323,7 +323,8 @@ def tooth_contact(
             rtol=rtol,
             max_iter=max_iter,
         )
-        dmax = A * F * (2.0 / 3.0 + np.log(B / F))
+        k_sec = 1.0 / (A * (2.0 / 3.0 + math.log(B) - np.log(F)))  # F_max/δ_max, eq 41 [N/mm]
+        dmax = F / k_sec
     else:
         from gearte.models.cycloid_loaded_contact import solve_rotation
 
@@ -347,7 +348,7 @@ def tooth_contact(
     approach_i = lr * dmax[:, None]
     in_mesh = loaded & (approach_i > clr)
     if contact_law == "hu2020":
-        force = np.where(in_mesh, (approach_i - clr) / dmax[:, None] * F[:, None], 0.0)
+        force = np.where(in_mesh, (approach_i - clr) * k_sec[:, None], 0.0)
     else:
         force = np.where(
             in_mesh, force_from_coefficients(np.where(in_mesh, approach_i - clr, 0.0), a0, a1), 0.0
