@@ -574,7 +574,7 @@ class CycloidStage:
     dr_rp: float = 0.0
     dr_p: float = 0.0
     rotation: float = 0.0
-    z_c: int | None = None
+    z_c: int = None  # type: ignore[assignment]  # z_p - 1 when omitted (__post_init__)
     k1_definition: str = "ground"
 
     def __post_init__(self) -> None:
