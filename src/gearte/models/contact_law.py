@@ -218,9 +218,9 @@ def max_contact_pressure(
     Johnson (1985), eq 4.45. doi:10.1017/CBO9781139171731
     """
     _check_material(E, nu, b)
-    F = np.maximum(np.asarray(F, dtype=float), 0.0)
+    f = np.maximum(np.asarray(F, dtype=float), 0.0)
     rs = relative_radius(rho, r)
-    return np.sqrt(F * contact_modulus(E, nu) / (math.pi * b * rs))
+    return np.sqrt(f * contact_modulus(E, nu) / (math.pi * b * rs))
 
 
 def log_law_coefficients(

@@ -203,9 +203,9 @@ class ToothContact:
     n_eval: np.ndarray
     T_c: float
     rho: float
-    curvature: np.ndarray | None = None
-    pressure: np.ndarray | None = None
-    contact_law: str = "hu2020"
+    curvature: np.ndarray
+    pressure: np.ndarray
+    contact_law: str
 
     @property
     def pins_in_mesh(self) -> np.ndarray:

@@ -151,7 +151,7 @@ class PinContactLaw:
         """The solver's :class:`~gearte.solvers.rv_equilibrium.ContactLaw` for ``system``."""
         if self.name == "linear":
             return ContactLaw(kind="linear", stiffness=self.stiffness, name="linear")
-        a0, a1 = self.coefficients(system.contact_phase)
+        a0, a1 = self.coefficients(contact_phase(system))
         kind = "secant_per_disc" if self.name == "hu2020" else "secant_per_contact"
         return ContactLaw(kind=kind, stiffness=self.stiffness, a0=a0, a1=a1, name=self.name)
 
@@ -260,6 +260,15 @@ class RVSystem:
     layout: DofLayout
     spring_c: np.ndarray | None = None
     contact_phase: np.ndarray | None = None
+
+
+def contact_phase(system: RVSystem) -> np.ndarray:
+    """Meshing phase of every contact of ``system`` [rad], shape (P, nc)."""
+    if system.contact_phase is None:
+        raise ParameterError(
+            "system.contact_phase", None, "needed for the flank curvature; build it with assemble()"
+        )
+    return system.contact_phase
 
 
 def _u(a: np.ndarray) -> np.ndarray:
@@ -501,8 +510,8 @@ class LoadSharing:
     output_error: np.ndarray
     contact_stiffness: np.ndarray
     q: np.ndarray
-    contact_pressure: np.ndarray | None = None
-    contact_law: str = ""
+    contact_pressure: np.ndarray
+    contact_law: str
 
     @property
     def peak_pin_load(self) -> float:
@@ -543,7 +552,7 @@ def _postprocess(
     disc_torque = -np.sum(pin * arm, axis=-1)
     stage = cycloid_stage(reducer)
     d = reducer.discs
-    rho = stage.curvature_radius(system.contact_phase).reshape(P, N, zp)
+    rho = stage.curvature_radius(contact_phase(system)).reshape(P, N, zp)
     pressure = max_contact_pressure(
         pin, rho, stage.r, d.youngs_modulus, d.poisson_ratio, d.face_width
     )
