@@ -16,6 +16,7 @@ from gearte.studies import RunOptions, run_case
 #: Result names issue 11 fixes as API for the bundled RV cases ("Must show").
 REQUIRED = [
     "peak_pin_load [N]",
+    "max_contact_pressure [MPa]",
     "lost_motion [arcmin]",
     "torsional_rigidity [N*m/arcmin]",
     "total_te_peak_to_peak [arcsec]",

@@ -253,6 +253,9 @@ class Discs:
     crank_bore_diameter, centre_bore_diameter : float or None
         Diameters of the crank bores and of the central bore [mm] (needed only to derive the
         disc's mass and inertia; no central bore when None).
+    contact_law : str
+        Name of the pin-contact law (``gearte.models.contact_law``: ``"line_contact"``, the
+        textbook default, or ``"hu2020"``); every analysis of the reducer uses it.
     """
 
     count: int
@@ -263,6 +266,7 @@ class Discs:
     poisson_ratio: float
     crank_bore_diameter: float | None = None
     centre_bore_diameter: float | None = None
+    contact_law: str = "line_contact"
 
     def __post_init__(self) -> None:
         _check_int("discs.count", self.count, 1, 3)
