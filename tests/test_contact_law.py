@@ -221,3 +221,16 @@ def test_rv_reducer_echoes_law_and_pressure_and_warns_over_allowable():
     # the textbook law is about twice as stiff: fewer pins carry more load (docs/contact-law.md)
     assert ls2["peak_pin_load [N]"] > 1.1 * ls["peak_pin_load [N]"]
     assert ls2["pairs_in_mesh_max"] < ls["pairs_in_mesh_max"]
+
+
+def test_li2023_loaded_contact_pressure_uses_each_pins_curvature():
+    from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED, mesh_period_contact
+
+    mp = mesh_period_contact(LI2023_PAIR_MODIFIED, 225e3, 8)
+    c = mp.contact
+    rho = profile_curvature_radius(LI2023_PAIR_MODIFIED, c.phi)
+    st = LI2023_PAIR_MODIFIED.stage
+    ref = cl.max_contact_pressure(c.force, rho, st.r, E, NU, 12.0)
+    np.testing.assert_allclose(c.pressure, ref, rtol=1e-12)
+    assert mp.max_contact_pressure == pytest.approx(float(ref.max()))
+    assert LI2023_PAIR_MODIFIED.contact_law == "line_contact"
