@@ -273,6 +273,7 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
         poisson_ratio=di.poisson_ratio,
         pin_radius_modification_mm=di.equidistant_modification,
         pin_position_modification_mm=di.shift_modification,
+        contact_law=di.contact_law,  # the reducer's one pin-contact law
     )
     eps = involute_contact_ratio(fs.sun_teeth, fs.planet_teeth, fs.module, fs.pressure_angle)
     kw = dict(
