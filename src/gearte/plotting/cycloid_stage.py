@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.units import Nmm_to_Nm, rad_to_deg
 
 __all__ = ["figures", "profile_figure", "contact_figures", "sensitivity_figure", "pareto_figure"]
 
@@ -34,7 +35,7 @@ def profile_figure(stage: Any) -> Figure:
     a1, r1 = polar(True, flank=2)
     dr = np.interp(a0, a1, r1) - r0
     k = _exaggeration(float(np.max(np.abs(dr))), stage.tip_radius - stage.root_radius)
-    deg = np.degrees(a0)
+    deg = rad_to_deg(a0)
     fig, ax = new_figure(figsize=(7.0, 4.0))
     ax.plot(deg, r0, color=PALETTE[7], lw=1.0, label="unmodified profile")
     ax.plot(
@@ -110,7 +111,7 @@ def contact_figures(result: Any) -> list[Figure]:
         Figure(
             "Contact force per pin",
             f"F_i = (δ_i − Δ_i)/δ_max · F_max (eq 41); torque on the disc "
-            f"{v['torque_on_disc [N·mm]'] / 1e3:.1f} N·m.",
+            f"{Nmm_to_Nm(v['torque_on_disc [N·mm]']):.1f} N·m.",
             fig,
         )
     )

@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gearte.units import deg_to_rad
+
 if TYPE_CHECKING:  # the model calls these functions; typing only
     from gearte.models.rv_dynamics.assembly import RVDynamicModel
 
@@ -66,7 +68,7 @@ def rigid_mode(model: RVDynamicModel, t: float = 0.0) -> np.ndarray:
     m, n = p.crank_count, p.disc_count
     q = np.zeros(model.n_dof)
     th_o = p.output_speed * t
-    th_h = np.deg2rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
+    th_h = deg_to_rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
     rate = 1.0 - p.pair.pin_count
     q[2] = p.ratio
     for i in range(m):
