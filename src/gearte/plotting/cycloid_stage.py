@@ -22,7 +22,8 @@ def _exaggeration(max_dev_mm: float, tooth_height_mm: float) -> float:
 
 
 def profile_figure(stage: Any) -> Figure:
-    """Modified against unmodified profile over three teeth (polar, unwrapped), exaggerated."""
+    """Modified against unmodified profile of ``stage`` over three teeth (polar, unwrapped),
+    exaggerated."""
     phi = np.linspace(-3.0 * np.pi, 3.0 * np.pi, 4001)
 
     def polar(modified: bool, flank: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -56,7 +57,8 @@ def profile_figure(stage: Any) -> Figure:
 
 
 def contact_figures(result: Any) -> list[Figure]:
-    """Clearance & deformation per pin (paper Fig 7/10), force per pin, sweep over a pitch."""
+    """Clearance & deformation per pin (paper Fig 7/10), force per pin, sweep over a pitch, from
+    the ``result`` of a cycloid_stage study."""
     tc = result["tooth_contact"]
     v = tc.values
     idx = np.asarray(v["pin_index"])
@@ -140,7 +142,7 @@ def contact_figures(result: Any) -> list[Figure]:
 
 
 def sensitivity_figure(result: Any) -> Figure:
-    """Bar chart of the sensitivity indices (Table 2)."""
+    """Bar chart of the sensitivity indices (Table 2) of a cycloid_stage ``result``."""
     v = result["geometric_te"].values
     names = list(v["sensitivity_index"])
     vals = np.array([v["sensitivity_index"][k] for k in names])
@@ -161,7 +163,7 @@ def sensitivity_figure(result: Any) -> Figure:
 
 
 def pareto_figure(result: Any) -> Figure:
-    """Pareto of the factors' TE contributions (mean) and tolerance shares."""
+    """Pareto of the factors' TE contributions (mean) and tolerance shares of a ``result``."""
     v = result["geometric_te"].values
     contrib = v["contribution [arcmin]"]
     tol = v["tolerance_contribution [arcmin]"]
