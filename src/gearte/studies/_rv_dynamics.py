@@ -162,7 +162,15 @@ def build_dynamic_model(case, red: RVReducer):
 
 def batch_tolerances(red: RVReducer, scale: float = 1.0):
     """Error tolerances of a random batch: ``scale`` × the largest of the reducer's errors of each
-    part (:class:`gearte.runners.rv_dynamics_sim.ErrorTolerances`, [mm])."""
+    part (:class:`gearte.runners.rv_dynamics_sim.ErrorTolerances`, [mm]).
+
+    Parameters
+    ----------
+    red : RVReducer
+        The reducer whose ``[[reducer.errors]]`` give the amplitudes.
+    scale : float
+        Factor on every amplitude [-].
+    """
     from gearte.runners.rv_dynamics_sim import ErrorTolerances
 
     amp = red.error_set.amplitudes()
@@ -502,7 +510,17 @@ def _batch(case, red, model, options) -> AnalysisResult:
 
 
 def run_dynamics(case, red: RVReducer, options) -> tuple[list[AnalysisResult], list[str]]:
-    """Run the dynamic analyses an ``rv_reducer`` case asks for."""
+    """Run the dynamic analyses an ``rv_reducer`` case asks for.
+
+    Parameters
+    ----------
+    case : gearte.studies.rv_reducer.Case
+        The validated case.
+    red : RVReducer
+        Its reducer (:func:`gearte.studies.rv_reducer.build_reducer`).
+    options : gearte.studies.RunOptions
+        Execution options (workers, scheduler, seed, samples, progress).
+    """
     model, mp = build_dynamic_model(case, red)
     warnings: list[str] = []
     analyses = []

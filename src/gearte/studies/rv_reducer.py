@@ -844,7 +844,13 @@ def _compensation(red, sec: CompensationSection) -> AnalysisResult:
 
 def load_dynamic_model(name: str):
     """The dynamic model and the reducer of a bundled or given ``rv_reducer`` case (benchmarks,
-    tests): ``(RVDynamicModel, RVReducer)``."""
+    tests): ``(RVDynamicModel, RVReducer)``.
+
+    Parameters
+    ----------
+    name : str
+        A bundled case name or a path to a case file.
+    """
     from gearte.io.case_file import load_case
 
     case = load_case(name)
