@@ -111,7 +111,9 @@ class SpurGearSpec(_ThicknessLimits):
         from gearte.tolerance.iso1328 import radial_composite_tolerances
 
         return radial_composite_tolerances(
-            int(self.grade), module_mm, module_mm * self.teeth  # type: ignore[arg-type]
+            int(self.grade),
+            module_mm,
+            module_mm * self.teeth,  # type: ignore[arg-type]
         ).F_i2
 
 
