@@ -201,3 +201,25 @@ def test_bad_inputs_name_the_field():
         SpecLimit("y")
     with pytest.raises(ParameterError, match="spec.z"):
         run_yield(Linear(), _lin_set(), [SpecLimit("z", upper=1.0)], 10)
+
+
+class SumOfFour:
+    """y = p1 + p2 + p3 + q: a family 'pins' of three errors and one other error."""
+
+    def __call__(self, e):
+        return {"y": e["p1"] + e["p2"] + e["p3"] + e["q"]}
+
+
+def test_family_sobol_and_linear_share_group_members_and_groups_name_families():
+    pins = tuple(Tolerance(f"p{i}", "normal", 0.03, family="pins") for i in (1, 2, 3))
+    ts = ToleranceSet(pins + (Tolerance("q", "normal", 0.03),))
+    r = sobol_tolerances(SumOfFour(), ts, ["y"], n=4000, seed=3, bootstrap=0)["y"]
+    assert set(r.total) == {"pins", "q"}
+    assert r.total["pins"] == pytest.approx(0.75, abs=0.04)  # 3 σ² of 4 σ²
+    lin = linear_prediction(SumOfFour(), ts, ["y"])["y"]
+    assert lin.share == pytest.approx({"pins": 0.75, "q": 0.25})
+    # one ground batch: the family as a correlated group; widths set per family
+    grouped = ToleranceSet(ts.tolerances, (CorrelatedGroup("batch", ("pins",), 1.0),))
+    e = grouped.sample(np.random.default_rng(1), 1000)
+    assert np.array_equal(e["p1"], e["p3"])
+    assert grouped.with_tolerances({"pins": 0.06})["p2"].tolerance == 0.06

@@ -369,7 +369,7 @@ def yield_analysis(
     if section.allocation is not None:
         costs: dict[str, CostModel | PriceTable] = {}
         for key, c in section.allocation.costs.items():
-            if key not in ts.keys:
+            if key not in ts.families:
                 raise ParameterError(
                     f"analyses.yield.allocation.costs.{key}", key, "has no tolerance to allocate"
                 )

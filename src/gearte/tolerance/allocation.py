@@ -169,7 +169,8 @@ def allocate(
         As :func:`gearte.tolerance.yield_mc.run_yield`; the widths of ``tolerances`` are the
         starting point (and the centre of a cost model's ladder).
     costs : mapping
-        ``{tolerance key: CostModel | PriceTable}``; tolerances without a cost stay fixed.
+        ``{tolerance key or family: CostModel | PriceTable}`` (a family's cost is per family:
+        one stated tolerance); tolerances without a cost stay fixed.
     target : float
         Required yield in (0, 1).
     n, seed
@@ -182,16 +183,16 @@ def allocate(
     spec = tuple(spec)
     if not spec:
         raise ParameterError("spec", [], "allocation needs at least one spec limit")
+    fams = tolerances.families
     for key in costs:
-        if key not in tolerances.keys:
-            raise ParameterError(f"costs.{key}", key, "is not a tolerance key")
-    keys = [k for k in tolerances.keys if k in costs]
-    ladders = {k: costs[k].ladder(float(tolerances[k].tolerance)) for k in keys}
+        if key not in fams:
+            raise ParameterError(f"costs.{key}", key, "is not a tolerance key or family")
+    keys = [k for k in fams if k in costs]
+    # a family's width: that of its first member
+    t0 = {k: float(tolerances.tolerances[fams[k][0]].tolerance) for k in keys}
+    ladders = {k: costs[k].ladder(t0[k]) for k in keys}
     # start at the ladder level closest to the given width
-    level = {
-        k: int(np.argmin([abs(w - float(tolerances[k].tolerance)) for w in ladders[k]]))
-        for k in keys
-    }
+    level = {k: int(np.argmin([abs(w - t0[k]) for w in ladders[k]])) for k in keys}
     chunks = seeded_chunks(int(n), int(chunk_size), seed)
     cache: dict[tuple[int, ...], int] = {}
     evaluations = 0

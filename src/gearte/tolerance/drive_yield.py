@@ -12,6 +12,11 @@ bound. They are picklable (module-level classes), so processes and Dask can run 
 * :class:`PlanetaryCoupledTE` — 2K-H planetary, eccentricity magnitudes [µm] and directions
   [deg] (Wang et al. 2013) → exact coupled TE amplitude and peak-to-peak [arcsec]
   (:func:`gearte.models.planetary_errors.sample_extremes`).
+* :class:`RVReducerYield` — a whole RV reducer, each sample one assembled reducer: its
+  eccentricity errors (magnitude [µm] and direction) and pin errors [µm] → the catalogue virtual
+  test (lost motion at ±3 % rated torque, rigidity, backlash, hysteresis), angular TE over one
+  output revolution (unloaded: geometric; at the TE torque: total) and the peak pin load
+  (Han et al. 2023 load sharing, :mod:`gearte.models.rv_load_sharing`).
 """
 
 from __future__ import annotations
@@ -20,9 +25,23 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from gearte.units import deg_to_rad, rad_to_arcmin, rad_to_arcsec, um_to_mm
+from gearte.units import (
+    Nmm_to_Nm,
+    arcmin_to_rad,
+    deg_to_rad,
+    rad_to_arcmin,
+    rad_to_arcsec,
+    um_to_mm,
+)
 
-__all__ = ["CycloidGeometricTE", "PlanetaryCoupledTE"]
+__all__ = [
+    "CycloidGeometricTE",
+    "PlanetaryCoupledTE",
+    "RVReducerYield",
+    "RV_VECTOR_PARTS",
+    "RV_PIN_FAMILIES",
+    "rv_error_keys",
+]
 
 
 def _n(errors: Mapping[str, np.ndarray]) -> int:
@@ -151,3 +170,183 @@ class PlanetaryCoupledTE:
                 rad_to_arcsec((fmax - fmin) * s), dtype=float
             ),
         }
+
+
+#: Eccentricity error families of an RV reducer (``[[reducer.errors]]`` parts); each instance
+#: is a vector: a magnitude [µm] and a direction ``<key>_phase_rad`` in the part's frame.
+RV_VECTOR_PARTS: tuple[str, ...] = (
+    "planet_base_circle",
+    "disc_crank_bore",
+    "cam",
+    "carrier_crank_bore",
+)
+#: Pin error families (``[reducer.pins]`` ``*_errors_um``), one value per pin [µm].
+RV_PIN_FAMILIES: tuple[str, ...] = (
+    "radius_errors",
+    "radial_position_errors",
+    "tangential_position_errors",
+)
+
+
+def rv_error_keys(reducer) -> dict[str, list[str]]:
+    """Error family → the keys of its instances for this reducer.
+
+    ``planet_base_circle.c<i>``, ``disc_crank_bore.c<i>.d<j>``, ``cam.c<i>.d<j>``,
+    ``carrier_crank_bore.c<i>`` (crank ``i``, disc ``j``, 1-based as in the case file) and
+    ``radius_errors.p<k>`` … for every pin ``k``.
+    """
+    m, n, zp = reducer.cranks.count, reducer.discs.count, reducer.pins.count
+    cr = range(1, m + 1)
+    return {
+        "planet_base_circle": [f"planet_base_circle.c{i}" for i in cr],
+        "disc_crank_bore": [f"disc_crank_bore.c{i}.d{j}" for i in cr for j in range(1, n + 1)],
+        "cam": [f"cam.c{i}.d{j}" for i in cr for j in range(1, n + 1)],
+        "carrier_crank_bore": [f"carrier_crank_bore.c{i}" for i in cr],
+        **{f: [f"{f}.p{k}" for k in range(1, zp + 1)] for f in RV_PIN_FAMILIES},
+    }
+
+
+class RVReducerYield:
+    """A whole RV reducer as a yield model: drawn errors → catalogue test, TE, pin load.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The nominal reducer (its measured errors are the nominal of errors not drawn).
+    positions : int
+        Output positions over one revolution for the TE and the pin loads (≥ 36 for a
+        catalogue TE).
+    te_torque : float, optional
+        Torque of the loaded TE and the pin loads [N·mm]; default the rated torque.
+    zero_load_fraction : float
+        The unloaded (geometric) TE is solved at this fraction of ``te_torque``.
+    lost_motion_fraction : float
+        Lost motion read at ± this fraction of the rated torque (catalogue: 0.03).
+
+    Notes
+    -----
+    A drawn error replaces the reducer's value of that instance; an error not drawn keeps it.
+    Each sample is solved on its own (the quasi-static solver of
+    :mod:`gearte.solvers.rv_equilibrium`): 14 torque levels for the catalogue values and
+    ``2 × positions`` positions for the TE.
+
+    Outputs: ``"lost_motion [arcmin]"``, ``"torsional_rigidity [Nm/arcmin]"``,
+    ``"backlash [arcmin]"``, ``"hysteresis_loss [arcmin]"``, ``"angular_te [arcmin]"``
+    (unloaded, peak-to-peak over one output revolution), ``"loaded_te [arcmin]"``,
+    ``"peak_pin_load [N]"``.
+
+    References
+    ----------
+    Han et al. (2023), Hu et al. (2020); see :mod:`gearte.models.rv_load_sharing` and
+    :mod:`gearte.models.rv_catalogue`.
+    """
+
+    def __init__(
+        self,
+        reducer,
+        *,
+        positions: int = 36,
+        te_torque: float | None = None,
+        zero_load_fraction: float = 0.02,
+        lost_motion_fraction: float = 0.03,
+    ) -> None:
+        from gearte.errors import ParameterError
+        from gearte.models.rv_load_sharing import output_positions
+
+        if int(positions) != positions or positions < 2:
+            raise ParameterError("positions", positions, "must be an integer >= 2")
+        self.reducer = reducer
+        self.theta = output_positions(int(positions))
+        self.te_torque = float(reducer.rated_torque if te_torque is None else te_torque)
+        self.zero_load_fraction = float(zero_load_fraction)
+        self.lost_motion_fraction = float(lost_motion_fraction)
+        self.keys = rv_error_keys(reducer)
+
+    def reducer_for(self, errors: Mapping[str, float]):
+        """The assembled reducer of one sample (errors [µm], phases [rad])."""
+        from gearte.geometry.rv import ManufacturingErrors
+
+        red = self.reducer
+        e0 = red.errors
+        planet = e0.planet.copy()
+        disc = e0.disc_bore.copy()
+        cam = e0.cam.copy()
+        carrier = e0.carrier_bore.copy()
+
+        def vec(key: str) -> np.ndarray | None:
+            if key not in errors:
+                return None
+            r = float(um_to_mm(errors[key]))
+            ph = float(errors.get(f"{key}_phase_rad", 0.0))
+            return r * np.array([np.cos(ph), np.sin(ph)])
+
+        for i in range(red.cranks.count):
+            if (v := vec(f"planet_base_circle.c{i + 1}")) is not None:
+                planet[i] = v
+            if (v := vec(f"carrier_crank_bore.c{i + 1}")) is not None:
+                carrier[i] = v
+            for j in range(red.discs.count):
+                if (v := vec(f"disc_crank_bore.c{i + 1}.d{j + 1}")) is not None:
+                    disc[j, i] = v
+                if (v := vec(f"cam.c{i + 1}.d{j + 1}")) is not None:
+                    cam[i, j] = v
+        red = red.with_errors(ManufacturingErrors(planet, disc, cam, carrier))
+        pins = red.pins
+        changed = {}
+        for f in RV_PIN_FAMILIES:
+            keys = self.keys[f]
+            if any(k in errors for k in keys):
+                arr = np.asarray(getattr(pins, f), dtype=float).copy()
+                for k, key in enumerate(keys):
+                    if key in errors:
+                        arr[k] = float(um_to_mm(errors[key]))
+                changed[f] = arr
+        if changed:
+            from dataclasses import replace
+
+            red = red.replace(pins=replace(pins, **changed))
+        return red
+
+    def one(self, red) -> dict[str, float]:
+        """The quantities of one assembled reducer."""
+        from gearte.models.rv_catalogue import catalogue_values
+        from gearte.models.rv_load_sharing import assemble, contact_law, load_sharing
+
+        law = contact_law(red)
+        # the catalogue quantities only (a two-point curve: the hysteresis plot is not needed)
+        cv = catalogue_values(
+            red,
+            turning_points=(1.0, -1.0),
+            steps_per_segment=2,
+            lost_motion_fraction=self.lost_motion_fraction,
+            law=law,
+        )
+        system = assemble(red, self.theta)
+        loaded = load_sharing(red, self.te_torque, law=law, system=system)
+        unloaded = load_sharing(
+            red, self.zero_load_fraction * self.te_torque, law=law, system=system
+        )
+
+        def arcmin(x: float) -> float:
+            return float(rad_to_arcmin(x))
+
+        return {
+            "lost_motion [arcmin]": arcmin(cv.lost_motion),
+            "torsional_rigidity [Nm/arcmin]": float(Nmm_to_Nm(cv.torsional_rigidity))
+            * float(arcmin_to_rad(1.0)),
+            "backlash [arcmin]": arcmin(cv.backlash),
+            "hysteresis_loss [arcmin]": arcmin(cv.hysteresis_loss),
+            "angular_te [arcmin]": arcmin(float(np.ptp(unloaded.output_error))),
+            "loaded_te [arcmin]": arcmin(float(np.ptp(loaded.output_error))),
+            "peak_pin_load [N]": loaded.peak_pin_load,
+        }
+
+    def __call__(self, errors: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        n = _n(errors)
+        rows = []
+        for s in range(n):
+            e = {k: float(v[s]) for k, v in errors.items()}
+            rows.append(self.one(self.reducer_for(e)))
+        if not rows:
+            rows.append(self.one(self.reducer))
+        return {k: np.array([r[k] for r in rows]) for k in rows[0]}

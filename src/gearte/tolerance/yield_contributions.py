@@ -75,14 +75,15 @@ def _sobol_chunk(chunk: Any, shared: _SobolShared) -> dict[str, np.ndarray]:
     m = chunk.size
     za, pa = ts.draw_standard(rng, m)
     zb, pb = ts.draw_standard(rng, m)
-    k = len(ts.tolerances)
-    # stack the k + 2 matrices and call the model once
+    fams = list(ts.families.values())
+    k = len(fams)
+    # stack the k + 2 matrices and call the model once; factor i = every column of family i
     z = np.concatenate([za, zb] + [za] * k)
     p = np.concatenate([pa, pb] + [pa] * k)
-    for i in range(k):
+    for i, cols in enumerate(fams):
         rows = slice((2 + i) * m, (3 + i) * m)
-        z[rows, i] = zb[:, i]
-        p[rows, i] = pb[:, i]
+        z[rows, cols] = zb[:, cols]
+        p[rows, cols] = pb[:, cols]
     out = evaluate_checked(shared.model, ts.values(z, p), (k + 2) * m)
     return {q: out[q].reshape(k + 2, m) for q in shared.quantities}
 
@@ -133,7 +134,8 @@ def sobol_tolerances(
     Returns
     -------
     dict
-        ``{quantity: SobolIndices}``. A quantity with zero variance gets zeros.
+        ``{quantity: SobolIndices}`` keyed by tolerance family (a key that has no family is
+        its own). A quantity with zero variance gets zeros.
     """
     if n < 50:
         raise ParameterError("n", n, "Sobol estimation needs >= 50 base samples")
@@ -149,7 +151,7 @@ def sobol_tolerances(
         progress=progress,
         description=f"Sobol indices ({n} base samples)",
     )
-    keys = tolerances.keys
+    keys = list(tolerances.families)
     # bootstrap stream: its own child of the seed, so the intervals are reproducible too
     rng = np.random.default_rng(None if seed is None else [int(seed), 7919])
     a = (1.0 - confidence) / 2.0
@@ -181,8 +183,8 @@ def sobol_tolerances(
 @dataclass
 class LinearPrediction:
     """First-order prediction of one quantity: nominal value, σ and the variance share of
-    each tolerance (fractions); ``sensitivity`` ∂f/∂x per tolerance [quantity unit / error
-    unit] (a radial error with phase: the gradient's length ``√(g_x² + g_y²)``)."""
+    each tolerance family (fractions); ``sensitivity`` ∂f/∂x per tolerance key [quantity unit /
+    error unit] (a radial error with phase: the gradient's length ``√(g_x² + g_y²)``)."""
 
     quantity: str
     nominal: float
@@ -244,11 +246,14 @@ def linear_prediction(
                 sens[key] = float(g)
                 i += 2
         tot = sum(var.values())
+        fam_var: dict[str, float] = {}
+        for t in ts.tolerances:
+            fam_var[t.family_name] = fam_var.get(t.family_name, 0.0) + var.get(t.key, 0.0)
         res[q] = LinearPrediction(
             quantity=q,
             nominal=float(y[0]),
             sd=math.sqrt(tot),
-            share={k: (v / tot if tot > 0 else 0.0) for k, v in var.items()},
+            share={k: (v / tot if tot > 0 else 0.0) for k, v in fam_var.items()},
             sensitivity=sens,
         )
     return res

@@ -99,6 +99,10 @@ class Tolerance:
         Radial errors: also draw a uniform direction ``<key>_phase_rad`` [rad].
     values : sequence of float, optional
         ``empirical``: measured deviations from nominal [same unit].
+    family : str, optional
+        The tolerance this error's law comes from when one stated tolerance covers many
+        errors (every pin's radius, every cam of every crank); contributions are reported per
+        family. Default: the key itself.
     """
 
     key: str
@@ -108,6 +112,12 @@ class Tolerance:
     sigmas: float | None = None
     phase: bool = False
     values: tuple[float, ...] | None = None
+    family: str | None = None
+
+    @property
+    def family_name(self) -> str:
+        """The contribution group: ``family`` or the key."""
+        return self.family or self.key
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -212,8 +222,8 @@ class CorrelatedGroup:
     def __post_init__(self) -> None:
         if not (0.0 <= self.rho <= 1.0):
             raise ParameterError(f"groups.{self.name}.rho", self.rho, "must be in [0, 1]")
-        if len(self.keys) < 2:
-            raise ParameterError(f"groups.{self.name}.keys", self.keys, "needs >= 2 keys")
+        if len(self.keys) < 1:
+            raise ParameterError(f"groups.{self.name}.keys", self.keys, "needs >= 1 key")
 
 
 @dataclass(frozen=True)
@@ -230,16 +240,48 @@ class ToleranceSet:
             raise ParameterError("tolerances", dup, "each error key may have one tolerance")
         seen: set[str] = set()
         for g in self.groups:
-            for k in g.keys:
-                if k not in keys:
-                    raise ParameterError(f"groups.{g.name}.keys", k, "is not a tolerance key")
+            for k in self.group_members(g):
                 if k in seen:
                     raise ParameterError(f"groups.{g.name}.keys", k, "is in two groups")
                 seen.add(k)
 
+    def group_members(self, group: CorrelatedGroup) -> list[str]:
+        """Tolerance keys of a group (a family name stands for all its members)."""
+        keys = [t.key for t in self.tolerances]
+        out: list[str] = []
+        for k in group.keys:
+            if k in keys:
+                out.append(k)
+                continue
+            members = [t.key for t in self.tolerances if t.family_name == k]
+            if not members:
+                raise ParameterError(
+                    f"groups.{group.name}.keys", k, "is not a tolerance key or family"
+                )
+            out += members
+        return out
+
     @property
     def keys(self) -> list[str]:
         return [t.key for t in self.tolerances]
+
+    @property
+    def families(self) -> dict[str, list[int]]:
+        """Family name → indices of its tolerances (in order of first appearance)."""
+        out: dict[str, list[int]] = {}
+        for i, t in enumerate(self.tolerances):
+            out.setdefault(t.family_name, []).append(i)
+        return out
+
+    def family_widths(self, widths: Mapping[str, float]) -> dict[str, float]:
+        """Per-key widths from per-family (or per-key) widths."""
+        out: dict[str, float] = {}
+        for t in self.tolerances:
+            if t.key in widths:
+                out[t.key] = float(widths[t.key])
+            elif t.family_name in widths:
+                out[t.key] = float(widths[t.family_name])
+        return out
 
     def __getitem__(self, key: str) -> Tolerance:
         for t in self.tolerances:
@@ -248,11 +290,12 @@ class ToleranceSet:
         raise KeyError(key)
 
     def with_tolerances(self, widths: Mapping[str, float]) -> ToleranceSet:
-        """A copy with some widths changed."""
+        """A copy with some widths changed (keyed by tolerance key or by family)."""
+        w = self.family_widths(widths)
         return replace(
             self,
             tolerances=tuple(
-                t.with_tolerance(widths[t.key]) if t.key in widths else t for t in self.tolerances
+                t.with_tolerance(w[t.key]) if t.key in w else t for t in self.tolerances
             ),
         )
 
@@ -271,7 +314,7 @@ class ToleranceSet:
         if self.groups:
             zg = rng.standard_normal((n, len(self.groups)))
             for j, g in enumerate(self.groups):
-                cols = [self.keys.index(key) for key in g.keys]
+                cols = [self.keys.index(key) for key in self.group_members(g)]
                 z[:, cols] = (
                     math.sqrt(g.rho) * zg[:, j : j + 1] + math.sqrt(1.0 - g.rho) * z[:, cols]
                 )
@@ -283,8 +326,9 @@ class ToleranceSet:
     ) -> dict[str, np.ndarray]:
         """The drawn errors by column name, at the set's widths (or ``widths`` where given)."""
         out: dict[str, np.ndarray] = {}
+        w_all = None if widths is None else self.family_widths(widths)
         for i, t in enumerate(self.tolerances):
-            w = None if widths is None else widths.get(t.key)
+            w = None if w_all is None else w_all.get(t.key)
             out[t.key] = t.transform(z[:, i], w)
             if t.phase:
                 out[f"{t.key}_phase_rad"] = phases[:, i].copy()

@@ -1,0 +1,72 @@
+"""The RV reducer through the yield engine: each sample one assembled reducer."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import gearte
+from gearte.geometry.rv import ManufacturingErrors
+from gearte.models.rv_catalogue import catalogue_values
+from gearte.studies.rv_reducer import build_reducer
+from gearte.tolerance.drive_yield import RVReducerYield, rv_error_keys
+from gearte.tolerance.yield_mc import SpecLimit, Tolerance, ToleranceSet, run_yield
+from gearte.units import rad_to_arcmin
+
+
+@pytest.fixture(scope="module")
+def rv():
+    red = build_reducer(gearte.load_case("han2023_rv110e").reducer)
+    return red, RVReducerYield(red, positions=36)
+
+
+def test_rv_zero_tolerances_give_the_deterministic_catalogue_values_exactly(rv):
+    red, model = rv
+    keys = rv_error_keys(red)
+    ts = ToleranceSet(
+        tuple(Tolerance(k, "rayleigh", 0.0, phase=True, family="cam") for k in keys["cam"])
+        + tuple(Tolerance(k, "normal", 0.0, family="radius_errors") for k in keys["radius_errors"])
+    )
+    r = run_yield(model, ts, [SpecLimit("lost_motion [arcmin]", upper=1.0)], 2, seed=0)
+    # a drawn error replaces the measured one: the deterministic reducer has zero cam errors
+    e = red.errors
+    red0 = red.with_errors(
+        ManufacturingErrors(e.planet, e.disc_bore, np.zeros_like(e.cam), e.carrier_bore)
+    )
+    red0 = red0.replace(pins=replace(red0.pins, radius_errors=np.zeros(red0.pins.count)))
+    cv = catalogue_values(red0)
+    st = r.quantities["lost_motion [arcmin]"].stats
+    assert st.min == st.max == pytest.approx(float(rad_to_arcmin(cv.lost_motion)), rel=1e-12)
+
+
+def test_rv_drawn_errors_change_the_reducer_as_keyed(rv):
+    red, model = rv
+    e = {"cam.c1.d2": 10.0, "cam.c1.d2_phase_rad": np.pi / 2, "radius_errors.p3": -2.0}
+    r = model.reducer_for(e)
+    np.testing.assert_allclose(r.errors.cam[0, 1], [0.0, 0.01], atol=1e-15)
+    assert r.pins.radius_errors[2] == pytest.approx(-0.002)
+    # errors not drawn keep the reducer's measured values
+    np.testing.assert_array_equal(r.errors.planet, red.errors.planet)
+
+
+@pytest.mark.slow
+def test_rv_samples_give_every_catalogue_quantity(rv):
+    red, model = rv
+    keys = rv_error_keys(red)
+    ts = ToleranceSet(
+        tuple(Tolerance(k, "rayleigh", 5.0, phase=True, family="cam") for k in keys["cam"])
+    )
+    r = run_yield(model, ts, [SpecLimit("angular_te [arcmin]", upper=1.0)], 4, seed=3, chunk_size=2)
+    names = {
+        "lost_motion [arcmin]",
+        "torsional_rigidity [Nm/arcmin]",
+        "backlash [arcmin]",
+        "hysteresis_loss [arcmin]",
+        "angular_te [arcmin]",
+        "loaded_te [arcmin]",
+        "peak_pin_load [N]",
+    }
+    assert names <= set(r.quantities)
+    assert r.quantities["angular_te [arcmin]"].stats.sd > 0
