@@ -8,9 +8,9 @@ import pytest
 
 from gearte.io.case_file import load_case
 from gearte.models.cycloid_te import geometric_te
+from gearte.runners.yield_models import CycloidGeometricTE, PlanetaryCoupledTE
 from gearte.studies.cycloid_stage import build_stage
 from gearte.studies.planetary import build_terms
-from gearte.tolerance.drive_yield import CycloidGeometricTE, PlanetaryCoupledTE
 from gearte.tolerance.yield_contributions import linear_prediction
 from gearte.tolerance.yield_mc import SpecLimit, Tolerance, ToleranceSet, run_yield
 from gearte.units import mm_to_um, rad_to_arcmin

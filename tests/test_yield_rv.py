@@ -10,8 +10,8 @@ import pytest
 import gearte
 from gearte.geometry.rv import ManufacturingErrors
 from gearte.models.rv_catalogue import catalogue_values
+from gearte.runners.yield_models import RVReducerYield, rv_error_keys
 from gearte.studies.rv_reducer import build_reducer
-from gearte.tolerance.drive_yield import RVReducerYield, rv_error_keys
 from gearte.tolerance.yield_mc import SpecLimit, Tolerance, ToleranceSet, run_yield
 from gearte.units import rad_to_arcmin
 

@@ -1,6 +1,6 @@
 """``[analyses.yield]``: the production-yield analysis any study kind can offer.
 
-A kind that has a yield model of its drive (:mod:`gearte.tolerance.drive_yield`) adds
+A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) adds
 ``yield: YieldSection | None`` to its analyses and calls :func:`yield_analysis`. The section::
 
     [analyses.yield]

@@ -484,8 +484,8 @@ def _yield(st, case: Case, options) -> AnalysisResult:
     """``[analyses.yield]``: the nine component errors [µm] drawn from their laws → the
     distribution of the geometric TE (not only eq 17's RSS band) and its yield."""
     from gearte.models.cycloid_te import ERROR_FACTORS
+    from gearte.runners.yield_models import CycloidGeometricTE
     from gearte.studies._yield import ToleranceEntry, yield_analysis
-    from gearte.tolerance.drive_yield import CycloidGeometricTE
 
     means = {k: getattr(case.errors, k).mean_um for k in ERROR_FACTORS}
     # the [errors] bands (mean ± T/2) as normal laws with σ = T/6, unless the section says else

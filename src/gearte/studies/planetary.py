@@ -533,8 +533,8 @@ def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> Analy
     """``[analyses.yield]``: magnitudes [µm] and directions [deg] as tolerances (e.g. Wang's
     random assembly: each direction ``uniform``, ``nominal_deg = 180``, ``tolerance_deg =
     180``) → yield of the coupled TE."""
+    from gearte.runners.yield_models import PlanetaryCoupledTE
     from gearte.studies._yield import yield_analysis
-    from gearte.tolerance.drive_yield import PlanetaryCoupledTE
 
     mag_um = {k: float(mm_to_um(v)) for k, v in mags.items()}
     ang_deg = {k: float(rad_to_deg(v)) for k, v in angs.items()}
