@@ -109,7 +109,9 @@ def bench_rv(n: int, workers: int) -> None:
     tols = []
     for fam in ("cam", "disc_crank_bore", "carrier_crank_bore", "planet_base_circle"):
         tols += [Tolerance(k, "rayleigh", 5.0, phase=True, family=fam) for k in keys[fam]]
-    tols += [Tolerance(k, "normal", 2.0, family="radius_errors") for k in keys["radius_errors"]]
+    tols += [
+        Tolerance(k, "normal", 2.0, family="pins.radius_errors") for k in keys["pins.radius_errors"]
+    ]
     ts = ToleranceSet(tuple(tols))
     spec = [
         SpecLimit("lost_motion [arcmin]", upper=1.0),

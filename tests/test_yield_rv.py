@@ -27,7 +27,10 @@ def test_rv_zero_tolerances_give_the_deterministic_catalogue_values_exactly(rv):
     keys = rv_error_keys(red)
     ts = ToleranceSet(
         tuple(Tolerance(k, "rayleigh", 0.0, phase=True, family="cam") for k in keys["cam"])
-        + tuple(Tolerance(k, "normal", 0.0, family="radius_errors") for k in keys["radius_errors"])
+        + tuple(
+            Tolerance(k, "normal", 0.0, family="pins.radius_errors")
+            for k in keys["pins.radius_errors"]
+        )
     )
     r = run_yield(model, ts, [SpecLimit("lost_motion [arcmin]", upper=1.0)], 2, seed=0)
     # a drawn error replaces the measured one: the deterministic reducer has zero cam errors
@@ -43,7 +46,7 @@ def test_rv_zero_tolerances_give_the_deterministic_catalogue_values_exactly(rv):
 
 def test_rv_drawn_errors_change_the_reducer_as_keyed(rv):
     red, model = rv
-    e = {"cam.c1.d2": 10.0, "cam.c1.d2_phase_rad": np.pi / 2, "radius_errors.p3": -2.0}
+    e = {"cam.c1.d2": 10.0, "cam.c1.d2_phase_rad": np.pi / 2, "pins.radius_errors.p3": -2.0}
     r = model.reducer_for(e)
     np.testing.assert_allclose(r.errors.cam[0, 1], [0.0, 0.01], atol=1e-15)
     assert r.pins.radius_errors[2] == pytest.approx(-0.002)
@@ -70,3 +73,26 @@ def test_rv_samples_give_every_catalogue_quantity(rv):
     }
     assert names <= set(r.quantities)
     assert r.quantities["angular_te [arcmin]"].stats.sd > 0
+
+
+def test_rv_reducer_case_yield_analysis_and_runnable_worst_case(tmp_path):
+    """han2023_rv110e_yield with 4 samples and no Sobol: the result names issue 14 requires,
+    and the worst reducer written as a case file gives the same lost motion when run alone."""
+    import json
+    import tomllib
+
+    from gearte.cases import case_path
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies import RunOptions
+
+    data = tomllib.loads(case_path("han2023_rv110e_yield").read_text())
+    data["analyses"]["yield"].update(samples=4, chunk_size=2, sobol_samples=0, keep_worst=1)
+    res = gearte.run_case(load_case_dict(data, name="rv_yield"), RunOptions(progress=False))
+    gearte.write_outputs(res, tmp_path / "out")
+    v = json.loads((tmp_path / "out" / "results.json").read_text())["analyses"]["yield"]["values"]
+    for k in ("yield", "yield_ci_low", "yield_ci_high", "cpk"):
+        assert k in v
+    worst = v["worst_samples"][0]
+    alone = gearte.run_case(gearte.load_case(tmp_path / "out" / "worst_sample_1.toml"))
+    lm = alone["catalogue"]["lost_motion [arcmin]"]
+    assert lm == pytest.approx(worst["values"]["lost_motion [arcmin]"], rel=1e-6)

@@ -193,7 +193,7 @@ def rv_error_keys(reducer) -> dict[str, list[str]]:
 
     ``planet_base_circle.c<i>``, ``disc_crank_bore.c<i>.d<j>``, ``cam.c<i>.d<j>``,
     ``carrier_crank_bore.c<i>`` (crank ``i``, disc ``j``, 1-based as in the case file) and
-    ``radius_errors.p<k>`` … for every pin ``k``.
+    ``pins.radius_errors.p<k>`` … for every pin ``k`` (families ``pins.radius_errors`` …).
     """
     m, n, zp = reducer.cranks.count, reducer.discs.count, reducer.pins.count
     cr = range(1, m + 1)
@@ -202,7 +202,7 @@ def rv_error_keys(reducer) -> dict[str, list[str]]:
         "disc_crank_bore": [f"disc_crank_bore.c{i}.d{j}" for i in cr for j in range(1, n + 1)],
         "cam": [f"cam.c{i}.d{j}" for i in cr for j in range(1, n + 1)],
         "carrier_crank_bore": [f"carrier_crank_bore.c{i}" for i in cr],
-        **{f: [f"{f}.p{k}" for k in range(1, zp + 1)] for f in RV_PIN_FAMILIES},
+        **{f"pins.{f}": [f"pins.{f}.p{k}" for k in range(1, zp + 1)] for f in RV_PIN_FAMILIES},
     }
 
 
@@ -247,7 +247,7 @@ class RVReducerYield:
         *,
         positions: int = 36,
         te_torque: float | None = None,
-        zero_load_fraction: float = 0.02,
+        zero_load_fraction: float = 1e-3,
         lost_motion_fraction: float = 0.03,
     ) -> None:
         from gearte.errors import ParameterError
@@ -294,7 +294,7 @@ class RVReducerYield:
         pins = red.pins
         changed = {}
         for f in RV_PIN_FAMILIES:
-            keys = self.keys[f]
+            keys = self.keys[f"pins.{f}"]
             if any(k in errors for k in keys):
                 arr = np.asarray(getattr(pins, f), dtype=float).copy()
                 for k, key in enumerate(keys):

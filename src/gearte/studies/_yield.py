@@ -82,7 +82,7 @@ class GroupEntry(StrictModel):
     """Correlated errors (one grinding batch, one fixture)."""
 
     name: str = Field(min_length=1, max_length=100)
-    keys: list[str] = Field(min_length=2, max_length=1000)
+    keys: list[str] = Field(min_length=1, max_length=1000, description="keys or families")
     rho: float = Field(ge=0, le=1, description="correlation of the members' standard normals")
 
 
@@ -150,23 +150,35 @@ def _tolerances(
     units: Mapping[str, str],
     nominal: Mapping[str, float],
     defaults: Mapping[str, ToleranceEntry],
+    families: Mapping[str, list[str]],
 ):
     from gearte.errors import ParameterError
     from gearte.tolerance.yield_mc import CorrelatedGroup, Tolerance, ToleranceSet
 
+    given = {**defaults, **section.tolerances}
+    # a family's tolerance stands for each of its instances (an instance may be given itself)
+    expanded: dict[str, tuple[ToleranceEntry, str | None]] = {}
+    for key, t in given.items():
+        if key in families:
+            for inst in families[key]:
+                if inst not in given:
+                    expanded[inst] = (t, key)
+        else:
+            expanded[key] = (t, None)
     tols = []
-    for key, t in {**defaults, **section.tolerances}.items():
-        if key not in units:
+    for key, (t, fam) in expanded.items():
+        ukey = fam or key
+        if ukey not in units:
             raise ParameterError(
-                f"analyses.yield.tolerances.{key}",
-                key,
-                f"is not an error key; known: {list(units)}",
+                f"analyses.yield.tolerances.{ukey}",
+                ukey,
+                f"is not an error key or family; known: {sorted(units)}",
             )
-        if t.unit != units[key]:
+        if t.unit != units[ukey]:
             raise ParameterError(
-                f"analyses.yield.tolerances.{key}",
+                f"analyses.yield.tolerances.{ukey}",
                 t.unit,
-                f"this error is in {units[key]}: give tolerance_{units[key]}",
+                f"this error is in {units[ukey]}: give tolerance_{units[ukey]}",
             )
         tol = t.tolerance_um if t.unit == "um" else t.tolerance_deg
         nom = t.nominal_um if t.unit == "um" else t.nominal_deg
@@ -179,6 +191,7 @@ def _tolerances(
                 sigmas=t.sigmas,
                 phase=t.phase,
                 values=None if t.values_um is None else tuple(t.values_um),
+                family=fam,
             )
         )
     groups = tuple(CorrelatedGroup(g.name, tuple(g.keys), g.rho) for g in section.groups)
@@ -240,6 +253,7 @@ def yield_analysis(
     worst_case: Callable[[Mapping[str, float]], dict] | None = None,
     references: list[str] | None = None,
     defaults: Mapping[str, ToleranceEntry] | None = None,
+    families: Mapping[str, list[str]] | None = None,
 ) -> AnalysisResult:
     """Run the yield analysis of a drive.
 
@@ -259,6 +273,9 @@ def yield_analysis(
     defaults : mapping, optional
         Tolerances the drive's own description implies (e.g. a cycloid stage's error bands);
         the section's entries replace them key by key.
+    families : mapping, optional
+        Family key → its instance keys (e.g. ``cam`` → ``cam.c1.d1`` …): a tolerance on a
+        family applies to each instance, drawn independently (a correlated group may name it).
     """
     from gearte.errors import ParameterError
     from gearte.tolerance.allocation import CostModel, PriceTable, allocate
@@ -272,7 +289,7 @@ def yield_analysis(
     seed = section.seed if getattr(options, "seed", None) is None else int(options.seed)
     n = section.samples if getattr(options, "samples", None) is None else int(options.samples)
     defaults = dict(defaults or {})
-    ts = _tolerances(section, units, nominal, defaults)
+    ts = _tolerances(section, units, nominal, defaults, dict(families or {}))
     spec = [SpecLimit(q, s.lower, s.upper) for q, s in section.spec.items()]
     progress = getattr(options, "progress", False)
     res = run_yield(
