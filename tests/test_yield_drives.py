@@ -139,3 +139,26 @@ def test_planetary_yield_case_runs_and_names_its_worst_assembly(tmp_path):
     assert v["samples"] == 5_000
     assert 0.0 < v["yield"] < 1.0
     assert (tmp_path / "worst_sample_1.toml").exists()
+
+
+def test_cycloid_yield_is_bit_identical_on_threads_and_processes():
+    case, st = _hu_stage()
+    model = CycloidGeometricTE(st)
+    ts = ToleranceSet(
+        (
+            Tolerance("pin_radius_error", "normal", 3.0),
+            Tolerance("eccentricity_error", "rayleigh", 5.0),
+        )
+    )
+    spec = [SpecLimit("geometric_te [arcmin]", upper=1.1)]
+
+    class Opt:
+        def __init__(self, scheduler):
+            self.workers, self.scheduler, self.progress = 2, scheduler, False
+
+    a = run_yield(model, ts, spec, 6000, seed=2, chunk_size=1500, options=Opt(None))
+    b = run_yield(model, ts, spec, 6000, seed=2, chunk_size=1500, options=Opt("processes"))
+    assert a.passed == b.passed
+    q = "geometric_te [arcmin]"
+    assert a.quantities[q].stats.as_tuple() == b.quantities[q].stats.as_tuple()
+    assert a.worst == b.worst

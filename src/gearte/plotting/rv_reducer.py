@@ -145,4 +145,7 @@ def figures(result) -> list[Figure]:
         out.append(_hysteresis(cat, result["catalogue"]["rated_torque [N*m]"] * 1e3))
     if "compensation" in result:
         out.append(_compensation(result["compensation"].data["compensation"]))
+    from gearte.plotting.yield_figures import yield_figures
+
+    out += yield_figures(result)
     return out
