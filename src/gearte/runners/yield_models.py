@@ -17,6 +17,10 @@ bound. They are picklable (module-level classes), so processes and Dask can run 
   test (lost motion at ±3 % rated torque, rigidity, backlash, hysteresis), angular TE over one
   output revolution (unloaded: geometric; at the TE torque: total) and the peak pin load
   (Han et al. 2023 load sharing, :mod:`gearte.models.rv_load_sharing`).
+* :class:`GearChainLostMotion` — a chain of drives: each stage's lost motion [arcmin, at its
+  output] drawn from its own distribution (:func:`chain_tolerances` builds them from each drive's
+  ``lost_motion_spread``), combined at the joint by Jiang et al. (2024) eq. (30) → the
+  distribution of the joint's lost motion, not only its maximum.
 """
 
 from __future__ import annotations
@@ -41,6 +45,8 @@ __all__ = [
     "RV_VECTOR_PARTS",
     "RV_PIN_FAMILIES",
     "rv_error_keys",
+    "GearChainLostMotion",
+    "chain_tolerances",
 ]
 
 
@@ -350,3 +356,64 @@ class RVReducerYield:
         if not rows:
             rows.append(self.one(self.reducer))
         return {k: np.array([r[k] for r in rows]) for k in rows[0]}
+
+
+class GearChainLostMotion:
+    """Lost motion at the joint of a chain from the stages' drawn lost motions.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Stage keys (motor to joint), the tolerance keys [arcmin at the stage output].
+    ratios : sequence of float
+        Stage reduction ratios (``> 0``), motor to joint.
+
+    Notes
+    -----
+    ``Δφ_joint = Σₖ max(Δφₖ, 0) / Πⱼ₍ⱼ>ₖ₎ iⱼ`` (Jiang et al. 2024 eq. 30; a stage whose parts
+    interfere has no lost motion, never a negative one). Output ``"joint_lost_motion [arcmin]"``.
+
+    References
+    ----------
+    Jiang et al. (2024), see :mod:`gearte.models.lost_motion`.
+    """
+
+    def __init__(self, names, ratios) -> None:
+        from gearte.models.lost_motion import stage_transfer_factors
+
+        self.names = tuple(names)
+        self.factors = stage_transfer_factors(ratios)
+        if len(self.names) != self.factors.size:
+            from gearte.errors import ParameterError
+
+            raise ParameterError("names", self.names, "one name per stage ratio")
+
+    def __call__(self, errors: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        n = _n(errors)
+        e = np.column_stack(
+            [np.maximum(np.asarray(errors[k], dtype=float), 0.0) for k in self.names]
+        )
+        return {"joint_lost_motion [arcmin]": (e @ self.factors).reshape(n)}
+
+
+def chain_tolerances(drives, confidence: float = 0.9973):
+    """One normal tolerance per drive from its ``lost_motion_spread`` [arcmin]: nominal = the
+    stack's mean, σ = its σ (``sigmas = 3`` with ``tolerance = 3σ``). Drives without a tolerance
+    stack (``None``) are an error naming the drive."""
+    from gearte.errors import ParameterError
+    from gearte.tolerance.yield_mc import Tolerance, ToleranceSet
+
+    tols = []
+    for d in drives:
+        s = d.lost_motion_spread(confidence)
+        if s is None:
+            raise ParameterError(f"{d.name}.lost_motion_spread", None, "this drive has no stack")
+        tols.append(
+            Tolerance(
+                d.name,
+                "normal",
+                3.0 * float(rad_to_arcmin(s.sd)),
+                nominal=float(rad_to_arcmin(s.mean)),
+            )
+        )
+    return ToleranceSet(tuple(tols))
