@@ -110,11 +110,8 @@ class SpurGearSpec(_ThicknessLimits):
             return float(self.radial_composite_tol_um)
         from gearte.tolerance.iso1328 import radial_composite_tolerances
 
-        return radial_composite_tolerances(
-            int(self.grade),
-            module_mm,
-            module_mm * self.teeth,  # type: ignore[arg-type]
-        ).F_i2
+        assert self.grade is not None  # one of the two is given (validated)
+        return radial_composite_tolerances(self.grade, module_mm, module_mm * self.teeth).F_i2
 
 
 class _Clearance(StrictModel):

@@ -607,7 +607,8 @@ def run_yield(
             scale[s.quantity] = (s.upper - s.lower) / 2.0
         else:
             lim = s.upper if s.upper is not None else s.lower
-            scale[s.quantity] = max(abs(float(lim)), abs(float(nominal[s.quantity][0])), 1e-300)
+            assert lim is not None  # SpecLimit has at least one limit
+            scale[s.quantity] = max(abs(lim), abs(float(nominal[s.quantity][0])), 1e-300)
     shared = _Shared(model, tolerances, spec, keep_worst, keep_head, scale)
     chunks = seeded_chunks(n, chunk_size, seed)
     total = map_chunks(
@@ -631,13 +632,13 @@ def run_yield(
     specs = {s.quantity: s for s in spec}
     cpks = []
     for k, st in total.stats.items():
-        s = specs.get(k)
+        sp = specs.get(k)
         cpk = None
         ff = None
-        if s is not None:
+        if sp is not None:
             ff = total.fails[k] / total.n
             if st.count > 1:
-                _, cpk = process_capability(st.mean, st.sd, s.lower, s.upper)
+                _, cpk = process_capability(st.mean, st.sd, sp.lower, sp.upper)
             if cpk is not None:
                 cpks.append(cpk)
         quantities[k] = QuantityStats(k, st, ff, cpk)
