@@ -399,7 +399,15 @@ class GearChainLostMotion:
 def chain_tolerances(drives, confidence: float = 0.9973):
     """One normal tolerance per drive from its ``lost_motion_spread`` [arcmin]: nominal = the
     stack's mean, σ = its σ (``sigmas = 3`` with ``tolerance = 3σ``). Drives without a tolerance
-    stack (``None``) are an error naming the drive."""
+    stack (``None``) are an error naming the drive.
+
+    Parameters
+    ----------
+    drives : sequence of Drive
+        The chain's drives, motor to joint.
+    confidence : float
+        Confidence passed to ``lost_motion_spread`` [-].
+    """
     from gearte.errors import ParameterError
     from gearte.tolerance.yield_mc import Tolerance, ToleranceSet
 

@@ -200,7 +200,15 @@ def _tolerances(
 
 def to_toml(data: Mapping[str, Any], _prefix: str = "") -> str:
     """A minimal TOML writer for case dictionaries (tables, scalars, lists of scalars or of
-    tables)."""
+    tables).
+
+    Parameters
+    ----------
+    data : mapping
+        The case dictionary.
+    _prefix : str
+        Dotted name of the enclosing table (recursion).
+    """
 
     def scalar(v: Any) -> str:
         if isinstance(v, bool):
@@ -265,11 +273,14 @@ def yield_analysis(
     units : mapping
         Error key → ``"um"`` or ``"deg"`` (the keys a tolerance may name).
     nominal : mapping
-        Error key → the case's value (the nominal of a tolerance that gives none).
+        Error key → the case's value [unit of the key] (the nominal of a tolerance that gives
+        none).
     options : RunOptions, optional
         ``seed``/``samples`` override the section's; workers, scheduler, progress.
     worst_case : callable, optional
-        Drawn errors → a case dictionary that reproduces that drive on its own.
+        Drawn errors [units of the keys] → a case dictionary that reproduces that drive alone.
+    references : list of str, optional
+        Reference keys of the analysis.
     defaults : mapping, optional
         Tolerances the drive's own description implies (e.g. a cycloid stage's error bands);
         the section's entries replace them key by key.

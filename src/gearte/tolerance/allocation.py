@@ -172,11 +172,17 @@ def allocate(
         ``{tolerance key or family: CostModel | PriceTable}`` (a family's cost is per family:
         one stated tolerance); tolerances without a cost stay fixed.
     target : float
-        Required yield in (0, 1).
+        Required yield in (0, 1) [-].
     n, seed
         Search sample (common to every candidate).
     verify_n, verify_seed
         The independent verification run (default ``n`` samples, ``seed + 1``).
+    chunk_size : int
+        Samples per chunk.
+    max_steps : int
+        Limit of tightening and loosening steps.
+    options : RunOptions, optional
+        Workers and scheduler.
     """
     if not 0.0 < target < 1.0:
         raise ParameterError("target_yield", target, "must be in (0, 1)")

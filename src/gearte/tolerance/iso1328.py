@@ -76,7 +76,7 @@ _RANGES = {
 
 
 def iso1328_round(value_um: float) -> float:
-    """Round a tolerance [µm] as ISO 1328-1:2013 §5.2.3 prescribes.
+    """Round a tolerance ``value_um`` [µm] as ISO 1328-1:2013 §5.2.3 prescribes.
 
     > 10 µm: nearest 1 µm; 5 … 10 µm: nearest 0.5 µm; < 5 µm: nearest 0.1 µm (halves away from
     zero).
@@ -255,6 +255,9 @@ def grade_tolerances_um(
     grade: int, module_mm: float, reference_diameter_mm: float, face_width_mm: float
 ) -> dict[str, float]:
     """All tolerances a grade gives one gear [µm], keyed by the names case files use.
+
+    Parameters: ``grade`` (flank class 1 … 11), ``module_mm`` [mm], ``reference_diameter_mm``
+    [mm], ``face_width_mm`` [mm].
 
     ``single_pitch_um`` (f_pT), ``cumulative_pitch_um`` (F_pT), ``profile_total_um`` (F_αT),
     ``helix_total_um`` (F_βT), ``runout_um`` (F_rT), ``radial_composite_um`` (F_i″, same number

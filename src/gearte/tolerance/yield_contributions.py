@@ -127,9 +127,13 @@ def sobol_tolerances(
     bootstrap : int
         Bootstrap resamples for the confidence intervals (0: none, intervals collapse).
     confidence : float
-        Level of the intervals.
+        Level of the intervals [-].
     chunk_size : int
         Base samples per chunk (memory ∝ ``chunk_size·(k + 2)``).
+    options : RunOptions, optional
+        Workers and scheduler.
+    progress : bool, optional
+        Progress bar.
 
     Returns
     -------
@@ -204,6 +208,15 @@ def linear_prediction(
 
     Central differences with step ``step × tolerance`` (tolerances of width 0 contribute
     nothing); every perturbed drive is evaluated in one vectorised model call.
+
+    Parameters
+    ----------
+    model, tolerances
+        As :func:`sobol_tolerances`.
+    quantities : sequence of str
+        Model outputs to predict.
+    step : float
+        Relative finite-difference step [-] (fraction of each tolerance).
     """
     ts = tolerances
     rows: list[dict[str, float]] = []
@@ -263,7 +276,13 @@ def pareto_rows(
     sobol: SobolIndices, linear: LinearPrediction | None = None
 ) -> list[dict[str, Any]]:
     """Rows of a contribution Pareto sorted by total index: name, S, ST, CIs, cumulative ST
-    share and the linear share beside them."""
+    share and the linear share beside them.
+
+    Parameters
+    ----------
+    sobol : SobolIndices
+    linear : LinearPrediction, optional
+    """
     tot = sum(max(v, 0.0) for v in sobol.total.values()) or 1.0
     rows = []
     cum = 0.0

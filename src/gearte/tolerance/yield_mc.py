@@ -382,7 +382,8 @@ class SpecLimit:
 
 
 def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
-    """Wilson score interval of a binomial proportion ``k/n`` (Wilson 1927)."""
+    """Wilson score interval of a binomial proportion ``k/n`` (Wilson 1927); ``confidence``
+    [-] its two-sided level."""
     from scipy.stats import norm
 
     if n <= 0:
@@ -396,7 +397,8 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
 
 
 def clopper_pearson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
-    """Exact (Clopper–Pearson 1934) interval of a binomial proportion ``k/n``."""
+    """Exact (Clopper–Pearson 1934) interval of a binomial proportion ``k/n``; ``confidence``
+    [-] its two-sided level."""
     from scipy.stats import beta
 
     if n <= 0:
@@ -447,7 +449,8 @@ class YieldResult:
 def evaluate_checked(
     model: Model, errors: Mapping[str, np.ndarray], n: int
 ) -> dict[str, np.ndarray]:
-    """Call ``model`` and check it returned one finite-or-nan float per sample per quantity."""
+    """Call ``model`` on ``errors`` (one array of ``n`` samples per key [units of the keys]) and
+    return one float per sample per quantity."""
     out = model(errors)
     res: dict[str, np.ndarray] = {}
     for k, v in out.items():
@@ -569,7 +572,7 @@ def run_yield(
     chunk_size : int
         Samples per chunk (fixes the streams; memory per worker ∝ ``chunk_size``).
     confidence : float
-        Level of the yield's confidence interval.
+        Level of the yield's confidence interval [-].
     ci_method : {"wilson", "clopper-pearson"}
     keep_worst : int
         Worst samples kept (smallest margin to the spec, normalised by each quantity's spec
