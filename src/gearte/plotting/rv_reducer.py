@@ -158,4 +158,7 @@ def figures(result) -> list[Figure]:
     from gearte.plotting import rv_dynamics
 
     out += rv_dynamics.figures(result)
+    from gearte.plotting.yield_figures import yield_figures
+
+    out += yield_figures(result)
     return out
