@@ -15,6 +15,7 @@ __all__ = [
     "ConvergenceError",
     "DivergenceError",
     "SchedulerError",
+    "BenchFileError",
 ]
 
 
@@ -70,3 +71,23 @@ class DivergenceError(GearteError, RuntimeError):
 
 class SchedulerError(GearteError, ConnectionError):
     """A distributed scheduler could not be reached or failed."""
+
+
+class BenchFileError(GearteError, ValueError):
+    """A bench measurement file (CSV) is malformed.
+
+    The message names the file, the line (1-based, as an editor shows it) and the column (its
+    header name and 1-based number) where the problem was found, and the reason.
+    """
+
+    def __init__(self, file: str, line: int | None, column: str | None, reason: str) -> None:
+        self.file = file
+        self.line = line
+        self.column = column
+        self.reason = reason
+        where = file
+        if line is not None:
+            where += f", line {line}"
+        if column is not None:
+            where += f", column {column}"
+        super().__init__(f"{where}: {reason}")
