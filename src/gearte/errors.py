@@ -16,6 +16,7 @@ __all__ = [
     "DivergenceError",
     "SchedulerError",
     "BenchFileError",
+    "OutputError",
 ]
 
 
@@ -73,6 +74,28 @@ class SchedulerError(GearteError, ConnectionError):
     """A distributed scheduler could not be reached or failed."""
 
 
+class OutputError(GearteError):
+    """The output folder cannot receive the results: read-only, full disk, file-size limit, a
+    path under a file, a folder holding files gearte did not write. A user error (CLI exit
+    code 4), raised before the computation where it can be foreseen.
+
+    Parameters
+    ----------
+    path : str
+        The output path as the user gave it.
+    reason : str
+        What is wrong and, where possible, what to do.
+    """
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"output {path}: {reason}")
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.path, self.reason))
+
+
 class BenchFileError(GearteError, ValueError):
     """A bench measurement file (CSV) is malformed.
 
@@ -91,3 +114,6 @@ class BenchFileError(GearteError, ValueError):
         if column is not None:
             where += f", column {column}"
         super().__init__(f"{where}: {reason}")
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.file, self.line, self.column, self.reason))
