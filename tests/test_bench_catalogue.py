@@ -38,8 +38,9 @@ def test_definitions_on_an_analytic_loop():
     hv = hysteresis_values(t, a, TR)
     assert hv.torsional_rigidity == pytest.approx(k, rel=1e-12)
     assert hv.lost_motion == pytest.approx(0.06 * TR / k + play, rel=1e-12)
-    # the mid-curve between ±1e-4 T_r samples: linear interpolation across the jump
+    # loop width at zero = play + friction width; backlash = that less the width at ±T_r/2
     assert hv.hysteresis_loss == pytest.approx(play + fr, rel=1e-9)
+    assert hv.backlash == pytest.approx(play, rel=1e-9)
     hv5 = hysteresis_values(t, a, TR, lost_motion_fraction=0.05)
     assert hv5.lost_motion == pytest.approx(0.10 * TR / k + play, rel=1e-12)
 
@@ -60,6 +61,9 @@ def test_sweep_short_of_rated_torque_is_a_named_error():
     t, a, _ = _loop()
     with pytest.raises(ValueError, match="rated torque"):
         hysteresis_values(0.5 * t, a, TR)
+    # a peak 1 % short of T_r is read at its own peak (no extrapolation)
+    hv = hysteresis_values(0.99 * t, a * 0.99, TR)
+    assert hv.torsional_rigidity == pytest.approx(1e6, rel=1e-9)
 
 
 def test_te_peak_to_peak_and_forward_backward_difference():

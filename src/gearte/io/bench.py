@@ -33,12 +33,13 @@ from __future__ import annotations
 import difflib
 import os
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from gearte.errors import BenchFileError
+from gearte.models.bench_data import HysteresisCurve, TETrace
 from gearte.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, Nm_to_Nmm
 
 __all__ = [
@@ -91,57 +92,6 @@ _META_TEXT = ("serial", "angle_unit", "te_unit", "torque_unit", "kind")
 _KEY = re.compile(r"^#\s*([A-Za-z_][A-Za-z0-9_]*)\s*:\s*(.*?)\s*$")
 _HEADER = re.compile(r"^\s*([^\[\]]+?)\s*(?:\[\s*([^\[\]]*?)\s*\])?\s*$")
 _TE_LIMIT = 1.0 / DEG_PER_RAD  # a TE beyond 1° is a unit mistake, not a reducer
-
-
-@dataclass(frozen=True, eq=False)
-class TETrace:
-    """Angular transmission error of one operating point, per direction.
-
-    Attributes
-    ----------
-    source : str
-        File it was read from.
-    forward_position, forward_te, backward_position, backward_te : ndarray or None
-        Output position [rad] and TE [rad] of each direction (``None`` if not measured).
-    speed_rpm, torque, oil_temperature : float or None
-        Operating point: output speed [rpm], torque [N·mm], oil temperature [°C].
-    serial : str or None
-    """
-
-    source: str
-    forward_position: np.ndarray | None
-    forward_te: np.ndarray | None
-    backward_position: np.ndarray | None
-    backward_te: np.ndarray | None
-    speed_rpm: float | None = None
-    torque: float | None = None
-    oil_temperature: float | None = None
-    serial: str | None = None
-    metadata: dict = field(default_factory=dict)
-
-    def directions(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """``{"forward": (position, te), "backward": (...)}`` for the measured directions."""
-        out = {}
-        if self.forward_position is not None and self.forward_te is not None:
-            out["forward"] = (self.forward_position, self.forward_te)
-        if self.backward_position is not None and self.backward_te is not None:
-            out["backward"] = (self.backward_position, self.backward_te)
-        return out
-
-
-@dataclass(frozen=True, eq=False)
-class HysteresisCurve:
-    """Torque [N·mm] and output torsion angle [rad] in recording order, with branch marks.
-
-    ``branch`` is ``None`` (to be inferred) or an int array: +1 ascending torque, −1 descending.
-    """
-
-    source: str
-    torque: np.ndarray
-    angle: np.ndarray
-    branch: np.ndarray | None = None
-    serial: str | None = None
-    metadata: dict = field(default_factory=dict)
 
 
 # ---- parsing -----------------------------------------------------------------------------

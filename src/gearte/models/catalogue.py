@@ -15,8 +15,8 @@ motion"; the same definitions are in GB/T 35089):
 * **torsional rigidity** ``b/a``: ``(T_r/2)/(θ_mid(T_r) − θ_mid(T_r/2))`` and the same for
   ``−T_r``, averaged [N·mm/rad];
 * **lost motion** ``θ_mid(+f T_r) − θ_mid(−f T_r)``, ``f = 0.03`` (configurable, e.g. 0.05) [rad];
-* **backlash at zero torque** ``θ_mid(+ε T_r) − θ_mid(−ε T_r)`` with ``ε = 1e-4``: the jump of the
-  mid-curve across zero torque, i.e. the free play without the friction width [rad];
+* **backlash at zero torque**: the hysteresis loss less the friction width ``w_f`` (the loop
+  width at ``±T_r/2``, where only friction separates the branches): the free play [rad];
 * **hysteresis loss** ``θ_desc(0) − θ_asc(0)``: the width of the loop at zero torque after
   unloading from ``±T_r`` (free play plus friction) [rad].
 
@@ -58,7 +58,7 @@ __all__ = [
 ]
 
 ZERO_TORQUE_FRACTION = 1e-4
-"""``ε``: the torques ``±ε T_r`` that bracket zero for the backlash."""
+"""``ε``: a virtual test samples ``±ε T_r`` on either side of zero torque."""
 
 
 @dataclass(frozen=True)
@@ -128,7 +128,7 @@ def split_branches(
     rated_torque: float,
     direction: ArrayLike | None = None,
     *,
-    reach: float = 0.999,
+    reach: float = 0.98,
 ) -> Branches:
     """Split a hysteresis sweep into its ascending and descending branches.
 
@@ -190,11 +190,18 @@ def split_branches(
 
 def torsional_rigidity(branches: Branches, rated_torque: float) -> float:
     """Torsional rigidity b/a [N·mm/rad]: ``(T_r/2)/(θ_mid(T_r) − θ_mid(T_r/2))``, both signs
-    averaged."""
+    averaged.
+
+    A measured sweep whose peak torque falls short of ``T_r`` (within the ``reach`` that
+    :func:`split_branches` accepts) is read at its own peak ``T_hi``:
+    ``(T_hi − T_r/2)/(θ_mid(T_hi) − θ_mid(T_r/2))`` — nothing is extrapolated.
+    """
     tr = rated_torque
-    th = branches.mid(np.array([-tr, -0.5 * tr, 0.5 * tr, tr]))
-    k_pos = 0.5 * tr / (th[3] - th[2])
-    k_neg = 0.5 * tr / (th[1] - th[0])
+    hi = min(tr, branches.asc_torque[-1], branches.desc_torque[-1])
+    lo = max(-tr, branches.asc_torque[0], branches.desc_torque[0])
+    th = branches.mid(np.array([lo, -0.5 * tr, 0.5 * tr, hi]))
+    k_pos = (hi - 0.5 * tr) / (th[3] - th[2])
+    k_neg = (-0.5 * tr - lo) / (th[1] - th[0])
     return float(0.5 * (k_pos + k_neg))
 
 
@@ -207,9 +214,15 @@ def lost_motion(branches: Branches, rated_torque: float, fraction: float = 0.03)
 
 
 def backlash_at_zero(branches: Branches, rated_torque: float) -> float:
-    """Backlash ``θ_mid(+ε T_r) − θ_mid(−ε T_r)`` [rad], ``ε`` = :data:`ZERO_TORQUE_FRACTION`."""
-    th = branches.mid(np.array([-1.0, 1.0]) * ZERO_TORQUE_FRACTION * rated_torque)
-    return float(th[1] - th[0])
+    """Backlash at zero torque [rad]: the hysteresis loss less the friction width.
+
+    ``(θ_desc(0) − θ_asc(0)) − w_f`` with the friction width ``w_f`` the mean loop width at
+    ``±T_r/2``, where the reducer is closed and only friction separates the branches. The free
+    play without friction; equal to the hysteresis loss for a frictionless (virtual) curve.
+    """
+    half = np.array([-0.5, 0.5]) * rated_torque
+    w_f = float(np.mean(branches.descending(half) - branches.ascending(half)))
+    return hysteresis_loss(branches) - w_f
 
 
 def hysteresis_loss(branches: Branches) -> float:
