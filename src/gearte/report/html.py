@@ -79,7 +79,7 @@ def render_report(result: Any) -> str:
     """HTML text of the report of a :class:`~gearte.results.StudyResult`."""
     import jinja2
 
-    from gearte import __version__
+    from gearte._version import __version__
     from gearte.plotting import figures_for
     from gearte.references import REFERENCES
 
