@@ -86,7 +86,8 @@ def load_case_dict(data: Any, *, source: str = "<dict>", name: str | None = None
     if name is not None and "name" not in meta:
         data = {**data, "case": {**meta, "name": name}}
     try:
-        return module.Case.model_validate(data)
+        # the source lets a kind resolve paths written relative to the case file
+        return module.Case.model_validate(data, context={"source": source})
     except ValidationError as exc:
         raise CaseFileError(source, format_validation_errors(exc)) from None
 

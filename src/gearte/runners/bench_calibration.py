@@ -292,6 +292,18 @@ def calibrate(
         p.update(zip(fit, x * scale, strict=True))
         return p
 
+    def te_map(direction):
+        base = unpack(np.zeros(len(fit)))
+        c0 = te_coefficients(model, base, direction)
+        cx = np.empty((c0.size, len(fit)))
+        for j in range(len(fit)):
+            e = np.zeros(len(fit))
+            e[j] = 1.0
+            cx[:, j] = te_coefficients(model, unpack(e), direction) - c0
+        return c0, cx
+
+    te_maps = [te_map(r.direction) for r in te_rows]
+
     def blocks(x):
         p = unpack(x)
         out = {}
@@ -299,10 +311,9 @@ def calibrate(
             out["hysteresis"] = hysteresis_angle(model, p, hysteresis.torque, direction) - (
                 hysteresis.angle
             )
-        if te_rows:
-            out["te"] = np.concatenate(
-                [r.r @ (te_coefficients(model, p, r.direction) - r.c_hat) for r in te_rows]
-            )
+        if te_rows:  # the TE coefficients are linear in the parameters: c = c0 + C x
+            out["te"] = np.concatenate([r.r @ (c0 + cx @ x - r.c_hat) for r, (c0, cx) in
+                                        zip(te_rows, te_maps, strict=True)])  # fmt: skip
         return out
 
     weights = dict.fromkeys(("hysteresis", "te"), 1.0 / arcsec_to_rad(1.0))

@@ -48,17 +48,15 @@ class Diagnosis:
     statements: list[str] = field(default_factory=list)
 
 
-def _draws(cal: CalibrationResult, n: int, seed: int) -> list[dict]:
+def _draws(cal: CalibrationResult, n: int, seed: int) -> dict:
+    """Parameter draws as a dict of arrays (fitted) and scalars (held fixed)."""
     rng = np.random.default_rng(seed)
     mean = np.array([cal.params[k] for k in cal.fitted])
     cov = np.nan_to_num(cal.covariance, nan=0.0, posinf=0.0, neginf=0.0)
     x = rng.multivariate_normal(mean, cov, size=n, method="eigh")
-    out = []
-    for row in x:
-        p = dict(cal.params)
-        p.update(zip(cal.fitted, row, strict=True))
-        out.append(p)
-    return out
+    p = dict(cal.params)
+    p.update({k: x[:, i] for i, k in enumerate(cal.fitted)})
+    return p
 
 
 def _rank(cands: list[dict], samples: np.ndarray) -> list[dict]:
@@ -91,7 +89,7 @@ def _te_candidates(cal: CalibrationResult):
         groups.append((n, [f for f, _ in live], [k for _, k in live]))
 
     def amp(p, keys):
-        return float(np.hypot(sum(p[f"{k}_cos"] for k in keys), sum(p[f"{k}_sin"] for k in keys)))
+        return np.hypot(sum(p[f"{k}_cos"] for k in keys), sum(p[f"{k}_sin"] for k in keys))
 
     return groups, amp
 
@@ -138,11 +136,12 @@ def diagnose(
             "source": " or ".join(fams),
             "order": n,
             "parts": "; ".join(FAMILY_PARTS.get(f, f) for f in fams),
-            "contribution": amp(cal.params, keys),
+            "contribution": float(amp(cal.params, keys)),
             "indistinguishable": fams if len(fams) > 1 else [],
         })  # fmt: skip
     if te_c:
-        s = np.array([[amp(p, keys) for _, _, keys in groups] for p in sample])
+        s = np.column_stack([np.broadcast_to(amp(sample, keys), (draws,))
+                             for _, _, keys in groups])  # fmt: skip
         diag.te = _rank(te_c, s)
 
     # --- lost motion: play, reducer elasticity, rig compliance
@@ -188,7 +187,7 @@ def diagnose(
             fns = [terms[g][0] for g in grp]
 
             def total(p, fns=fns):
-                return float(sum(fn(model, p) for fn in fns))
+                return sum(fn(model, p) for fn in fns)
 
             note = []
             if grp == ["bearing clearances"] and (
@@ -200,11 +199,11 @@ def diagnose(
             lm_c.append({
                 "source": " or ".join(grp),
                 "parts": "; ".join(parts[g] for g in grp),
-                "contribution": total(cal.params),
+                "contribution": float(total(cal.params)),
                 "indistinguishable": note,
             })  # fmt: skip
             funcs.append(total)
-        s = np.array([[fn(p) for fn in funcs] for p in sample])
+        s = np.column_stack([np.broadcast_to(fn(sample), (draws,)) for fn in funcs])
         diag.lost_motion = _rank(lm_c, s)
 
     # --- statements
