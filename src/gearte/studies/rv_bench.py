@@ -54,9 +54,8 @@ DEFAULT_FAMILIES = ("output rotation", "crank rotation", "2× crank rotation", "
 def _resolve(value: str, info: ValidationInfo) -> str:
     p = Path(value).expanduser()
     if not p.is_absolute():
-        src = (info.context or {}).get("source") if info.context else None
-        base = Path(src).parent if src and src != "<dict>" else Path.cwd()
-        p = base / p
+        case_dir = (info.context or {}).get("case_dir")
+        p = (Path(case_dir) if case_dir else Path.cwd()) / p
     if not p.exists():
         raise ValueError(f"no file or folder {str(p)!r}")
     return str(p)
