@@ -152,3 +152,26 @@ def test_calibration_coverage_and_diagnosis_rate_over_50_seeds():
     coverage, rate = _coverage_and_diagnosis(range(50))
     print(f"coverage {coverage:.3f}, diagnosis {rate:.3f}")
     assert coverage >= 0.90 and rate >= 0.90
+
+
+def test_analytic_hysteresis_jacobian_matches_central_differences():
+    from gearte.models.bench_reduced import (
+        HYSTERESIS_PARAMETERS,
+        hysteresis_angle,
+        hysteresis_jacobian,
+    )
+
+    rng = np.random.default_rng(0)
+    p = _truth(rng)
+    t = np.linspace(-784e3, 784e3, 101) + 123.0  # off the exact zero of u
+    s = np.where(np.arange(t.size) % 2, 1, -1)
+    jac = hysteresis_jacobian(MODEL, p, t, s)
+    for name in HYSTERESIS_PARAMETERS:
+        h = 1e-6 * max(abs(p[name]), 1e-9)
+        hi, lo = dict(p), dict(p)
+        hi[name] += h
+        lo[name] -= h
+        fd = (hysteresis_angle(MODEL, hi, t, s) - hysteresis_angle(MODEL, lo, t, s)) / (2 * h)
+        np.testing.assert_allclose(
+            jac[name], fd, rtol=1e-5, atol=1e-6 * np.abs(fd).max(), err_msg=name
+        )

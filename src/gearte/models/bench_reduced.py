@@ -51,6 +51,7 @@ __all__ = [
     "hysteresis_angle",
     "te_trace",
     "te_basis",
+    "hysteresis_jacobian",
     "te_orders",
     "te_coefficients",
     "parameter_names",
@@ -125,6 +126,42 @@ def hysteresis_angle(
     elastic = elastic * np.sign(x) * np.abs(x) ** p
     play = 0.5 * _play(params, model) * np.tanh(u / params["play_transition_torque"])
     return params["angle_offset"] + play + elastic + params["rig_compliance"] * t
+
+
+def hysteresis_jacobian(
+    model: ReducedRV, params: dict, torque: ArrayLike, direction: ArrayLike
+) -> dict[str, np.ndarray]:
+    """Partial derivatives of :func:`hysteresis_angle` with respect to each of
+    :data:`HYSTERESIS_PARAMETERS` [rad per parameter unit], analytic.
+
+    At exactly ``u = T − s T_fr = 0`` the elastic law's slope ``|u|^(p−1)`` is infinite; it is
+    evaluated at ``|u/T_r| = 1e-12`` there.
+    """
+    t = np.asarray(torque, dtype=float)
+    s = np.asarray(direction, dtype=float)
+    tr = model.rated_torque
+    g_cam, g_car = model.backlash_per_clearance
+    tb = params["play_transition_torque"]
+    f = params["contact_stiffness_factor"]
+    u = t - s * params["friction_torque"]
+    x = u / tr
+    p = STIFFNESS_EXPONENT
+    cp = 0.5 / (1.0 - 0.5**p)
+    e = tr * cp / (f * model.nominal_rigidity)
+    ax = np.maximum(np.abs(x), 1e-12)
+    th = np.tanh(u / tb)
+    sech2 = 1.0 - th**2
+    beta = _play(params, model)
+    d_du = 0.5 * beta * sech2 / tb + e * p * ax ** (p - 1.0) / tr
+    return {
+        "cam_bearing_clearance": 0.5 * g_cam * th,
+        "carrier_bearing_clearance": 0.5 * g_car * th,
+        "play_transition_torque": -0.5 * beta * sech2 * u / tb**2,
+        "contact_stiffness_factor": -(e / f) * np.sign(x) * np.abs(x) ** p,
+        "rig_compliance": t.copy(),
+        "friction_torque": -s * d_du,
+        "angle_offset": np.ones_like(t),
+    }
 
 
 def te_orders(model: ReducedRV) -> list[int]:

@@ -21,6 +21,7 @@ from gearte.models.bench_reduced import (
     TE_COMMON,
     ReducedRV,
     hysteresis_angle,
+    hysteresis_jacobian,
     parameter_names,
     te_basis,
     te_coefficients,
@@ -321,7 +322,26 @@ def calibrate(
     def fun(x):
         return np.concatenate([weights[k] * v for k, v in blocks(x).items()])
 
-    res = least_squares(fun, x0, bounds=(lo, hi), method="trf", x_scale=1.0, tr_solver="lsmr")
+    def jac(x):
+        """Analytic Jacobian of ``fun`` in the scaled parameters (hysteresis: the model's
+        derivatives; TE: its linear map)."""
+        rows = []
+        if hysteresis is not None:
+            d = hysteresis_jacobian(model, unpack(x), hysteresis.torque, direction)
+            w = np.asarray(weights["hysteresis"])
+            block = np.zeros((hysteresis.torque.size, len(fit)))
+            for j, nm in enumerate(fit):
+                if nm in d:
+                    block[:, j] = d[nm] * scale[j]
+            rows.append(block * (w[:, None] if w.ndim else w))
+        if te_rows:
+            te_j = [r.r @ cx for r, (_, cx) in zip(te_rows, te_maps, strict=True)]
+            rows.append(weights["te"] * np.vstack(te_j))
+        return np.vstack(rows)
+
+    res = least_squares(
+        fun, x0, bounds=(lo, hi), method="trf", x_scale=1.0, jac=jac, tr_solver="lsmr"
+    )
     counts = {"hysteresis": 0 if hysteresis is None else hysteresis.torque.size,
               "te": sum(r.samples for r in te_rows)}  # fmt: skip
     rss0 = {"hysteresis": 0.0, "te": sum(r.rss0 for r in te_rows)}
@@ -343,7 +363,9 @@ def calibrate(
         r2 = float(np.mean(blocks(res.x)["hysteresis"] ** 2))
         var_a = max(r2 - float(np.mean(var_t)), 0.0025 * r2)
         weights["hysteresis"] = 1.0 / np.sqrt(var_a + var_t)
-    res = least_squares(fun, res.x, bounds=(lo, hi), method="trf", x_scale=1.0, tr_solver="lsmr")
+    res = least_squares(
+        fun, res.x, bounds=(lo, hi), method="trf", x_scale=1.0, jac=jac, tr_solver="lsmr"
+    )
     nfev = res.nfev
     b = blocks(res.x)
     n = len(fit)
