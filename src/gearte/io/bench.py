@@ -252,7 +252,7 @@ def _parse(path, allowed, aliases, text_columns=()) -> _Table:
                 data = np.array(flat, dtype=float).reshape(rows, ncol)
             except ValueError:
                 data = None
-    text: dict = {j: [] for j in text_cols}
+    cells_text: dict = {j: [] for j in text_cols}
     if data is None:  # slow path: find the offending line and cell
         data = np.full((rows, ncol), np.nan)
         header_norm = [s.strip() for s in cells]
@@ -270,8 +270,8 @@ def _parse(path, allowed, aliases, text_columns=()) -> _Table:
                     src, k + 1, None, f"has {len(parts)} cells; the header has {ncol} columns"
                 )
             for j, cell in enumerate(parts):
-                if j in text:
-                    text[j].append(cell.strip().lower())
+                if j in cells_text:
+                    cells_text[j].append(cell.strip().lower())
                     continue
                 s = cell.strip()
                 if not s:
@@ -283,7 +283,7 @@ def _parse(path, allowed, aliases, text_columns=()) -> _Table:
                         src, k + 1, _col(names, units, j), f"{s!r} is not a number"
                     ) from None
     lines_arr = np.asarray(body_idx, dtype=np.int64) + 1
-    num_cols = [j for j in range(ncol) if j not in text]
+    num_cols = [j for j in range(ncol) if j not in cells_text]
     bad = ~np.isfinite(data[:, num_cols]) if num_cols else np.zeros((rows, 0), bool)
     if bad.any():
         r, jj = np.argwhere(bad)[0]
@@ -294,7 +294,7 @@ def _parse(path, allowed, aliases, text_columns=()) -> _Table:
             _col(names, units, j),
             f"{data[r, j]!r} is not a finite number (NaN/inf: a dropout of the encoder?)",
         )
-    return _Table(src, meta, meta_lines, names, units, data, text, lines_arr, header_line)
+    return _Table(src, meta, meta_lines, names, units, data, cells_text, lines_arr, header_line)
 
 
 def _col(names, units, j) -> str:
@@ -409,7 +409,7 @@ def read_te_trace(path: str | os.PathLike) -> TETrace:
                 None,
                 f"column '{missing}' is missing (the {d} direction needs position and TE)",
             )
-        if pj is None:
+        if pj is None or tj is None:
             arrays[d + "_position"] = arrays[d + "_te"] = None
             continue
         fp = _unit_factor(t, pj, _ANGLE_UNITS, "angle_unit", "angle")

@@ -72,11 +72,11 @@ class Branches:
 
     def ascending(self, torque: ArrayLike) -> np.ndarray:
         """``θ_asc(T)`` [rad] by linear interpolation."""
-        return np.interp(torque, self.asc_torque, self.asc_angle)
+        return np.interp(np.asarray(torque, dtype=float), self.asc_torque, self.asc_angle)
 
     def descending(self, torque: ArrayLike) -> np.ndarray:
         """``θ_desc(T)`` [rad] by linear interpolation."""
-        return np.interp(torque, self.desc_torque, self.desc_angle)
+        return np.interp(np.asarray(torque, dtype=float), self.desc_torque, self.desc_angle)
 
     def mid(self, torque: ArrayLike) -> np.ndarray:
         """Mid-curve ``(θ_asc + θ_desc)/2`` [rad]."""

@@ -11,6 +11,7 @@ rig compliance) for tests, the benchmark and the bundled example.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -263,7 +264,7 @@ def calibrate(
     te_rows = _te_rows(model, traces)
     if hysteresis is None and not te_rows:
         raise ParameterError("calibration", None, "needs a hysteresis curve or a TE trace")
-    direction = None
+    direction: Any = None
     if hysteresis is not None:
         direction = (
             hysteresis.branch
@@ -369,10 +370,10 @@ def calibrate(
     nfev = res.nfev
     b = blocks(res.x)
     n = len(fit)
-    jac = np.asarray(res.jac)
-    norms = np.linalg.norm(jac, axis=0)
+    jmat = np.asarray(res.jac)
+    norms = np.linalg.norm(jmat, axis=0)
     norms = np.where(norms > 0, norms, 1.0)
-    jn = jac / norms
+    jn = jmat / norms
     # singular values/vectors of Jn from the small Gram matrix (LAPACK on the tall Jn is slow)
     ev, evec = np.linalg.eigh(jn.T @ jn)
     order = np.argsort(ev)[::-1]

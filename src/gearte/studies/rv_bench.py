@@ -47,8 +47,9 @@ FamilyName = Literal[
     "output rotation", "crank rotation", "2× crank rotation", "involute mesh", "cycloid mesh",
     "input rotation",
 ]  # fmt: skip
-DEFAULT_FAMILIES = ("output rotation", "crank rotation", "2× crank rotation", "involute mesh",
-                    "cycloid mesh")  # fmt: skip
+_DEFAULT_FAMILIES: list[FamilyName] = [
+    "output rotation", "crank rotation", "2× crank rotation", "involute mesh", "cycloid mesh",
+]  # fmt: skip
 
 
 def _resolve(value: str, info: ValidationInfo) -> str:
@@ -104,7 +105,7 @@ class OrdersSection(StrictModel):
 
 
 class CalibrationSection(StrictModel):
-    families: list[FamilyName] = Field(default_factory=lambda: list(DEFAULT_FAMILIES))
+    families: list[FamilyName] = Field(default_factory=lambda: list(_DEFAULT_FAMILIES))
     fit: list[str] | None = Field(default=None, description="parameters to fit (default all)")
     encoder_eccentricity_arcsec: tuple[float, float] | None = Field(
         default=None, description="known (cos, sin) of the output encoder's eccentricity"
