@@ -30,7 +30,7 @@ from gearte.units import arcsec_to_rad, rad_to_arcsec, rad_to_deg
 HERE = Path(__file__).resolve().parent
 FAMILIES = ("output rotation", "crank rotation", "2× crank rotation", "involute mesh",
             "cycloid mesh")
-TRUTH_ARCSEC = {  # amplitude [arcsec], phase [deg] of each error family (invented)
+TRUTH_ARCSEC = {  # amplitude A [arcsec], lag ψ [deg]: A cos(n φ − ψ) per error family (invented)
     "output rotation": (2.0, 30.0),
     "crank rotation": (6.0, -50.0),
     "2× crank rotation": (1.5, 120.0),

@@ -292,6 +292,7 @@ def _orders(traces, sources, sec: OrdersSection) -> AnalysisResult:
 
 def _calibration(case, reducer, rcase, sources, traces, hyst, warnings):
     from gearte.runners.bench_calibration import (
+        Z95,
         calibrate,
         parameter_specs,
         reduced_constants,
@@ -328,7 +329,27 @@ def _calibration(case, reducer, rcase, sources, traces, hyst, warnings):
             "value": cal.params[n], "ci95": cal.ci[n] if np.isfinite(cal.ci[n]) else None,
             "unit": unit, "identified": n not in cal.flags, "note": cal.flags.get(n, ""),
         }  # fmt: skip
+    families = {}
+    fitted = list(cal.fitted)
+    for fam in (*fams, "encoder eccentricity"):
+        kc, ks = (f"{fam.replace(' ', '_')}_{x}" for x in ("cos", "sin"))
+        if kc not in fitted or ks not in fitted:
+            continue
+        a, b = cal.params[kc], cal.params[ks]
+        amp = float(np.hypot(a, b))
+        ident = kc not in cal.flags and ks not in cal.flags
+        ci = None
+        if ident and amp > 0:
+            i, j = fitted.index(kc), fitted.index(ks)
+            g = np.array([a, b]) / amp
+            cov = cal.covariance[np.ix_([i, j], [i, j])]
+            ci = _sec(Z95 * float(np.sqrt(max(g @ cov @ g, 0.0))))
+        families[fam] = {
+            "amplitude [arcsec]": _sec(amp), "phase [deg]": float(np.degrees(np.arctan2(-b, a))),
+            "amplitude_ci95 [arcsec]": ci, "identified": ident,
+        }  # fmt: skip
     values = {
+        "error_families": families,
         "parameters": params,
         "unidentifiable_groups": [list(g) for g in cal.groups],
         "jacobian_rank": cal.rank,
