@@ -8,7 +8,8 @@ Case file::
                                                            (order labels), rated torque, the whole
                                                            model behind the reduced one
     [data]    te = "<CSV file or folder of operating points>", hysteresis = "<CSV file>"
-              (paths relative to the case file), torque_noise_fraction (torque sensor, × T_r)
+              (paths relative to the case file, else to the bundled examples),
+              torque_noise_fraction (torque sensor, × T_r)
     [analyses.catalogue]    lost_motion_fraction (0.03)
     [analyses.te_orders]    n_orders (12)
     [analyses.calibration]  families, fit, encoder_eccentricity_arcsec,
@@ -53,10 +54,16 @@ _DEFAULT_FAMILIES: list[FamilyName] = [
 
 
 def _resolve(value: str, info: ValidationInfo) -> str:
+    """A data path: absolute, or relative to the case file's folder, or (like a bundled case
+    name) relative to the bundled examples."""
+    from gearte.cases import examples_dir
+
     p = Path(value).expanduser()
     if not p.is_absolute():
         case_dir = (info.context or {}).get("case_dir")
-        p = (Path(case_dir) if case_dir else Path.cwd()) / p
+        beside = (Path(case_dir) if case_dir else Path.cwd()) / p
+        bundled = examples_dir() / p
+        p = beside if beside.exists() or not bundled.exists() else bundled
     if not p.exists():
         raise ValueError(f"no file or folder {str(p)!r}")
     return str(p)
