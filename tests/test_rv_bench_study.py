@@ -109,3 +109,14 @@ def test_bundled_synthetic_bench_runs_calibrates_and_writes_the_serial(tmp_path)
     assert serial.case.kind == "rv_reducer"
     cranks = serial.reducer.cranks
     assert cranks.cam_bearing.radial_clearance_um == pytest.approx(3.5, abs=0.3)
+
+
+@pytest.mark.parametrize("bad", ["x" * 5000, "nul\x00.csv"])
+def test_unusable_data_paths_are_field_errors_not_crashes(tmp_path, bad):
+    """Found by the case fuzzer: a name too long for the OS was an OSError."""
+    data, _ = _case(tmp_path)
+    data["data"]["te"] = bad
+    data["reducer"]["case"] = bad
+    with pytest.raises(CaseFileError) as ei:
+        load_case_dict(data)
+    assert "data.te" in str(ei.value) and "reducer.case" in str(ei.value)

@@ -58,14 +58,21 @@ def _resolve(value: str, info: ValidationInfo) -> str:
     name) relative to the bundled examples."""
     from gearte.cases import examples_dir
 
+    def exists(q: Path) -> bool:
+        try:
+            return q.exists()
+        except (OSError, ValueError):  # a name too long, a NUL byte: not a usable path
+            return False
+
     p = Path(value).expanduser()
     if not p.is_absolute():
         case_dir = (info.context or {}).get("case_dir")
         beside = (Path(case_dir) if case_dir else Path.cwd()) / p
         bundled = examples_dir() / p
-        p = beside if beside.exists() or not bundled.exists() else bundled
-    if not p.exists():
-        raise ValueError(f"no file or folder {str(p)!r}")
+        p = beside if exists(beside) or not exists(bundled) else bundled
+    if not exists(p):
+        shown = str(p) if len(str(p)) <= 200 else str(p)[:200] + "..."
+        raise ValueError(f"no file or folder {shown!r}")
     return str(p)
 
 
