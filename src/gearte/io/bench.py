@@ -40,7 +40,7 @@ import numpy as np
 
 from gearte.errors import BenchFileError
 from gearte.models.bench_data import HysteresisCurve, TETrace
-from gearte.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, Nm_to_Nmm
+from gearte.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, Nm_to_Nmm, rad_to_deg
 
 __all__ = [
     "TETrace",
@@ -476,7 +476,7 @@ def _check_positions(t: _Table, j: int, pos: np.ndarray) -> None:
             t.source,
             int(t.data_lines[-1]),
             t.col_label(j),
-            f"positions cover {np.degrees(span):.4g}°; one output revolution (>= 342°) is "
+            f"positions cover {rad_to_deg(span):.4g}°; one output revolution (>= 342°) is "
             "needed (wrong unit, e.g. rad declared as deg?)",
         )
     if span > 2 * np.pi * 1.01:
@@ -484,7 +484,7 @@ def _check_positions(t: _Table, j: int, pos: np.ndarray) -> None:
             t.source,
             int(t.data_lines[-1]),
             t.col_label(j),
-            f"positions cover {np.degrees(span):.6g}°, more than one output revolution "
+            f"positions cover {rad_to_deg(span):.6g}°, more than one output revolution "
             "(split the trace per revolution, or wrong unit, e.g. arcmin declared as deg?)",
         )
 
@@ -557,7 +557,7 @@ def read_hysteresis(path: str | os.PathLike) -> HysteresisCurve:
             t.source,
             int(t.data_lines[r]),
             t.col_label(aj),
-            f"torsion angle spans {np.degrees(np.ptp(angle)):.4g}°: wrong unit (arcmin "
+            f"torsion angle spans {rad_to_deg(np.ptp(angle)):.4g}°: wrong unit (arcmin "
             "declared as deg?)",
         )
     branch = None

@@ -38,6 +38,7 @@ from gearte.units import (
     Nm_to_Nmm,
     arcsec_to_rad,
     mm_to_um,
+    rad_to_deg,
 )
 
 KIND = "rv_bench"
@@ -359,7 +360,7 @@ def _calibration(case, reducer, rcase, sources, traces, hyst, warnings):
             cov = cal.covariance[np.ix_([i, j], [i, j])]
             ci = _sec(Z95 * float(np.sqrt(max(g @ cov @ g, 0.0))))
         families[fam] = {
-            "amplitude [arcsec]": _sec(amp), "phase [deg]": float(np.degrees(np.arctan2(-b, a))),
+            "amplitude [arcsec]": _sec(amp), "phase [deg]": float(rad_to_deg(np.arctan2(-b, a))),
             "amplitude_ci95 [arcsec]": ci, "identified": ident,
         }  # fmt: skip
     values = {
