@@ -201,6 +201,18 @@ class Case(CaseBase):
     errors: Errors | None = None
     analyses: Analyses = Analyses(contact=ContactOptions(), modal=ModalOptions(), dte=DTEOptions())
 
+    @model_validator(mode="after")
+    def _buildable(self) -> Case:
+        """The checks ``run`` makes when it builds the model (pins that overlap, ...), made at
+        validation, so ``gearte validate`` refuses what ``run`` would."""
+        from gearte.errors import ParameterError
+
+        try:
+            build_parameters(self)
+        except ParameterError as exc:
+            raise ValueError(f"the reducer cannot be built: {exc}") from None
+        return self
+
 
 # --- building the domain objects -----------------------------------------------------------
 def build_parameters(case: Case, **overrides):
