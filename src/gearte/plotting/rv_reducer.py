@@ -6,7 +6,13 @@ from __future__ import annotations
 import numpy as np
 
 from gearte.plotting import PALETTE, Figure, new_figure
-from gearte.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
+from gearte.units import (
+    Nm_to_Nmm,
+    Nmm_per_rad_to_Nm_per_arcmin,
+    rad_to_arcmin,
+    rad_to_arcsec,
+    rad_to_deg,
+)
 
 __all__ = ["figures"]
 
@@ -92,7 +98,7 @@ def _hysteresis(cat, rated: float) -> Figure:
             ang[i100] + rad_to_arcmin((t - 100.0) / 100.0 * rated / k),
             color=PALETTE[1],
             lw=2,
-            label=f"rigidity {k / 1e3 / rad_to_arcmin(1.0):.0f} N*m/arcmin",
+            label=f"rigidity {Nmm_per_rad_to_Nm_per_arcmin(k):.0f} N*m/arcmin",
         )
     ax.axvspan(-3.0, 3.0, color=PALETTE[2], alpha=0.2,
                label=f"±3 %: lost motion {rad_to_arcmin(cat.lost_motion):.3f}'")  # fmt: skip
@@ -142,7 +148,7 @@ def figures(result) -> list[Figure]:
         out.append(_te(result["transmission_error"].data["te"]))
     if "catalogue" in result:
         cat = result["catalogue"].data["catalogue"]
-        out.append(_hysteresis(cat, result["catalogue"]["rated_torque [N*m]"] * 1e3))
+        out.append(_hysteresis(cat, Nm_to_Nmm(result["catalogue"]["rated_torque [N*m]"])))
     if "compensation" in result:
         out.append(_compensation(result["compensation"].data["compensation"]))
     return out
