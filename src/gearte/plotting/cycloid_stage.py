@@ -207,4 +207,6 @@ def figures(result: Any) -> list[Figure]:
         out += contact_figures(result)
     if "geometric_te" in result:
         out += [sensitivity_figure(result), pareto_figure(result)]
-    return out
+    from gearte.plotting.yield_figures import yield_figures
+
+    return out + yield_figures(result)

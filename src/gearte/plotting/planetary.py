@@ -126,5 +126,7 @@ def mc_histograms_figure(result: Any) -> Figure | None:
 
 def figures(result: Any) -> list[Figure]:
     """All figures of a ``planetary`` result."""
+    from gearte.plotting.yield_figures import yield_figures
+
     out = [phasor_figure(result), te_period_figure(result), mc_histograms_figure(result)]
-    return [f for f in out if f is not None]
+    return [f for f in out if f is not None] + yield_figures(result)

@@ -151,4 +151,7 @@ def figures(result) -> list[Figure]:
         out.append(_hysteresis(cat, Nm_to_Nmm(result["catalogue"]["rated_torque [N*m]"])))
     if "compensation" in result:
         out.append(_compensation(result["compensation"].data["compensation"]))
+    from gearte.plotting.yield_figures import yield_figures
+
+    out += yield_figures(result)
     return out
