@@ -103,3 +103,9 @@ def test_iso1328_out_of_range_is_an_error_not_extrapolated(args, field):
     with pytest.raises(ParameterError) as e:
         flank_tolerances(*args)
     assert e.value.field == field
+
+
+def test_iso1328_2013_runout_needs_no_face_width():
+    from gearte.tolerance.iso1328 import runout_tolerance
+
+    assert runout_tolerance(6, 3.0, 120.0) == flank_tolerances(6, 3.0, 120.0, 30.0).F_rT == 26.0

@@ -70,6 +70,7 @@ def test_rv_samples_give_every_catalogue_quantity(rv):
         "angular_te [arcmin]",
         "loaded_te [arcmin]",
         "peak_pin_load [N]",
+        "max_contact_pressure [MPa]",
     }
     assert names <= set(r.quantities)
     assert r.quantities["angular_te [arcmin]"].stats.sd > 0
@@ -96,3 +97,20 @@ def test_rv_reducer_case_yield_analysis_and_runnable_worst_case(tmp_path):
     alone = gearte.run_case(gearte.load_case(tmp_path / "out" / "worst_sample_1.toml"))
     lm = alone["catalogue"]["lost_motion [arcmin]"]
     assert lm == pytest.approx(worst["values"]["lost_motion [arcmin]"], rel=1e-6)
+
+
+def test_rv_planet_eccentricity_tolerance_from_its_iso1328_grade(tmp_path):
+    """grade = 6 on planet_base_circle: planet m 1.5, z 40 → d 60 mm; F_pT = (0.12 + 0.55·√60 +
+    1.05 + 12)·√2 = 24.65 µm, F_rT = 0.9·F_pT = 22.19 → 22 µm; eccentricity tolerance F_rT/2 =
+    11 µm (by hand from ISO 1328-1:2013 eq. 6 and the rounding rule)."""
+    import tomllib
+
+    from gearte.cases import case_path
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies import RunOptions
+
+    data = tomllib.loads(case_path("han2023_rv110e_yield").read_text())
+    data["analyses"]["yield"].update(samples=2, chunk_size=2, sobol_samples=0, keep_worst=0)
+    data["analyses"]["yield"]["spec"] = {}
+    res = gearte.run_case(load_case_dict(data, name="rv_grade"), RunOptions(progress=False))
+    assert res["yield"]["tolerances"]["planet_base_circle"]["tolerance"] == 11.0

@@ -239,7 +239,8 @@ class RVReducerYield:
     Outputs: ``"lost_motion [arcmin]"``, ``"torsional_rigidity [Nm/arcmin]"``,
     ``"backlash [arcmin]"``, ``"hysteresis_loss [arcmin]"``, ``"angular_te [arcmin]"``
     (unloaded, peak-to-peak over one output revolution), ``"loaded_te [arcmin]"``,
-    ``"peak_pin_load [N]"``.
+    ``"peak_pin_load [N]"``, ``"max_contact_pressure [MPa]"`` (Hertz, each pin with its own flank
+    curvature, at the TE torque).
 
     References
     ----------
@@ -345,6 +346,7 @@ class RVReducerYield:
             "angular_te [arcmin]": arcmin(float(np.ptp(unloaded.output_error))),
             "loaded_te [arcmin]": arcmin(float(np.ptp(loaded.output_error))),
             "peak_pin_load [N]": loaded.peak_pin_load,
+            "max_contact_pressure [MPa]": loaded.max_contact_pressure,
         }
 
     def __call__(self, errors: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:

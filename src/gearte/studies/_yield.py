@@ -14,7 +14,8 @@ A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) 
 
     [analyses.yield.tolerances.<error key>]   # keys: the drive's error keys
     kind = "normal"     # normal | truncated_normal | uniform | rayleigh | empirical | constant
-    tolerance_um = 8.0          # or tolerance_deg for an angle key
+    tolerance_um = 8.0          # or tolerance_deg for an angle key, or grade = N for a gear's
+                                # eccentricity (ISO 1328-1:2013: tolerance = F_rT/2)
     nominal_um = 0.0            # default: the case's value of that error
     sigmas = 3.0                # optional: σ = tolerance / sigmas
     phase = false               # rayleigh: also a uniform direction
@@ -57,6 +58,13 @@ class ToleranceEntry(StrictModel):
     )
     tolerance_um: float | None = Field(default=None, ge=0, le=100_000)
     tolerance_deg: float | None = Field(default=None, ge=0, le=360)
+    grade: int | None = Field(
+        default=None,
+        ge=1,
+        le=11,
+        description="ISO 1328-1:2013 class instead of tolerance_um, where the error is a gear's "
+        "eccentricity: tolerance = F_rT / 2",
+    )
     nominal_um: float | None = Field(default=None, ge=-100_000, le=100_000)
     nominal_deg: float | None = Field(default=None, ge=-360, le=360)
     sigmas: float | None = Field(default=None, gt=0, le=100)
@@ -65,8 +73,9 @@ class ToleranceEntry(StrictModel):
 
     @model_validator(mode="after")
     def _one_unit(self) -> ToleranceEntry:
-        if (self.tolerance_um is None) == (self.tolerance_deg is None):
-            raise ValueError("give exactly one of tolerance_um and tolerance_deg")
+        given = [self.tolerance_um, self.tolerance_deg, self.grade]
+        if sum(v is not None for v in given) != 1:
+            raise ValueError("give exactly one of tolerance_um, tolerance_deg and grade")
         if self.phase and self.kind != "rayleigh":
             raise ValueError("phase = true goes with kind = 'rayleigh' only")
         if self.kind == "empirical" and self.values_um is None:
@@ -75,7 +84,7 @@ class ToleranceEntry(StrictModel):
 
     @property
     def unit(self) -> str:
-        return "um" if self.tolerance_um is not None else "deg"
+        return "deg" if self.tolerance_deg is not None else "um"
 
 
 class GroupEntry(StrictModel):
@@ -151,6 +160,7 @@ def _tolerances(
     nominal: Mapping[str, float],
     defaults: Mapping[str, ToleranceEntry],
     families: Mapping[str, list[str]],
+    grade_um: Callable[[str, int], float | None] | None = None,
 ):
     from gearte.errors import ParameterError
     from gearte.tolerance.yield_mc import CorrelatedGroup, Tolerance, ToleranceSet
@@ -181,6 +191,14 @@ def _tolerances(
                 f"this error is in {units[ukey]}: give tolerance_{units[ukey]}",
             )
         tol = t.tolerance_um if t.unit == "um" else t.tolerance_deg
+        if t.grade is not None:
+            tol = None if grade_um is None else grade_um(ukey, t.grade)
+            if tol is None:
+                raise ParameterError(
+                    f"analyses.yield.tolerances.{ukey}.grade",
+                    t.grade,
+                    "this error is not a gear's eccentricity: give tolerance_um",
+                )
         nom = t.nominal_um if t.unit == "um" else t.nominal_deg
         tols.append(
             Tolerance(
@@ -262,6 +280,7 @@ def yield_analysis(
     references: list[str] | None = None,
     defaults: Mapping[str, ToleranceEntry] | None = None,
     families: Mapping[str, list[str]] | None = None,
+    grade_um: Callable[[str, int], float | None] | None = None,
 ) -> AnalysisResult:
     """Run the yield analysis of a drive.
 
@@ -287,6 +306,9 @@ def yield_analysis(
     families : mapping, optional
         Family key → its instance keys (e.g. ``cam`` → ``cam.c1.d1`` …): a tolerance on a
         family applies to each instance, drawn independently (a correlated group may name it).
+    grade_um : callable, optional
+        ``(key, grade) -> tolerance [µm]`` for errors that are a gear's eccentricity (``None``
+        for the others): how ``grade = N`` reads for this drive.
     """
     from gearte.errors import ParameterError
     from gearte.tolerance.allocation import CostModel, PriceTable, allocate
@@ -300,7 +322,7 @@ def yield_analysis(
     seed = section.seed if getattr(options, "seed", None) is None else int(options.seed)
     n = section.samples if getattr(options, "samples", None) is None else int(options.samples)
     defaults = dict(defaults or {})
-    ts = _tolerances(section, units, nominal, defaults, dict(families or {}))
+    ts = _tolerances(section, units, nominal, defaults, dict(families or {}), grade_um)
     spec = [SpecLimit(q, s.lower, s.upper) for q, s in section.spec.items()]
     progress = getattr(options, "progress", False)
     res = run_yield(
@@ -336,6 +358,10 @@ def yield_analysis(
         "seed": seed,
         "spec": {s.quantity: {"lower": s.lower, "upper": s.upper} for s in spec},
         "quantities": quantities,
+        "tolerances": {
+            t.family_name: {"kind": t.kind, "tolerance": t.tolerance, "nominal": t.nominal}
+            for t in ts.tolerances
+        },
     }
     notes = [
         f"{res.n} assembled drives drawn (seed {seed}, chunks of {section.chunk_size}); yield = "

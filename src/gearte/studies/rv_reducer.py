@@ -656,6 +656,15 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         }
         return d
 
+    def grade_um(key: str, grade: int) -> float | None:
+        """planet_base_circle: eccentricity tolerance F_rT/2 of the planet (ISO 1328-1:2013)."""
+        from gearte.tolerance.iso1328 import runout_tolerance
+
+        fs = case.reducer.first_stage
+        if key.split(".")[0] != "planet_base_circle":
+            return None
+        return 0.5 * runout_tolerance(grade, fs.module_mm, fs.module_mm * fs.planet_teeth)
+
     return yield_analysis(
         sec,
         model,
@@ -665,4 +674,5 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         worst_case=worst_case,
         references=["han2023", "hu2020"],
         families=families,
+        grade_um=grade_um,
     )

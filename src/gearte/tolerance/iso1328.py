@@ -65,6 +65,7 @@ __all__ = [
     "flank_tolerances",
     "radial_composite_tolerances",
     "grade_tolerances_um",
+    "runout_tolerance",
 ]
 
 _SQ2 = math.sqrt(2.0)
@@ -210,6 +211,25 @@ def flank_tolerances(
     raw["F_rT"] = 0.9 * raw["F_pT"]
     r = {k: iso1328_round(v) for k, v in raw.items()}
     return FlankTolerances(grade=a, unrounded=raw, **r)
+
+
+def runout_tolerance(grade: int, module_mm: float, reference_diameter_mm: float) -> float:
+    """Run-out tolerance ``F_rT = 0.9 F_pT`` [µm], rounded (ISO 1328-1:2013; no face width needed).
+
+    An eccentricity ``e`` of the gear's teeth about its axis gives a run-out of ``2e``, so the
+    eccentricity tolerance a grade implies is ``F_rT / 2``. Parameters: ``grade`` (class
+    1 … 11), ``module_mm`` [mm], ``reference_diameter_mm`` [mm].
+
+    Examples
+    --------
+    >>> runout_tolerance(6, 1.5, 60.0)   # F_pT 24.65 → F_rT 22.19
+    22.0
+    """
+    a = _check_grade("grade", grade, 1, 11)
+    mn = _check_range("module_mm", module_mm)
+    d = _check_range("reference_diameter_mm", reference_diameter_mm)
+    f_pt = (0.002 * d + 0.55 * math.sqrt(d) + 0.7 * mn + 12.0) * _SQ2 ** (a - 5)
+    return iso1328_round(0.9 * f_pt)
 
 
 def radial_composite_tolerances(
