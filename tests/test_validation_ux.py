@@ -76,3 +76,11 @@ def test_implausible_module_is_refused(case):
     data = _bundled(case)
     data["pair"]["module_mm"] = 1e-6
     assert "pair.module_mm" in _errors(data)
+
+
+def test_rv_dynamics_overlapping_pins_are_refused_by_validate():
+    """Issue 13: ``validate`` passed overlapping pins that ``run`` then refused."""
+    data = _bundled("li2023_rv")
+    data.setdefault("reducer", {})["pin_radius_mm"] = 8.0
+    (msg,) = _errors(data).values()
+    assert "pins overlap" in msg
