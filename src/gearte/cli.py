@@ -152,11 +152,16 @@ def run(
     """Run CASE (a .toml file or a bundled case name) and write results.json and report.html."""
 
     def _run() -> None:
+        import time
+
+        t0 = time.perf_counter()
         from gearte.io.case_file import load_case
         from gearte.report.outputs import write_outputs
         from gearte.studies import RunOptions, run_case
 
+        t1 = time.perf_counter()
         c = load_case(case)
+        t2 = time.perf_counter()
         with _executor(scheduler, workers) as executor:
             opts = RunOptions(
                 progress=not no_progress,
@@ -166,6 +171,7 @@ def run(
                 workers=workers,
             )
             result = run_case(c, opts)
+        result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
         target = out_dir or os.path.join("out", result.name)
         paths = write_outputs(result, target, report=not no_report)
         for w in result.warnings:

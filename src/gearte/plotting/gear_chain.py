@@ -161,17 +161,21 @@ def figures(result: Any) -> list[Figure]:
             label = a.title.split("Normal backlash")[0]
             mc_name = f"{prefix}monte_carlo"
             if mc_name in result:
-                figs.append(
-                    backlash_histogram(
-                        a, result[mc_name].data["mc"], f"{label}{a.data['kind']} pair backlash"
-                    )
+                f = backlash_histogram(
+                    a, result[mc_name].data["mc"], f"{label}{a.data['kind']} pair backlash"
                 )
+                f.analysis = mc_name
+                figs.append(f)
             c_name = f"{prefix}contributions"
             if c_name in result:
-                figs.append(
-                    contribution_pareto(result[c_name], f"{label}{a.data['kind']} pair Pareto")
-                )
+                f = contribution_pareto(result[c_name], f"{label}{a.data['kind']} pair Pareto")
+                f.analysis = c_name
+                figs.append(f)
     if "chain" in result:
-        figs.append(chain_diagram(result["chain"]))
-        figs.append(compensation(result))
+        f = chain_diagram(result["chain"])
+        f.analysis = "chain"
+        figs.append(f)
+        f = compensation(result)
+        f.analysis = "compensation" if "compensation" in result else "chain"
+        figs.append(f)
     return figs

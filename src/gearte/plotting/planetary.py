@@ -126,4 +126,12 @@ def mc_histograms_figure(result: Any) -> Figure | None:
 def figures(result: Any) -> list[Figure]:
     """All figures of a ``planetary`` result."""
     out = [phasor_figure(result), te_period_figure(result), mc_histograms_figure(result)]
+    names = [
+        "coupled_te",
+        "coupled_te",
+        next((a.name for a in result.analyses if a.name.startswith("mc_")), ""),
+    ]
+    for f, name in zip(out, names, strict=True):
+        if f is not None:
+            f.analysis = name
     return [f for f in out if f is not None]

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 
 __all__ = ["figures"]
 
@@ -198,15 +198,15 @@ def figures(result) -> list[Figure]:
     """All figures of an ``rv_dynamics`` result."""
     out: list[Figure] = []
     if "contact" in result:
-        out.append(_contact_figure(result["contact"]))
+        out += for_analysis("contact", [_contact_figure(result["contact"])])
         if result["contact"].values.get("load_sweep"):
-            out.append(_load_figure(result["contact"]))
+            out += for_analysis("contact", [_load_figure(result["contact"])])
     if "dte" in result:
-        out += _dte_figures(result["dte"])
+        out += for_analysis("dte", _dte_figures(result["dte"]))
     if "modal" in result:
-        out.append(_campbell_figure(result["modal"]))
+        out += for_analysis("modal", [_campbell_figure(result["modal"])])
     if "speed_sweep" in result:
-        out.append(_sweep_figure(result["speed_sweep"]))
+        out += for_analysis("speed_sweep", [_sweep_figure(result["speed_sweep"])])
     if "batch" in result:
-        out.append(_batch_figure(result["batch"]))
+        out += for_analysis("batch", [_batch_figure(result["batch"])])
     return out

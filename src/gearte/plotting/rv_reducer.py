@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 
 __all__ = ["figures"]
@@ -134,15 +134,17 @@ def figures(result) -> list[Figure]:
     if "load_sharing" in result:
         a = result["load_sharing"]
         ls, ls0 = a.data["load"], a.data.get("load_without_errors")
-        out.append(_pin_map(ls, "Pin-load map"))
+        figs = [_pin_map(ls, "Pin-load map")]
         if ls0 is not None:
-            out.append(_pin_map(ls0, "Pin-load map without errors"))
-        out.append(_peak(ls, ls0))
+            figs.append(_pin_map(ls0, "Pin-load map without errors"))
+        out += for_analysis("load_sharing", [*figs, _peak(ls, ls0)])
     if "transmission_error" in result:
-        out.append(_te(result["transmission_error"].data["te"]))
+        out += for_analysis("transmission_error", [_te(result["transmission_error"].data["te"])])
     if "catalogue" in result:
         cat = result["catalogue"].data["catalogue"]
-        out.append(_hysteresis(cat, result["catalogue"]["rated_torque [N*m]"] * 1e3))
+        rated = result["catalogue"]["rated_torque [N*m]"] * 1e3
+        out += for_analysis("catalogue", [_hysteresis(cat, rated)])
     if "compensation" in result:
-        out.append(_compensation(result["compensation"].data["compensation"]))
+        comp = result["compensation"].data["compensation"]
+        out += for_analysis("compensation", [_compensation(comp)])
     return out

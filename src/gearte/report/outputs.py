@@ -46,22 +46,35 @@ def atomic_write_text(path: Path, text: str) -> None:
 def write_outputs(
     result: Any, out_dir: str | os.PathLike[str], *, report: bool = True
 ) -> dict[str, Path]:
-    """Write ``results.json`` (and ``report.html`` unless ``report=False``) into ``out_dir``.
+    """Write ``results.json`` (and ``report.html`` unless ``report=False``) into ``out_dir``,
+    with the tabular results as CSV beside them (:func:`gearte.report.tables.csv_files`).
+
+    The time of each stage (``"figures"``, ``"render"``, ``"html"``, ``"csv"``, ``"write"``) is
+    added to ``result.timings``; ``"write"`` in ``results.json`` covers every file but
+    ``results.json`` itself (written last, it cannot time itself).
 
     Returns
     -------
     dict
         ``{"results": path, "report": path, <extra file name>: path}`` of the files written.
     """
+    import time
+
+    from gearte.report.tables import csv_files
+
     out = Path(out_dir)
-    json_text = result.to_json()
+    timings = result.timings
     html_text = None
     if report:
-        from gearte.report.html import render_report
+        from gearte.report.html import render_figures, render_report
 
-        html_text = render_report(result)
-    paths = {"results": out / "results.json"}
-    texts: dict[str, str] = {"results": json_text}
+        figures = render_figures(result, timings)
+        t0 = time.perf_counter()
+        html_text = render_report(result, figures)
+        timings["html"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    texts: dict[str, str] = {}
+    paths: dict[str, Path] = {}
     if html_text is not None:
         paths["report"] = out / "report.html"
         texts["report"] = html_text
@@ -71,16 +84,30 @@ def write_outputs(
                 raise ValueError(f"analysis {analysis.name!r}: bad output file name {fname!r}")
             paths[fname] = out / fname
             texts[fname] = text
-    # Both documents exist in memory: only now touch the disk.
+    for fname, text in csv_files(result).items():
+        if fname not in paths:
+            paths[fname] = out / fname
+            texts[fname] = text
+    timings["csv"] = time.perf_counter() - t0
+    # Every document exists in memory: only now touch the disk; results.json last, with the time
+    # the other files took to write.
+    t_write = time.perf_counter()
     tmp_files: list[tuple[str, Path]] = []
     out.mkdir(parents=True, exist_ok=True)
+
+    def stage(key: str, text: str) -> None:
+        fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".tmp", dir=out)
+        tmp_files.append((tmp, paths[key]))
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.chmod(tmp, _public_mode())
+
     try:
         for key, text in texts.items():
-            fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".tmp", dir=out)
-            with os.fdopen(fd, "w", encoding="utf-8") as fh:
-                fh.write(text)
-            os.chmod(tmp, _public_mode())
-            tmp_files.append((tmp, paths[key]))
+            stage(key, text)
+        timings["write"] = time.perf_counter() - t_write
+        paths = {"results": out / "results.json", **paths}
+        stage("results", result.to_json())
         for tmp, final in tmp_files:
             os.replace(tmp, final)
     finally:

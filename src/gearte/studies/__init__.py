@@ -7,10 +7,13 @@ Kinds are discovered without importing them, so adding a module is all it takes.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import pkgutil
+import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
@@ -79,8 +82,48 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
         from gearte.io.case_file import load_case
 
         case = load_case(case)
+    t_imp = time.perf_counter()
     module = get_kind(case.case.kind)
     t0 = time.perf_counter()
-    result = module.run(case, options or RunOptions())
-    result.elapsed_s = time.perf_counter() - t0
+    with _numba_timer() as numba_s:
+        result = module.run(case, options or RunOptions())
+    t_end = time.perf_counter()
+    result.elapsed_s = t_end - t0
+    result.timings["imports: study kind"] = t0 - t_imp
+    if numba_s:
+        result.timings["numba load/compile"] = numba_s[0]
+    result.timings.update(analysis_timings(result.analyses, t0, t_end))
     return result
+
+
+def analysis_timings(analyses: list[Any], start: float, end: float) -> dict[str, float]:
+    """Time of each analysis [s]: the interval from the previous analysis's result (or ``start``)
+    to its own (:attr:`AnalysisResult.created`); work after the last result is ``"analysis:
+    (after the last result)"``. Studies make each result as soon as its analysis is done, so the
+    intervals are the analyses' times (shared set-up falls to the first analysis)."""
+    out: dict[str, float] = {}
+    prev = start
+    for a in sorted(analyses, key=lambda a: a.created):
+        t = min(max(a.created, prev), end)
+        out[f"analysis: {a.name}"] = t - prev
+        prev = t
+    if end - prev > 1e-3:
+        out["analysis: (after the last result)"] = end - prev
+    return out
+
+
+@contextlib.contextmanager
+def _numba_timer() -> Iterator[list[float]]:
+    """Seconds numba spends loading kernels from its cache or compiling them (its
+    ``numba:compile`` event, outermost calls only), as a one-element list once the block ends;
+    empty if the study kind does not use numba (numba is not imported just to time it)."""
+    out: list[float] = []
+    if "numba" not in sys.modules:
+        yield out
+        return
+    from numba.core import event
+
+    timer = event.TimingListener()
+    with event.install_listener("numba:compile", timer):
+        yield out
+    out.append(timer.duration if timer.done else 0.0)
