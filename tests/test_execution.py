@@ -297,7 +297,8 @@ def test_cli_prints_an_unreachable_scheduler_without_traceback(tmp_path):
     case.write_text('[case]\nkind = "foundation_test"\n[demo]\nlength_mm = 4.0\n')
     port = _closed_port()
     r = CliRunner().invoke(
-        main, ["run", str(case), "--scheduler", f"tcp://127.0.0.1:{port}", "--out", str(tmp_path)]
+        main,
+        ["run", str(case), "--scheduler", f"tcp://127.0.0.1:{port}", "--out", str(tmp_path / "o")],
     )
     assert r.exit_code == 2, r.output
     assert "scheduler" in r.output and f"127.0.0.1:{port}" in r.output

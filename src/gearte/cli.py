@@ -3,8 +3,9 @@
 Only click is imported at start-up; everything else is imported inside the command that needs it,
 so ``gearte --help`` answers fast.
 
-Exit codes: 0 ok · 1 the analysis failed (non-convergence, divergence) · 2 bad input ·
-3 internal error (a bug: please report it, ``--debug`` shows the traceback).
+Exit codes (docs/errors.md): 0 ok · 1 the analysis failed (non-convergence, divergence) · 2 bad
+input · 3 internal error (a bug: please report it, ``--debug`` shows the traceback) · 4 the outputs
+cannot be written (read-only, disk full, file-size limit, a path under a file).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import click
 EXIT_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
+EXIT_OUTPUT = 4
 
 
 def _error(title: str, message: str) -> None:
@@ -40,6 +42,7 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
         ConvergenceError,
         DivergenceError,
         GearteError,
+        OutputError,
         ParameterError,
         SchedulerError,
     )
@@ -61,6 +64,9 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     except SchedulerError as exc:
         _error("scheduler", str(exc))
         sys.exit(EXIT_BAD_INPUT)
+    except OutputError as exc:
+        _error("cannot write outputs", str(exc))
+        sys.exit(EXIT_OUTPUT)
     except (ConvergenceError, DivergenceError) as exc:
         _error("analysis failed", str(exc))
         sys.exit(EXIT_FAILED)
@@ -129,14 +135,18 @@ def main() -> None:
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False),
     default=None,
-    help="Output folder (default: out/<case name>).",
+    help="Output folder, replaced as a whole by the new result set (default: out/<case name>).",
 )
 @click.option("--seed", type=int, default=None, help="Override the case's random seed.")
 @_execution_options
 @click.option("--no-report", is_flag=True, help="Write results.json only.")
 @click.option("--no-progress", is_flag=True, help="Hide progress bars.")
+@click.option(
+    "--timings",
+    is_flag=True,
+    help="Print the time of each stage (imports, analyses, figures, writing) as JSON on stderr.",
+)
 @click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
 def run(
     case: str,
@@ -147,6 +157,7 @@ def run(
     scheduler: str | None,
     no_report: bool,
     no_progress: bool,
+    timings: bool,
     debug: bool,
 ) -> None:
     """Run CASE (a .toml file or a bundled case name) and write results.json and report.html."""
@@ -156,12 +167,14 @@ def run(
 
         t0 = time.perf_counter()
         from gearte.io.case_file import load_case
-        from gearte.report.outputs import write_outputs
+        from gearte.report.outputs import check_output_dir, safe_label, write_outputs
         from gearte.studies import RunOptions, run_case
 
         t1 = time.perf_counter()
         c = load_case(case)
         t2 = time.perf_counter()
+        default = os.path.join("out", safe_label(c.case.name or c.case.kind))
+        target = check_output_dir(out_dir if out_dir is not None else default)
         with _executor(scheduler, workers) as executor:
             opts = RunOptions(
                 progress=not no_progress,
@@ -172,13 +185,17 @@ def run(
             )
             result = run_case(c, opts)
         result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
-        target = out_dir or os.path.join("out", result.name)
         paths = write_outputs(result, target, report=not no_report)
         for w in result.warnings:
             click.echo(f"warning: {w}", err=True)
         click.echo(f"{result.name}: {len(result.analyses)} analyses in {result.elapsed_s:.2f} s")
         for p in paths.values():
             click.echo(f"  wrote {p}")
+        if timings:
+            import json
+
+            result.timings["total in gearte"] = time.perf_counter() - t0
+            click.echo(f"timings [s]: {json.dumps(result.timings)}", err=True)
 
     _guarded(_run, debug)
 
@@ -197,9 +214,8 @@ def run(
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False),
     default=None,
-    help="Output folder (default: out/sweep_<case name>).",
+    help="Output folder, replaced as a whole (default: out/sweep_<case name>).",
 )
 @click.option("--seed", type=int, default=None, help="Override the case's seed (all points).")
 @_execution_options
@@ -221,9 +237,14 @@ def sweep(
     """Run CASE over a grid of parameter values; write sweep.csv, sweep.json and plots."""
 
     def _sweep() -> None:
+        from gearte.io.case_file import load_case
+        from gearte.report.outputs import check_output_dir, safe_label
         from gearte.sweep import parse_vary, run_sweep, write_sweep
 
         varies = [parse_vary(v) for v in vary]
+        c = load_case(case)
+        default = os.path.join("out", f"sweep_{safe_label(c.case.name or c.case.kind)}")
+        target = check_output_dir(out_dir if out_dir is not None else default)
         with _executor(scheduler, workers) as executor:
             result = run_sweep(
                 case,
@@ -234,7 +255,6 @@ def sweep(
                 workers=workers,
                 progress=not no_progress,
             )
-        target = out_dir or os.path.join("out", f"sweep_{result.name}")
         paths = write_sweep(result, target, plots=not no_plots)
         failed = [e for e in result.errors if e]
         click.echo(

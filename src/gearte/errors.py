@@ -15,6 +15,7 @@ __all__ = [
     "ConvergenceError",
     "DivergenceError",
     "SchedulerError",
+    "OutputError",
 ]
 
 
@@ -70,3 +71,25 @@ class DivergenceError(GearteError, RuntimeError):
 
 class SchedulerError(GearteError, ConnectionError):
     """A distributed scheduler could not be reached or failed."""
+
+
+class OutputError(GearteError):
+    """The output folder cannot receive the results: read-only, full disk, file-size limit, a
+    path under a file, a folder holding files gearte did not write. A user error (CLI exit
+    code 4), raised before the computation where it can be foreseen.
+
+    Parameters
+    ----------
+    path : str
+        The output path as the user gave it.
+    reason : str
+        What is wrong and, where possible, what to do.
+    """
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"output {path}: {reason}")
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.path, self.reason))

@@ -501,22 +501,20 @@ def write_sweep(
     dict
         ``{"csv": path, "json": path, "plots": [paths]}``.
     """
-    out = Path(out_dir)
-    rendered: list[tuple[Path, bytes]] = []
+    rendered: dict[str, bytes] = {}
     if plots:
         from gearte.plotting.sweep import figures
 
         for stem, fig in figures(result):
             buf = io.BytesIO()
             fig.fig.savefig(buf, format="png", dpi=100)
-            rendered.append((out / "plots" / f"{stem}.png", buf.getvalue()))
-    from gearte.report.outputs import atomic_write_bytes, atomic_write_text
+            rendered[f"plots/{stem}.png"] = buf.getvalue()
+    from gearte.report.outputs import write_file_set
 
-    csv_text, json_text = result.to_csv(), result.to_json()
-    paths: dict[str, Any] = {"csv": out / "sweep.csv", "json": out / "sweep.json", "plots": []}
-    atomic_write_text(paths["csv"], csv_text)
-    atomic_write_text(paths["json"], json_text)
-    for p, data in rendered:
-        atomic_write_bytes(p, data)
-        paths["plots"].append(p)
-    return paths
+    files = {"sweep.csv": result.to_csv().encode(), "sweep.json": result.to_json().encode()}
+    written = write_file_set(out_dir, {**files, **rendered})
+    return {
+        "csv": written["sweep.csv"],
+        "json": written["sweep.json"],
+        "plots": [written[k] for k in rendered],
+    }

@@ -1,41 +1,295 @@
-"""Write a study's outputs atomically: ``results.json`` and ``report.html``.
+"""Write a study's outputs as one set: ``results.json``, ``report.html`` and any extra files.
 
-Everything is computed and rendered in memory first; files are then written to temporary names in
-the output folder and moved into place with ``os.replace``, so a failed run never leaves a
-half-written report.
+The output folder belongs to gearte and holds one result set. Everything is computed and rendered
+in memory first; the files are then written into a *staging folder* beside the output folder (same
+parent, so on the same file system) and the staging folder replaces the output folder in one
+atomic rename (Linux ``renameat2(RENAME_EXCHANGE)``; elsewhere two renames). A reader therefore
+sees either the whole previous set or the whole new one, never a new ``results.json`` beside an
+old ``report.html``. Any failure removes the staging folder; a staging folder left by a killed
+process (``SIGKILL`` cannot be caught) is removed by the next write into the same folder.
+
+:func:`check_output_dir` is called by the CLI *before* any computation: a folder that cannot be
+written (read-only, under a file, a dangling symlink, holding files gearte did not write) is a
+user error (:class:`gearte.errors.OutputError`, exit code 4) instead of a lost computation.
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
+import json
 import os
+import re
+import shutil
+import sys
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-__all__ = ["write_outputs", "atomic_write_bytes", "atomic_write_text"]
+from gearte.errors import OutputError
+
+__all__ = [
+    "write_outputs",
+    "write_file_set",
+    "check_output_dir",
+    "safe_label",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "MARKER",
+]
+
+#: Name of the manifest gearte writes into every output folder it owns (JSON: version, files).
+MARKER = ".gearte-outputs.json"
+#: Files and folders an output folder of an older gearte (before the marker) may hold.
+_LEGACY_OUTPUT = re.compile(r"^(results\.json|report\.html|sweep\.(csv|json)|plots|[\w.-]+\.csv)$")
+_STAGING = ".gearte-staging-"
+
+
+def safe_label(name: str, *, default: str = "case") -> str:
+    """A case name as a single, harmless folder name: a label, never a path.
+
+    Path separators, ``..``, control characters and anything outside ``[A-Za-z0-9._-]`` become
+    ``_``; leading dots are dropped (no hidden or parent folders); at most 100 characters.
+
+    >>> safe_label("../../x")
+    '_.._x'
+    """
+    label = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).lstrip(".")[:100]
+    return label or default
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def _public_mode() -> int:
     """Mode of a normally created file (0o666 less the umask); ``mkstemp`` makes 0o600."""
-    mask = os.umask(0)
-    os.umask(mask)
-    return 0o666 & ~mask
+    return 0o666 & ~_umask()
+
+
+def _describe(exc: OSError) -> str:
+    reasons = {
+        errno.ENOSPC: "the disk is full",
+        errno.EDQUOT: "the disk quota is exceeded",
+        errno.EFBIG: "the file-size limit is exceeded",
+        errno.EROFS: "the file system is read-only",
+        errno.EACCES: "permission denied",
+        errno.EPERM: "operation not permitted",
+        errno.ENOTDIR: "a part of the path is a file, not a folder",
+        errno.ENAMETOOLONG: "the path is too long",
+        errno.ELOOP: "too many symbolic links",
+    }
+    return reasons.get(exc.errno or 0, exc.strerror or str(exc))
+
+
+def _output_error(path: Path | str, exc: OSError) -> OutputError:
+    return OutputError(str(path), f"cannot write: {_describe(exc)} ({exc.strerror or exc})")
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _remove_stale_staging(out: Path) -> None:
+    """Remove staging folders of ``out`` left by processes that no longer run (killed runs)."""
+    prefix = f".{out.name}{_STAGING}"
+    with contextlib.suppress(OSError):
+        for entry in out.parent.iterdir():
+            if not entry.name.startswith(prefix):
+                continue
+            pid_text = entry.name[len(prefix) :].split("-", 1)[0]
+            if pid_text.isdigit() and not _pid_alive(int(pid_text)):
+                shutil.rmtree(entry, ignore_errors=True)
+
+
+def _foreign_entries(out: Path) -> list[str]:
+    """Entries of an existing folder that show it is not a gearte output folder."""
+    names = sorted(e.name for e in out.iterdir())
+    if MARKER in names:
+        return []
+    return [n for n in names if not _LEGACY_OUTPUT.match(n)]
+
+
+def check_output_dir(out_dir: str | os.PathLike[str]) -> Path:
+    """Check that ``out_dir`` can receive a result set, before any computation.
+
+    Returns the folder as an absolute path with symbolic links resolved.
+
+    Raises
+    ------
+    OutputError
+        When the path is empty or holds a NUL byte, is a file or lies under a file, is a dangling
+        symbolic link, holds files gearte did not write, contains the current folder, or when
+        its parent folder cannot be written (read-only, permissions, full disk).
+    """
+    text = os.fspath(out_dir)
+    if not text.strip() or "\x00" in text:
+        raise OutputError(repr(text), "not a usable folder name")
+    if os.path.islink(text) and not os.path.exists(text):
+        raise OutputError(text, f"is a dangling symbolic link (to {os.readlink(text)!r})")
+    out = Path(os.path.realpath(text))
+    if out.parent == out:
+        raise OutputError(text, "cannot replace the root folder; choose a subfolder")
+    if out.exists() and not out.is_dir():
+        raise OutputError(text, "is a file, not a folder")
+    existing = out.parent  # where the staging folder is made
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise OutputError(text, f"lies under {str(existing)!r}, which is a file")
+    if out.exists():
+        try:
+            foreign = _foreign_entries(out)
+        except OSError as exc:
+            raise _output_error(text, exc) from None
+        if foreign:
+            shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+            raise OutputError(
+                text,
+                f"holds files gearte did not write ({shown}); gearte replaces its output folder "
+                "as a whole, so choose a new or empty folder (or an earlier gearte output folder)",
+            )
+        with contextlib.suppress(OSError):
+            cwd = Path(os.getcwd()).resolve()
+            if cwd == out or out in cwd.parents:
+                raise OutputError(text, "contains the current folder; choose a subfolder")
+    try:  # a real probe: os.access does not see read-only mounts and answers True for root
+        probe = tempfile.mkdtemp(prefix=".gearte-probe-", dir=existing)
+        os.rmdir(probe)
+    except OSError as exc:
+        raise _output_error(existing, exc) from None
+    return out
+
+
+def _write_file(path: Path, data: bytes) -> None:
+    """Write ``data`` to a new file, flushed to the disk (injected faults replace this)."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, _public_mode())
+    try:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view) :]
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap folders ``a`` and ``b`` atomically; ``False`` where the system cannot."""
+    if not sys.platform.startswith("linux"):
+        return False
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd, rename_exchange = -100, 2
+    if renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
+        return False
+    raise OSError(err, os.strerror(err), str(b))
+
+
+def _swap(staging: Path, out: Path) -> None:
+    """Put the filled ``staging`` folder in place of ``out``; the old set ends in ``staging``."""
+    try:
+        os.rename(staging, out)  # no previous set (or an empty folder): one rename
+        return
+    except OSError as exc:
+        if exc.errno not in (errno.EEXIST, errno.ENOTEMPTY, errno.EISDIR):
+            raise
+    if _exchange(staging, out):
+        return
+    old = staging.with_name(staging.name + "-old")
+    os.rename(out, old)
+    os.rename(staging, out)
+    os.rename(old, staging)
+
+
+def _check_relative(name: str) -> None:
+    parts = Path(name).parts
+    if (
+        not parts
+        or Path(name).is_absolute()
+        or any(p in ("..", ".", "") for p in parts)
+        or "\x00" in name
+        or len(parts) > 2
+        or name == MARKER
+    ):
+        raise ValueError(f"bad output file name {name!r}")
+
+
+def write_file_set(out_dir: str | os.PathLike[str], files: Mapping[str, bytes]) -> dict[str, Path]:
+    """Replace the output folder ``out_dir`` by exactly ``files`` (relative name → content).
+
+    Names are plain file names or ``folder/file``. The set appears at once (see the module
+    docstring); on any failure the previous set is left as it was and no temporary remains.
+
+    Raises
+    ------
+    OutputError
+        The folder cannot be written (see :func:`check_output_dir`), or the disk is full, the
+        file-size limit is hit, permission is denied while writing.
+    """
+    for name in files:
+        _check_relative(name)
+    out = check_output_dir(out_dir)
+    from gearte import __version__
+
+    manifest = json.dumps({"gearte_version": __version__, "files": sorted(files)}, indent=1)
+    staging: Path | None = None
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        _remove_stale_staging(out)
+        staging = Path(
+            tempfile.mkdtemp(prefix=f".{out.name}{_STAGING}{os.getpid()}-", dir=out.parent)
+        )
+        os.chmod(staging, 0o777 & ~_umask())  # mkdtemp makes 0o700
+        for name, data in files.items():
+            target = staging / name
+            target.parent.mkdir(exist_ok=True)
+            _write_file(target, data)
+        _write_file(staging / MARKER, manifest.encode("utf-8"))
+        _swap(staging, out)
+    except OSError as exc:
+        raise _output_error(out, exc) from None
+    finally:
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
+    return {name: out / name for name in files}
 
 
 def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically (temporary file in the same folder + rename), with
-    the mode of a normally created file; creates the folder."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    """Write one file ``path`` atomically (temporary file in the same folder + rename), with the
+    mode of a normally created file; creates the folder. For single files outside a result set."""
+    path = Path(path)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, _public_mode())
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise _output_error(path, exc) from None
+    os.close(fd)
+    try:
+        os.unlink(tmp)
+        _write_file(Path(tmp), data)
         os.replace(tmp, path)
-    except BaseException:
+    except OSError as exc:
+        raise _output_error(path, exc) from None
+    finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
-        raise
 
 
 def atomic_write_text(path: Path, text: str) -> None:
@@ -46,72 +300,50 @@ def atomic_write_text(path: Path, text: str) -> None:
 def write_outputs(
     result: Any, out_dir: str | os.PathLike[str], *, report: bool = True
 ) -> dict[str, Path]:
-    """Write ``results.json`` (and ``report.html`` unless ``report=False``) into ``out_dir``,
-    with the tabular results as CSV beside them (:func:`gearte.report.tables.csv_files`).
+    """Write ``results.json`` (and ``report.html`` unless ``report=False``), the analyses' extra
+    files and the tabular results as CSV (:func:`gearte.report.tables.csv_files`) into
+    ``out_dir`` as one set, replacing the previous set.
 
-    The time of each stage (``"figures"``, ``"render"``, ``"html"``, ``"csv"``, ``"write"``) is
-    added to ``result.timings``; ``"write"`` in ``results.json`` covers every file but
-    ``results.json`` itself (written last, it cannot time itself).
+    The time of each stage (``"figures"``, ``"render"``, ``"html"``, ``"csv"``) is added to
+    ``result.timings`` before ``results.json`` is serialised; ``"write"`` (the file set) is added
+    after, so it is in ``result.timings`` but not in ``results.json``.
 
     Returns
     -------
     dict
         ``{"results": path, "report": path, <extra file name>: path}`` of the files written.
+
+    Raises
+    ------
+    OutputError
+        The folder cannot be written (exit code 4 in the CLI); the previous set is kept.
     """
     import time
 
     from gearte.report.tables import csv_files
 
-    out = Path(out_dir)
     timings = result.timings
-    html_text = None
+    texts: dict[str, str] = {}
     if report:
         from gearte.report.html import render_figures, render_report
 
         figures = render_figures(result, timings)
         t0 = time.perf_counter()
-        html_text = render_report(result, figures)
+        texts["report.html"] = render_report(result, figures)
         timings["html"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    texts: dict[str, str] = {}
-    paths: dict[str, Path] = {}
-    if html_text is not None:
-        paths["report"] = out / "report.html"
-        texts["report"] = html_text
+    keys = {"results.json": "results", "report.html": "report"}
     for analysis in result.analyses:
         for fname, text in analysis.files.items():
-            if Path(fname).name != fname or fname in ("results.json", "report.html"):
+            if Path(fname).name != fname or fname in keys or fname == MARKER:
                 raise ValueError(f"analysis {analysis.name!r}: bad output file name {fname!r}")
-            paths[fname] = out / fname
             texts[fname] = text
+    t0 = time.perf_counter()
     for fname, text in csv_files(result).items():
-        if fname not in paths:
-            paths[fname] = out / fname
-            texts[fname] = text
+        texts.setdefault(fname, text)
     timings["csv"] = time.perf_counter() - t0
-    # Every document exists in memory: only now touch the disk; results.json last, with the time
-    # the other files took to write.
-    t_write = time.perf_counter()
-    tmp_files: list[tuple[str, Path]] = []
-    out.mkdir(parents=True, exist_ok=True)
-
-    def stage(key: str, text: str) -> None:
-        fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".tmp", dir=out)
-        tmp_files.append((tmp, paths[key]))
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.chmod(tmp, _public_mode())
-
-    try:
-        for key, text in texts.items():
-            stage(key, text)
-        timings["write"] = time.perf_counter() - t_write
-        paths = {"results": out / "results.json", **paths}
-        stage("results", result.to_json())
-        for tmp, final in tmp_files:
-            os.replace(tmp, final)
-    finally:
-        for tmp, _ in tmp_files:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-    return paths
+    texts = {"results.json": result.to_json(), **texts}
+    # Every document exists in memory: only now touch the disk.
+    t0 = time.perf_counter()
+    written = write_file_set(out_dir, {k: v.encode("utf-8") for k, v in texts.items()})
+    timings["write"] = time.perf_counter() - t0
+    return {keys.get(k, k): p for k, p in written.items()}
