@@ -26,9 +26,12 @@ def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:
     mean, sd = v["backlash_mean [um]"], v["backlash_sd [um]"]
     samples = np.asarray(mc.samples) * 1e3
     fig, ax = new_figure()
-    ax.hist(samples, bins=80, density=True, color=PALETTE[5], alpha=0.7, label="Monte-Carlo")
+    from gearte.plotting.display import STRIP_BELOW, distribution
+
+    drawn = distribution(ax, samples, color=PALETTE[5], label="Monte-Carlo", density=True, bins=80)
     x = np.linspace(mean - 4.5 * sd, mean + 4.5 * sd, 300)
-    ax.plot(
+    dens = ax if drawn == "histogram" else ax.twinx()
+    dens.plot(
         x,
         np.exp(-0.5 * ((x - mean) / sd) ** 2) / (sd * math.sqrt(2 * math.pi)),
         color=PALETTE[1],
@@ -41,7 +44,7 @@ def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:
     if lim:
         ax.axvline(lim, color=PALETTE[7], ls=":", lw=1.5, label=f"minimum limit {lim:g} µm")
     ax.set_xlabel("normal backlash [µm]")
-    ax.set_ylabel("probability density [1/µm]")
+    ax.set_ylabel("probability density [1/µm]" if len(samples) >= STRIP_BELOW else "samples")
     ax.legend(loc="upper left", fontsize=8)
     return Figure(
         title,

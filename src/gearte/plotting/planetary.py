@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from gearte.labels import label
 from gearte.plotting import PALETTE, Figure, new_figure
 
 _OPT = "optimal_assembly_te [arcsec]"
@@ -111,7 +112,8 @@ def mc_histograms_figure(result: Any) -> Figure | None:
             e,
             color=PALETTE[k % len(PALETTE)],
             lw=1.4,
-            label=f"{a.name[3:]}: mean {a['mc_mean [arcsec]']:.0f}″, sd {a['mc_sd [arcsec]']:.0f}″",
+            label=f"{label(a.name).removeprefix('Monte-Carlo: ')}: mean "
+            f"{a['mc_mean [arcsec]']:.0f}″, sd {a['mc_sd [arcsec]']:.0f}″",
         )
     ax.set_xlabel("coupled TE amplitude [arcsec]")
     ax.set_ylabel("probability density [1/arcsec]")

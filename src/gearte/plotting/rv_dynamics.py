@@ -184,9 +184,11 @@ def _sweep_figure(a) -> Figure:
 def _batch_figure(a) -> Figure:
     fig, ax = new_figure(figsize=(6.0, 3.4))
     rows = a.data["rows"]
-    ax.hist(rows[:, 0], bins=max(5, int(np.sqrt(rows.shape[0]))), color=PALETTE[0])
+    from gearte.plotting.display import distribution
+
+    drawn = distribution(ax, rows[:, 0], color=PALETTE[0])
     ax.set_xlabel("DTE peak-to-peak [arcsec]")
-    ax.set_ylabel("realisations")
+    ax.set_ylabel("realisations" if drawn == "histogram" else "")
     return Figure(
         "DTE peak-to-peak over random error realisations",
         f"{rows.shape[0]} realisations, mean {rows[:, 0].mean():.3g}″.",

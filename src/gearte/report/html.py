@@ -44,6 +44,9 @@ def figure_to_png_base64(fig: Any, dpi: int = DPI) -> str:
 
 
 def _render_one(f: Any) -> RenderedFigure:
+    from gearte.plotting.display import polish
+
+    polish(f.fig)
     w, h = f.fig.get_size_inches()
     png = figure_to_png_base64(f.fig)
     return RenderedFigure(
@@ -68,6 +71,17 @@ def render_figures(result: Any, timings: dict[str, float] | None = None) -> list
         timings["figures"] = t1 - t0
         timings["render"] = t2 - t1
     return out
+
+
+def _grouped(rows: list[Any]) -> list[list[Any]]:
+    """Consecutive summary rows of the same analysis, together (one title cell each)."""
+    groups: list[list[Any]] = []
+    for r in rows:
+        if groups and groups[-1][0].analysis == r.analysis:
+            groups[-1].append(r)
+        else:
+            groups.append([r])
+    return groups
 
 
 def _case_json(result: Any) -> str:
@@ -120,7 +134,7 @@ def render_report(result: Any, figures: list[RenderedFigure] | None = None) -> s
         elapsed=f"{result.elapsed_s:.2f}",
         description=result.case.case.description,
         warnings=list(result.warnings) + tradeoff_warnings(result),
-        headlines=headlines(result),
+        headline_groups=_grouped(headlines(result)),
         analyses=analyses,
         references=[(k, REFERENCES.get(k, k)) for k in result.references],
         case_json=_case_json(result),

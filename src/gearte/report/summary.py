@@ -181,7 +181,9 @@ def _analysis_headlines(a: Any) -> list[HeadlineRow]:
                 and all(_finite(x) for x in v.values())
             ):
                 item, share = max(v.items(), key=lambda kv: kv[1])
-                add(f"Largest {label(base).lower()}", f"{item} ({_text(share, unit)})")
+                from gearte.report.tables import item_label
+
+                add(f"Largest {label(base).lower()}", f"{item_label(item)} ({_text(share, unit)})")
                 break
     if not picked:
         for base, (unit, v) in vals.items():

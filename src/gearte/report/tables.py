@@ -29,7 +29,7 @@ import numpy as np
 from gearte.labels import label
 from gearte.units import format_number, format_quantity, split_unit, unit_text
 
-__all__ = ["Table", "analysis_tables", "csv_files", "summarise_series", "is_series"]
+__all__ = ["Table", "analysis_tables", "csv_files", "summarise_series", "is_series", "item_label"]
 
 #: Series up to this length are written inline (``0.168, 0.832``) instead of summarised.
 INLINE_MAX = 8
@@ -284,7 +284,7 @@ def analysis_tables(analysis: Any) -> list[Table]:
         )
     for keys, ks in mappings.items():
         units = [split_unit(k)[1] for k in ks]
-        rows = [[key] + [values[k][key] for k in ks] for key in keys]
+        rows = [[item_label(key)] + [values[k][key] for k in ks] for key in keys]
         title = ", ".join(label(k) for k in ks[:3]) + (" …" if len(ks) > 3 else "")
         out.append(
             Table(
@@ -307,6 +307,11 @@ def analysis_tables(analysis: Any) -> list[Table]:
             )
         )
     return out
+
+
+def item_label(key: str) -> str:
+    """An item of a mapping (a factor, a stage) for people: identifiers get :func:`label`."""
+    return label(key) if "_" in key and " " not in key else key
 
 
 def _records_table(key: str, name: str, records: list[dict[str, Any]]) -> Table:
