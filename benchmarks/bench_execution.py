@@ -6,7 +6,7 @@ Workloads, each run on every backend with the same seed (results must be identic
    pair (``examples/jiang2024_spur_pair.toml``) through ``gearte.tolerance.montecarlo`` (issue 3),
    in 40 chunks of 250 000. Plain baseline: the same stack sampled by numpy in one call.
 2. Dynamics batch: 200 runs of issue 6's RV dynamics model (Li et al. 2023 prototype, Table 3
-   errors) over random error realisations, ``gearte.models.rv_dynamics_sim.dte_batch`` (0.5 s
+   errors) over random error realisations, ``gearte.runners.rv_dynamics_sim.dte_batch`` (0.5 s
    simulated + 0.1 s settling per run, chunks of 4 runs). The batch is chosen by the one line
    ``DYNAMICS_BATCH =`` below.
 3. Calibration (stand-in kernel, :func:`standin_dynamics_batch`): 200 runs of a small numba
@@ -144,7 +144,7 @@ def rv_dynamics_batch(runs: int, options: RunOptions, *, seed: int = 6) -> np.nd
     returns the per-run rows (peak-to-peak, rms, mean DTE [arcsec])."""
     from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED
     from gearte.models.rv_dynamics import RVDynamicModel, RVDynamicsParameters, RVErrors
-    from gearte.models.rv_dynamics_sim import dte_batch
+    from gearte.runners.rv_dynamics_sim import dte_batch
 
     params = RVDynamicsParameters(pair=LI2023_PAIR_MODIFIED, cycloid_stiffness="mean")
     model = RVDynamicModel(params, RVErrors.table3(placement="first"))

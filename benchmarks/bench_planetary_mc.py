@@ -38,8 +38,8 @@ from gearte.models.planetary_errors import (
     group_phasors,
     sample_extremes,
 )
+from gearte.runners.planetary_mc import draw_chunk, run_scenario
 from gearte.studies.planetary import build_terms
-from gearte.tolerance.planetary_mc import draw_chunk, run_scenario
 
 
 def naive_term_grid(

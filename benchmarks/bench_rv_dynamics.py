@@ -28,10 +28,9 @@ from gearte.models.rv_dynamics import (
     RVDynamicModel,
     RVDynamicsParameters,
     RVErrors,
-    ode_system,
     rv_rhs,
 )
-from gearte.models.rv_dynamics_sim import default_step, dte_batch
+from gearte.runners.rv_dynamics_sim import default_step, dte_batch, ode_system
 from gearte.solvers.ode import integrate, kernels
 from gearte.units import ARCSEC_PER_RAD
 

@@ -251,9 +251,9 @@ def test_client_passed_in_stays_open_and_internal_ones_are_closed(client):
 
 
 def test_workers_with_another_gearte_version_are_refused(client, monkeypatch):
-    import gearte
+    import gearte._version
 
-    monkeypatch.setattr(gearte, "__version__", "0.0.0+other")
+    monkeypatch.setattr(gearte._version, "__version__", "0.0.0+other")
     with pytest.raises(SchedulerError, match="same version"):
         open_executor(client)
 

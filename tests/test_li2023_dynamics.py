@@ -17,10 +17,15 @@ from gearte.models.rv_dynamics import (
     RVDynamicModel,
     RVDynamicsParameters,
     RVErrors,
-    ode_system,
     rv_rhs,
 )
-from gearte.models.rv_dynamics_sim import default_step, dte_batch, dte_spectrum, simulate_dte
+from gearte.runners.rv_dynamics_sim import (
+    default_step,
+    dte_batch,
+    dte_spectrum,
+    ode_system,
+    simulate_dte,
+)
 from gearte.solvers.ode import integrate, rk4_stability_limit
 
 
@@ -256,7 +261,7 @@ def test_model_from_shared_rv_description(model):
 
 
 def test_spectrum_labels():
-    from gearte.models.rv_dynamics_sim import label_frequency
+    from gearte.runners.rv_dynamics_sim import label_frequency
 
     src = RVDynamicsParameters().frequencies()
     assert label_frequency(8.26, src, 0.1) == "crank rotation"

@@ -26,9 +26,9 @@ from gearte.models.planetary_errors import (
     grid_extremes_numpy,
     terms_from_table,
 )
-from gearte.solvers.planetary_assembly import optimal_assembly, paper_rule_assembly
+from gearte.runners.planetary_assembly import optimal_assembly, paper_rule_assembly
+from gearte.runners.planetary_mc import run_scenario
 from gearte.studies.planetary import build_terms
-from gearte.tolerance.planetary_mc import run_scenario
 from gearte.units import rad_to_arcsec
 
 ALPHA = np.pi / 9

@@ -131,7 +131,7 @@ class StudyResult:
         return keys
 
     def to_dict(self) -> dict[str, Any]:
-        from gearte import __version__
+        from gearte._version import __version__
         from gearte.references import REFERENCES
 
         return {

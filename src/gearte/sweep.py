@@ -341,7 +341,7 @@ class SweepResult:
         return buf.getvalue()
 
     def to_dict(self) -> dict[str, Any]:
-        from gearte import __version__
+        from gearte._version import __version__
         from gearte.results import to_jsonable
 
         return {

@@ -26,6 +26,10 @@ __all__ = [
     "Nm_to_Nmm",
     "Nmm_to_Nm",
     "format_dms",
+    "KG_TO_T",
+    "KGM2_TO_TMM2",
+    "N_PER_M_TO_N_PER_MM",
+    "NM_PER_RAD_TO_NMM_PER_RAD",
     "unit_text",
     "split_unit",
     "format_number",
@@ -35,6 +39,16 @@ __all__ = [
 DEG_PER_RAD: float = 180.0 / np.pi
 ARCMIN_PER_RAD: float = 10800.0 / np.pi
 ARCSEC_PER_RAD: float = 648000.0 / np.pi
+
+# --- mass-spring models in mm, N, s (hence mass in tonne): factors from the papers' SI units ---
+KG_TO_T: float = 1e-3
+"""Mass [kg] → [t] (1 t·mm/s² = 1 N)."""
+KGM2_TO_TMM2: float = 1e3
+"""Inertia [kg·m²] → [t·mm²]."""
+N_PER_M_TO_N_PER_MM: float = 1e-3
+"""Stiffness [N/m] → [N/mm]."""
+NM_PER_RAD_TO_NMM_PER_RAD: float = 1e3
+"""Torsional stiffness [N·m/rad] → [N·mm/rad]."""
 
 
 def rad_to_arcmin(x: ArrayLike) -> np.ndarray | float:

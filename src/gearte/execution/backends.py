@@ -313,9 +313,9 @@ def _connect(distributed: Any, address: str, timeout_s: float) -> Any:
 
 def _worker_gearte_version() -> str:
     """Runs on each Dask worker: the gearte version it imports."""
-    import gearte
+    from gearte._version import __version__
 
-    return gearte.__version__
+    return __version__
 
 
 class DaskExecutor(ChunkExecutor):
@@ -412,21 +412,21 @@ class DaskExecutor(ChunkExecutor):
         return self._workers
 
     def _check_versions(self) -> None:
-        import gearte
+        from gearte._version import __version__
 
         try:
             versions = self.client.run(_worker_gearte_version)
         except Exception as exc:  # noqa: BLE001 - unpickling fails where gearte is missing
             raise SchedulerError(
                 f"the Dask workers cannot run gearte ({type(exc).__name__}: {exc}); install "
-                f"gearte {gearte.__version__} in the workers' environment"
+                f"gearte {__version__} in the workers' environment"
             ) from None
-        wrong = {w: v for w, v in versions.items() if v != gearte.__version__}
+        wrong = {w: v for w, v in versions.items() if v != __version__}
         if wrong:
             listed = ", ".join(f"{w} has {v}" for w, v in sorted(wrong.items()))
             raise SchedulerError(
                 f"Dask workers run another gearte version than this process "
-                f"({gearte.__version__}): {listed}; install the same version everywhere"
+                f"({__version__}): {listed}; install the same version everywhere"
             )
 
     def batch(self, shared: Any = None, *, has_shared: bool = False) -> Batch:

@@ -66,7 +66,7 @@ def load_case_dict(data: Any, *, source: str = "<dict>", name: str | None = None
     """
     from pydantic import ValidationError
 
-    from gearte.studies import available_kinds, get_kind
+    from gearte.io.kinds import available_kinds, get_kind
 
     if not isinstance(data, dict):
         got = type(data).__name__

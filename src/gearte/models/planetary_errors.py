@@ -56,6 +56,7 @@ from gearte.solvers.trig_extremes import (
 
 __all__ = [
     "ErrorTerm",
+    "keyed_vector",
     "TermSet",
     "CoupledTE",
     "derive_terms",
@@ -540,8 +541,8 @@ def coupled_te(
     CoupledTE
         With the exact amplitude ``max |Σe(t)|`` and peak-to-peak over the common period.
     """
-    mags = _vector(terms.magnitudes, magnitudes, "magnitudes", required=True)
-    angs = _vector(terms.angles, angles, "angles", required=False)
+    mags = keyed_vector(terms.magnitudes, magnitudes, "magnitudes", required=True)
+    angs = keyed_vector(terms.angles, angles, "angles", required=False)
     q0, harm, _ = frequency_basis(terms)
     c, Z = group_phasors(terms, mags, angs)
     fmax, fmin = exact_extremes(np.array([c]), Z[None, :], harm)
@@ -557,7 +558,22 @@ def coupled_te(
     )
 
 
-def _vector(keys: Sequence[str], values: Mapping[str, float], what: str, required: bool):
+def keyed_vector(
+    keys: Sequence[str], values: Mapping[str, float], what: str, required: bool
+) -> np.ndarray:
+    """Values of a name → value mapping in the order of ``keys``, checked.
+
+    Parameters
+    ----------
+    keys : sequence of str
+        Term names, in the order of the returned vector.
+    values : mapping
+        Name → magnitude [mm] (``what="magnitudes"``, must be ≥ 0) or angle [rad].
+    what : str
+        Field name used in error messages.
+    required : bool
+        Missing names are an error (else 0).
+    """
     out = np.zeros(len(keys))
     for i, k in enumerate(keys):
         if k in values:

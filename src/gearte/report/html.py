@@ -99,7 +99,7 @@ def render_report(result: Any, figures: list[RenderedFigure] | None = None) -> s
     """
     import jinja2
 
-    from gearte import __version__
+    from gearte._version import __version__
     from gearte.references import REFERENCES
     from gearte.report.summary import headlines, tradeoff_warnings
     from gearte.report.tables import analysis_tables

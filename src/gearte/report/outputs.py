@@ -246,7 +246,7 @@ def write_file_set(out_dir: str | os.PathLike[str], files: Mapping[str, bytes]) 
     for name in files:
         _check_relative(name)
     out = check_output_dir(out_dir)
-    from gearte import __version__
+    from gearte._version import __version__
 
     manifest = json.dumps({"gearte_version": __version__, "files": sorted(files)}, indent=1)
     staging: Path | None = None

@@ -2,25 +2,23 @@
 
 A kind module defines ``KIND``, ``REFERENCES``, ``FIGURES`` (module path of its plotting),
 ``class Case(CaseBase)`` and ``run(case, options) -> StudyResult`` (see docs/architecture.md).
-Kinds are discovered without importing them, so adding a module is all it takes.
+Kinds are discovered without importing them (:mod:`gearte.io.kinds`), so adding a module is all
+it takes.
 """
 
 from __future__ import annotations
 
 import contextlib
-import importlib
 import os
-import pkgutil
 import sys
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
-from types import ModuleType
 from typing import Any
 
-__all__ = ["RunOptions", "available_kinds", "get_kind", "register_kind", "run_case"]
+from gearte.io.kinds import available_kinds, get_kind, register_kind
 
-_EXTRA_KINDS: dict[str, str] = {}
+__all__ = ["RunOptions", "available_kinds", "get_kind", "register_kind", "run_case"]
 
 
 @dataclass(frozen=True)
@@ -49,26 +47,6 @@ class RunOptions:
     samples: int | None = None
     scheduler: Any = None
     workers: int | None = None
-
-
-def available_kinds() -> list[str]:
-    """Names of all study kinds (module names in this package plus registered ones)."""
-    names = {m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")}
-    return sorted(names | set(_EXTRA_KINDS))
-
-
-def register_kind(kind: str, module: str) -> None:
-    """Register a study kind implemented outside gearte (plugins, tests)."""
-    _EXTRA_KINDS[kind] = module
-
-
-def get_kind(kind: str) -> ModuleType:
-    """Import the module of a study kind."""
-    if kind in _EXTRA_KINDS:
-        return importlib.import_module(_EXTRA_KINDS[kind])
-    if kind not in available_kinds():
-        raise KeyError(f"unknown study kind {kind!r}; known: {available_kinds()}")
-    return importlib.import_module(f"{__name__}.{kind}")
 
 
 def run_case(case: Any, options: RunOptions | None = None) -> Any:

@@ -302,7 +302,7 @@ def _meaning(key: str) -> str:
 # --------------------------------------------------------------------------- run
 def run(case: Case, options) -> StudyResult:
     """Derive (or read) the terms, then coupled TE, assembly phases and Monte-Carlo."""
-    from gearte.solvers.planetary_assembly import (
+    from gearte.runners.planetary_assembly import (
         optimal_assembly,
         paper_rule_assembly,
         relevant_angles,
@@ -470,7 +470,7 @@ def run(case: Case, options) -> StudyResult:
     # ---- Monte-Carlo
     mc = case.analyses.monte_carlo
     if mc is not None:
-        from gearte.tolerance.planetary_mc import run_scenario
+        from gearte.runners.planetary_mc import run_scenario
 
         samples = options.samples if options.samples is not None else mc.samples
         seed = options.seed if options.seed is not None else mc.seed

@@ -400,7 +400,7 @@ def _modal(case: Case, model, warnings: list[str]) -> AnalysisResult:
 
 
 def _dte(case: Case, model, warnings: list[str]) -> AnalysisResult:
-    from gearte.models.rv_dynamics_sim import default_step, dte_spectrum, simulate_dte
+    from gearte.runners.rv_dynamics_sim import default_step, dte_spectrum, simulate_dte
 
     opts = case.analyses.dte
     dt = default_step(model, opts.step_fraction) if opts.method == "rk4" else None
@@ -461,7 +461,7 @@ def _dte(case: Case, model, warnings: list[str]) -> AnalysisResult:
 
 def _sweep_one(task) -> float:
     model, rpm, duration, settle = task
-    from gearte.models.rv_dynamics_sim import simulate_dte
+    from gearte.runners.rv_dynamics_sim import simulate_dte
 
     m = model.with_params(input_speed_rpm=float(rpm))
     return simulate_dte(m, duration, settle_s=settle, record_dt=None).peak_to_peak
@@ -518,7 +518,7 @@ def _speed_sweep(case: Case, model, options) -> AnalysisResult:
 
 
 def _batch(case: Case, model, options) -> AnalysisResult:
-    from gearte.models.rv_dynamics_sim import ErrorTolerances, dte_batch
+    from gearte.runners.rv_dynamics_sim import ErrorTolerances, dte_batch
 
     b = case.analyses.batch
     e = case.errors or Errors()

@@ -33,7 +33,7 @@ import numpy as np
 
 from gearte.errors import ParameterError
 from gearte.execution import RunningStats, chunk_sizes, map_chunks, spawn_seeds
-from gearte.models.planetary_errors import TermSet, _vector, sample_extremes
+from gearte.models.planetary_errors import TermSet, keyed_vector, sample_extremes
 
 __all__ = ["SCENARIOS", "MCResult", "draw_chunk", "run_scenario", "te_upper_bound"]
 
@@ -166,7 +166,7 @@ def run_scenario(
         )
     if samples < 1:
         raise ParameterError("samples", samples, "must be >= 1")
-    tol = _vector(terms.magnitudes, dict(tolerances), "tolerances", required=True)
+    tol = keyed_vector(terms.magnitudes, dict(tolerances), "tolerances", required=True)
     fa = np.zeros(len(terms.angles))
     fm = np.zeros(len(terms.angles), dtype=bool)
     if scenario.endswith("_random_magnitudes"):

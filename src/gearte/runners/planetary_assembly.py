@@ -25,9 +25,9 @@ import numpy as np
 from gearte.errors import ParameterError
 from gearte.models.planetary_errors import (
     TermSet,
-    _vector,
     coupled_te,
     frequency_basis,
+    keyed_vector,
     sample_extremes,
 )
 
@@ -134,7 +134,7 @@ def paper_rule_assembly(
     (the smaller of the two solutions in [0, 2 pi)).
     """
     mags = dict(magnitudes)
-    _vector(terms.magnitudes, mags, "magnitudes", required=True)
+    keyed_vector(terms.magnitudes, mags, "magnitudes", required=True)
     ang = {a: float((given_angles or {}).get(a, 0.0)) for a in terms.angles}
     _, harm, group = frequency_basis(terms)
     owned: dict[str, int] = {}
@@ -234,7 +234,7 @@ def optimal_assembly(
     from scipy.stats import qmc
 
     mags = dict(magnitudes)
-    mvec = _vector(terms.magnitudes, mags, "magnitudes", required=True)
+    mvec = keyed_vector(terms.magnitudes, mags, "magnitudes", required=True)
     free = relevant_angles(terms, mags)
     base = np.zeros(len(terms.angles))
     if terms.reference_angle is not None:

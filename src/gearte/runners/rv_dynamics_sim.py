@@ -12,11 +12,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from gearte.errors import ParameterError
-from gearte.models.rv_dynamics import RVDynamicModel, RVErrors, ode_system
-from gearte.solvers.ode import ODEResult, integrate, rk4_stability_limit
+from gearte.models.rv_dynamics import (
+    RHS_SOURCE_KEY,
+    RHS_WORK_SIZE,
+    RVDynamicModel,
+    RVErrors,
+    rv_dte,
+    rv_rhs,
+)
+from gearte.solvers.ode import ODEResult, ODESystem, integrate, rk4_stability_limit
 from gearte.units import ARCSEC_PER_RAD
 
 __all__ = [
+    "ode_system",
     "DTEResult",
     "simulate_dte",
     "dte_spectrum",
@@ -26,6 +34,26 @@ __all__ = [
     "dte_batch",
     "default_step",
 ]
+
+
+def ode_system(model: RVDynamicModel, errors: RVErrors | None = None) -> ODESystem:
+    """The model as a :class:`gearte.solvers.ode.ODESystem` with DTE [rad] as output.
+
+    Compiled right-hand side :func:`~gearte.models.rv_dynamics.rhs.rv_rhs` with its plain twin
+    :meth:`RVDynamicModel.rhs_numpy`; ``errors`` [mm, rad] replace the model's errors.
+    """
+    args = model.kernel_args(errors)
+    m = model if errors is None else model.with_errors(errors)
+    return ODESystem(
+        rhs=rv_rhs,
+        output=rv_dte,
+        args=args,
+        key=RHS_SOURCE_KEY,
+        rhs_python=m.rhs_numpy,
+        output_python=lambda t, y: float(y[m.n_dof - 1] - y[2] / m.params.ratio),
+        stability_eigenvalues=model.damped_eigenvalues(mesh="max"),
+        work_size=RHS_WORK_SIZE,
+    )
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,362 @@
+"""Parameters and errors of the lumped RV dynamic model (Li et al. 2023, Tables 1–3).
+
+:class:`RVDynamicsParameters` holds geometry, masses, inertias, stiffnesses, damping and the
+operating point in paper units named in the fields (kg, kg·m², N/m, N·m/rad, N·m, rpm);
+:class:`RVErrors` the eccentricity/assembly errors [mm, rad] and bearing clearances [mm].
+:func:`parameters_from_reducer` and :func:`errors_from_reducer` build both from the shared RV
+description (:class:`gearte.geometry.rv.RVReducer`).
+
+References
+----------
+Li X., Huang J., Ding C., Guo R., Niu W. (2023). Dynamic Modeling and Analysis of an RV Reducer
+Considering Tooth Profile Modifications and Errors. Machines 11(6), 626.
+doi:10.3390/machines11060626
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gearte.errors import ParameterError
+from gearte.models.cycloid_loaded_contact import CycloidPinPair
+from gearte.models.rv_dynamics.mesh_stiffness import involute_contact_ratio
+from gearte.units import N_PER_M_TO_N_PER_MM
+
+__all__ = [
+    "RVDynamicsParameters",
+    "RVErrors",
+    "parameters_from_reducer",
+    "errors_from_reducer",
+]
+
+
+@dataclass(frozen=True)
+class RVDynamicsParameters:
+    """Parameters of the lumped RV model (paper 004 Tables 1–2 and stated assumptions).
+
+    Geometry (Table 1): ``sun_teeth`` z_s, ``planet_teeth`` z_pl, ``module_mm`` m [mm],
+    ``pressure_angle_deg`` α [deg], ``crank_count`` M, ``disc_count`` N, ``pair`` the cycloid–pin
+    pair (pins, radii, eccentricity, modification).
+    Masses [kg] and inertias [kg·m²] (Table 2, exponent signs restored: J_s = 4.44e-4,
+    J_p = 1.01e-3, J_H = 7.56e-5, J_c = 0.0209 per disc as printed, J_o = 0.106).
+    Stiffnesses [N/m] and torsional stiffnesses [N·m/rad] (Table 2). Not in the paper, assumed:
+    ``involute_single_pair_stiffness_N_per_m`` (ISO 6336 c' ≈ 14 N/(mm·µm) × 10 mm face width),
+    ``damping_ratio`` ζ of the lowest elastic mode.
+    ``cycloid_stiffness``: "fourier" (time-varying k_cr from the loaded contact, eq 13) or "mean"
+    (its mean only, as paper 004 §4.1 does). ``cycloid_mesh_stiffness_N_per_m`` and
+    ``cycloid_pressure_angle_deg`` override the contact analysis' mean k_cr (the ripple is scaled
+    with it) and β, e.g. to feed the paper's printed 2.62e8 N/m and 3.8°.
+    Operating point: ``input_speed_rpm``, ``output_torque_Nm`` (450 N·m, split equally over the
+    discs for the contact analysis).
+    """
+
+    sun_teeth: int = 12
+    planet_teeth: int = 36
+    module_mm: float = 1.5
+    pressure_angle_deg: float = 20.0
+    crank_count: int = 3
+    disc_count: int = 2
+    pair: CycloidPinPair = field(default_factory=CycloidPinPair)
+    sun_mass_kg: float = 1.3
+    planet_mass_kg: float = 0.88
+    crank_mass_kg: float = 0.4
+    disc_mass_kg: float = 2.76
+    output_mass_kg: float = 15.33
+    sun_inertia_kgm2: float = 4.44e-4
+    planet_inertia_kgm2: float = 1.01e-3
+    crank_inertia_kgm2: float = 7.56e-5
+    disc_inertia_kgm2: float = 0.0209
+    output_inertia_kgm2: float = 0.106
+    input_torsional_stiffness_Nm_per_rad: float = 1.16e4  # noqa: N815
+    sun_support_stiffness_N_per_m: float = 4.68e7  # noqa: N815
+    crank_torsional_stiffness_Nm_per_rad: float = 6.99e4  # noqa: N815
+    crank_bending_stiffness_N_per_m: float = 5.55e8  # noqa: N815
+    crank_bearing_stiffness_N_per_m: float = 5.76e8  # noqa: N815
+    turning_arm_bearing_stiffness_N_per_m: float = 2.84e8  # noqa: N815
+    output_support_stiffness_N_per_m: float = 3.15e8  # noqa: N815
+    involute_single_pair_stiffness_N_per_m: float = 1.4e8  # noqa: N815
+    involute_harmonics: int = 10
+    cycloid_harmonics: int = 8
+    contact_positions: int = 48
+    damping_ratio: float = 0.03
+    cycloid_stiffness: str = "fourier"
+    cycloid_mesh_stiffness_N_per_m: float | None = None  # noqa: N815
+    cycloid_pressure_angle_deg: float | None = None
+    input_speed_rpm: float = 1500.0
+    output_torque_Nm: float = 450.0  # noqa: N815
+    crank_phase_deg: float = 0.0
+
+    def __post_init__(self) -> None:
+        ints = {
+            "sun_teeth": 6,
+            "planet_teeth": 6,
+            "crank_count": 2,
+            "disc_count": 1,
+            "involute_harmonics": 1,
+            "cycloid_harmonics": 1,
+            "contact_positions": 8,
+        }
+        for name, lo in ints.items():
+            if int(getattr(self, name)) < lo:
+                raise ParameterError(name, getattr(self, name), f"must be an integer ≥ {lo}")
+        if self.crank_count > 6 or self.disc_count > 3:
+            raise ParameterError(
+                "crank_count/disc_count",
+                (self.crank_count, self.disc_count),
+                "at most 6 cranks and 3 discs (size of the right-hand side's memo)",
+            )
+        for name, val in self.__dict__.items():
+            if name in ints or name in ("pair", "crank_phase_deg", "cycloid_stiffness"):
+                continue
+            if val is None and name.startswith("cycloid_"):
+                continue
+            if not (np.isfinite(val) and val > 0):
+                raise ParameterError(name, val, "must be finite and > 0")
+        if self.cycloid_stiffness not in ("fourier", "mean"):
+            raise ParameterError(
+                "cycloid_stiffness", self.cycloid_stiffness, "must be 'fourier' or 'mean'"
+            )
+        if not self.damping_ratio < 1.0:
+            raise ParameterError("damping_ratio", self.damping_ratio, "must be in (0, 1)")
+        if self.cycloid_harmonics >= self.contact_positions // 2:
+            raise ParameterError(
+                "cycloid_harmonics",
+                self.cycloid_harmonics,
+                f"must be < contact_positions/2 = {self.contact_positions // 2}",
+            )
+
+    # --- derived kinematics ------------------------------------------------------------------
+    @property
+    def ratio(self) -> float:
+        """i = 1 + z_p z_pl / z_s, input/output speed ratio with fixed pins (121 for Table 1)."""
+        return 1.0 + self.pair.pin_count * self.planet_teeth / self.sun_teeth
+
+    @property
+    def output_speed(self) -> float:
+        """ω_o, nominal output speed [rad/s]."""
+        return self.input_speed_rpm * 2.0 * np.pi / 60.0 / self.ratio
+
+    @property
+    def centre_distance_mm(self) -> float:
+        """a_H = m (z_s + z_pl)/2, crank circle radius [mm]."""
+        return self.module_mm * (self.sun_teeth + self.planet_teeth) / 2.0
+
+    def frequencies(self) -> dict[str, float]:
+        """Characteristic frequencies at the operating speed [Hz]."""
+        fo = self.output_speed / (2 * np.pi)
+        zp, zc = self.pair.pin_count, self.pair.tooth_count
+        return {
+            "output rotation": fo,
+            "input rotation": self.ratio * fo,
+            "crank rotation": zp * fo,  # relative to the carrier
+            "involute mesh": self.sun_teeth * (self.ratio - 1.0) * fo,
+            "cycloid mesh": zp * zc * fo,
+        }
+
+
+@dataclass(frozen=True)
+class RVErrors:
+    """Errors of paper 004 Table 3 placed on explicit cranks/discs, and bearing clearances.
+
+    Each error is an (amplitude [mm], phase [rad]) pair; arrays give one per crank i (shape (M,)),
+    or per crank and disc (shape (M, N)); an amplitude of 0 means "not on this one".
+
+    sun_eccentricity (E_s, β_s): tooth geometry offset rotating with the sun.
+    planet_eccentricity (E_p,i, β_p,i): rotating with planet i.
+    sun_assembly (E_sa, β_sa): fixed offset of the sun's support seat in the housing.
+    disc_hole (E^H_cji, β^H_cji): offset of the crank hole i in disc j, rotating with the disc.
+    cam (E_dji, β_dji): offset of cam j of crank i, rotating with the crank.
+    carrier_hole (E^H_oi, β^H_oi): offset of crank hole i in the output disc, rotating with it.
+    output_assembly (E_o, β_o): fixed offset of the output's support seat.
+    pin_composite (E_cr,j, phase): composite error of disc j along its line of action,
+      E sin(θ_o + phase) (paper eq 21; no value given).
+    Clearances [mm]: turning-arm (crank–disc) bearings ε_c, crank support bearings in the output
+    disc ε_oH, output main bearing ε_h; radial dead zone of the bearing spring.
+    """
+
+    crank_count: int = 3
+    disc_count: int = 2
+    sun_eccentricity: tuple[float, float] = (0.0, 0.0)
+    sun_assembly: tuple[float, float] = (0.0, 0.0)
+    output_assembly: tuple[float, float] = (0.0, 0.0)
+    planet_eccentricity: np.ndarray | None = None  # (M, 2)
+    carrier_hole: np.ndarray | None = None  # (M, 2)
+    disc_hole: np.ndarray | None = None  # (M, N, 2)
+    cam: np.ndarray | None = None  # (M, N, 2)
+    pin_composite: np.ndarray | None = None  # (N, 2)
+    turning_arm_clearance_mm: float = 0.0
+    crank_bearing_clearance_mm: float = 0.0
+    output_bearing_clearance_mm: float = 0.0
+
+    def __post_init__(self) -> None:
+        m, n = self.crank_count, self.disc_count
+        shapes = {
+            "planet_eccentricity": (m, 2),
+            "carrier_hole": (m, 2),
+            "disc_hole": (m, n, 2),
+            "cam": (m, n, 2),
+            "pin_composite": (n, 2),
+        }
+        for name, shape in shapes.items():
+            v = getattr(self, name)
+            arr = np.zeros(shape) if v is None else np.asarray(v, dtype=float)
+            if arr.shape != shape:
+                raise ParameterError(name, arr.shape, f"must have shape {shape}")
+            if not np.all(np.isfinite(arr)) or np.any(arr[..., 0] < 0):
+                raise ParameterError(name, arr.tolist(), "amplitudes must be finite and ≥ 0")
+            object.__setattr__(self, name, arr)
+        for name in ("sun_eccentricity", "sun_assembly", "output_assembly"):
+            v = tuple(float(x) for x in getattr(self, name))
+            if len(v) != 2 or v[0] < 0 or not np.all(np.isfinite(v)):
+                raise ParameterError(name, v, "must be (amplitude ≥ 0 [mm], phase [rad])")
+            object.__setattr__(self, name, v)
+        for name in (
+            "turning_arm_clearance_mm",
+            "crank_bearing_clearance_mm",
+            "output_bearing_clearance_mm",
+        ):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v >= 0):
+                raise ParameterError(name, v, "must be finite and ≥ 0")
+
+    @classmethod
+    def table3(
+        cls,
+        crank_count: int = 3,
+        disc_count: int = 2,
+        placement: str = "first",
+        **clearances: float,
+    ) -> RVErrors:
+        """Paper 004 Table 3 with an explicit placement of the per-crank/per-disc errors.
+
+        placement = "first": each per-crank error sits on crank 1 and each per-disc error on
+        disc 1 (a single faulty part, the other parts nominal); "all": identical on every crank
+        and disc (the patterns then largely cancel, see docs). Angles of Table 3 in degrees.
+        """
+        if placement not in ("first", "all"):
+            raise ParameterError("placement", placement, "must be 'first' or 'all'")
+        d = np.deg2rad
+        m, n = crank_count, disc_count
+        mask_m = np.zeros(m)
+        mask_mn = np.zeros((m, n))
+        if placement == "first":
+            mask_m[0] = 1.0
+            mask_mn[0, 0] = 1.0
+        else:
+            mask_m[:] = 1.0
+            mask_mn[:] = 1.0
+
+        def per_m(e: float, b: float) -> np.ndarray:
+            return np.stack([e * mask_m, np.full(m, d(b))], axis=-1)
+
+        def per_mn(e: float, b: float) -> np.ndarray:
+            return np.stack([e * mask_mn, np.full((m, n), d(b))], axis=-1)
+
+        return cls(
+            crank_count=m,
+            disc_count=n,
+            sun_eccentricity=(0.005, d(45.0)),
+            planet_eccentricity=per_m(0.006, 30.0),
+            sun_assembly=(0.005, d(100.0)),
+            disc_hole=per_mn(0.008, 140.0),
+            cam=per_mn(0.008, 90.0),
+            carrier_hole=per_m(0.035, 270.0),
+            output_assembly=(0.038, d(90.0)),
+            **clearances,
+        )
+
+
+# --- building the dynamic model from the shared RV description (gearte.geometry.rv) ----------
+def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
+    """RVDynamicsParameters from an :class:`gearte.geometry.rv.RVReducer` description.
+
+    The description supplies geometry, modification, material, mesh/bearing/support stiffnesses
+    (its N/mm → N/m here); ``dynamic`` supplies what only the dynamics needs (masses, inertias,
+    torsional and bending stiffnesses, damping, operating point), defaulting to paper 004 Table 2.
+    The description's mean involute mesh stiffness k̄ becomes the single-pair stiffness k̄/ε_α of
+    the rectangular wave.
+
+    Raises
+    ------
+    ParameterError
+        When the crank circle radius differs from the first-stage centre distance (the dynamic
+        model derives it from the gears) or a per-pin error is given (the equivalent single-spring
+        cycloid–pin contact cannot represent it).
+    """
+    fs, cr, di, pins = reducer.first_stage, reducer.cranks, reducer.discs, reducer.pins
+    a_h = fs.module * (fs.sun_teeth + fs.planet_teeth) / 2.0
+    if abs(cr.circle_radius - a_h) > 1e-6 * a_h:
+        raise ParameterError(
+            "cranks.circle_radius",
+            cr.circle_radius,
+            f"must equal the first-stage centre distance m (z_1 + z_2)/2 = {a_h:g} mm",
+        )
+    for name in ("radius_errors", "radial_position_errors", "tangential_position_errors"):
+        if np.any(getattr(pins, name) != 0):
+            raise ParameterError(
+                f"pins.{name}",
+                "non-zero",
+                "per-pin errors are not representable by the equivalent cycloid–pin spring of "
+                "the dynamic model; use the composite error RVErrors.pin_composite",
+            )
+    pair = CycloidPinPair(
+        pin_count=pins.count,
+        pin_radius_mm=pins.pin_radius,
+        pin_circle_radius_mm=pins.circle_radius,
+        eccentricity_mm=cr.eccentricity,
+        face_width_mm=di.face_width,
+        youngs_modulus_MPa=di.youngs_modulus,
+        poisson_ratio=di.poisson_ratio,
+        pin_radius_modification_mm=di.equidistant_modification,
+        pin_position_modification_mm=di.shift_modification,
+    )
+    eps = involute_contact_ratio(fs.sun_teeth, fs.planet_teeth, fs.module, fs.pressure_angle)
+    kw = dict(
+        sun_teeth=fs.sun_teeth,
+        planet_teeth=fs.planet_teeth,
+        module_mm=fs.module,
+        pressure_angle_deg=float(np.degrees(fs.pressure_angle)),
+        crank_count=cr.count,
+        disc_count=di.count,
+        pair=pair,
+        sun_support_stiffness_N_per_m=fs.sun_support_stiffness / N_PER_M_TO_N_PER_MM,
+        involute_single_pair_stiffness_N_per_m=fs.mesh_stiffness / eps / N_PER_M_TO_N_PER_MM,
+        turning_arm_bearing_stiffness_N_per_m=cr.cam_bearing_stiffness / N_PER_M_TO_N_PER_MM,
+        crank_bearing_stiffness_N_per_m=cr.carrier_bearing_stiffness / N_PER_M_TO_N_PER_MM,
+        output_support_stiffness_N_per_m=reducer.supports.carrier_radial_stiffness
+        / N_PER_M_TO_N_PER_MM,
+    )
+    kw.update(dynamic)
+    return RVDynamicsParameters(**kw)
+
+
+def errors_from_reducer(reducer, **paper004) -> RVErrors:
+    """RVErrors from the description's measured errors and clearances.
+
+    The description's error vectors (x, y) in the part frames use the same frames as this model
+    (planet: from disc 1's eccentric direction; disc bore and carrier bore: from the radial
+    direction; cam: from its eccentric direction), so they map 1:1 to (amplitude, phase). Its
+    disc-bore array is indexed (disc, crank) and is transposed. ``paper004`` adds the errors the
+    description does not hold (sun_eccentricity, sun_assembly, output_assembly, pin_composite,
+    output_bearing_clearance_mm).
+    """
+    e = reducer.errors
+    m, n = reducer.cranks.count, reducer.discs.count
+
+    def polar(v):
+        v = np.asarray(v, dtype=float)
+        return np.stack([np.hypot(v[..., 0], v[..., 1]), np.arctan2(v[..., 1], v[..., 0])], -1)
+
+    return RVErrors(
+        crank_count=m,
+        disc_count=n,
+        planet_eccentricity=polar(e.planet),
+        carrier_hole=polar(e.carrier_bore),
+        disc_hole=polar(np.swapaxes(e.disc_bore, 0, 1)),
+        cam=polar(e.cam),
+        turning_arm_clearance_mm=reducer.cranks.cam_bearing_clearance,
+        crank_bearing_clearance_mm=reducer.cranks.carrier_bearing_clearance,
+        **paper004,
+    )
