@@ -20,7 +20,14 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gearte"
 # Lowest first. A module may import modules of its own layer and of the layers below it.
 # Keep in step with docs/architecture.md, "Layers".
 LAYERS: list[tuple[str, ...]] = [
-    ("gearte._version", "gearte.errors", "gearte.units", "gearte.references", "gearte.cases"),
+    (
+        "gearte._version",
+        "gearte.errors",
+        "gearte.units",
+        "gearte.labels",
+        "gearte.references",
+        "gearte.cases",
+    ),
     ("gearte.execution",),
     ("gearte.geometry",),
     ("gearte.tolerance",),
