@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from gearte.units import split_unit, unit_text
 
-__all__ = ["LABELS", "WORDS", "label", "label_with_unit"]
+__all__ = ["LABELS", "WORDS", "PHRASES", "label", "label_with_unit"]
 
 #: Whole names whose word-by-word reading is wrong or clumsy (name without its unit).
 LABELS: dict[str, str] = {
@@ -58,6 +58,10 @@ WORDS: dict[str, str] = {
 }
 
 
+#: Phrases read together after the words are joined.
+PHRASES: dict[str, str] = {"peak to peak": "peak-to-peak"}
+
+
 def label(name: str) -> str:
     """Readable label of a result name, without its unit: ``"peak_pin_load [N]"`` → ``"Peak pin
     load"``; names already written for people (with spaces or capitals) are kept."""
@@ -70,6 +74,8 @@ def label(name: str) -> str:
     if not words:
         return base
     text = " ".join(words)
+    for a, b in PHRASES.items():
+        text = text.replace(a, b)
     return text[0].upper() + text[1:]
 
 

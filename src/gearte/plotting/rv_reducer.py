@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
-from gearte.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
+from gearte.units import format_quantity, rad_to_arcmin, rad_to_arcsec, rad_to_deg
 
 __all__ = ["figures"]
 
@@ -92,14 +92,14 @@ def _hysteresis(cat, rated: float) -> Figure:
             ang[i100] + rad_to_arcmin((t - 100.0) / 100.0 * rated / k),
             color=PALETTE[1],
             lw=2,
-            label=f"rigidity {k / 1e3 / rad_to_arcmin(1.0):.0f} N*m/arcmin",
+            label=f"rigidity {format_quantity(k / 1e3 / rad_to_arcmin(1.0), 'N*m/arcmin')}",
         )
-    ax.axvspan(-3.0, 3.0, color=PALETTE[2], alpha=0.2,
-               label=f"±3 %: lost motion {rad_to_arcmin(cat.lost_motion):.3f}'")  # fmt: skip
+    lost = format_quantity(rad_to_arcmin(cat.lost_motion), "arcmin")
+    ax.axvspan(-3.0, 3.0, color=PALETTE[2], alpha=0.2, label=f"±3 %: lost motion {lost}")
     ax.axvline(0.0, color="k", lw=0.5)
     ax.set_xlabel("output torque [% rated]")
     ax.set_ylabel("output torsion angle [arcmin]")
-    ax.set_title(f"backlash {rad_to_arcmin(cat.backlash):.3f}'")
+    ax.set_title(f"backlash {format_quantity(rad_to_arcmin(cat.backlash), 'arcmin')}")
     ax.legend(fontsize=8)
     return Figure(
         "Hysteresis curve",

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from gearte.labels import label
+from gearte.report.tables import item_label, relative_change
 from gearte.units import format_quantity, split_unit
 
 __all__ = ["HeadlineRow", "headlines", "tradeoff_warnings", "HEADLINE_KEYS", "SPEC_CHECKS"]
@@ -181,8 +182,6 @@ def _analysis_headlines(a: Any) -> list[HeadlineRow]:
                 and all(_finite(x) for x in v.values())
             ):
                 item, share = max(v.items(), key=lambda kv: kv[1])
-                from gearte.report.tables import item_label
-
                 add(f"Largest {label(base).lower()}", f"{item_label(item)} ({_text(share, unit)})")
                 break
     if not picked:
@@ -214,9 +213,14 @@ def _worse(stem: str, before: float, after: float) -> bool:
     return after < before if higher else abs(after) > abs(before)
 
 
+def _lower(text: str) -> str:
+    """``"Peak pin load"`` → ``"peak pin load"``; acronyms stay (``"TE peak"``)."""
+    return text[:1].lower() + text[1:] if text[1:2].islower() else text
+
+
 def _change_text(stem: str, unit: str, before: float, after: float) -> str:
-    rel = f" ({100 * (after - before) / abs(before):+.0f} %)" if before else ""
-    return f"{label(stem).lower()} from {_text(before, unit)} to {_text(after, unit)}{rel}"
+    rel = relative_change(before, after)
+    return f"{_lower(label(stem))} from {_text(before, unit)} to {_text(after, unit)}{rel}"
 
 
 def tradeoff_warnings(result: Any, *, threshold: float = 0.01) -> list[str]:
@@ -242,7 +246,7 @@ def tradeoff_warnings(result: Any, *, threshold: float = 0.01) -> list[str]:
             if s.endswith("_min") and f"{s[:-4]}_max" in by_stem:
                 q = by_stem[f"{s[:-4]}_max"]
                 worse.append(
-                    f"{label(s[:-4]).lower()} from {_text(pb, u)}–{_text(q[2], u)} to "
+                    f"{_lower(label(s[:-4]))} from {_text(pb, u)}–{_text(q[2], u)} to "
                     f"{_text(pa, u)}–{_text(q[3], u)}"
                 )
                 merged.add(q[0])

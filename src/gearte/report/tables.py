@@ -29,7 +29,15 @@ import numpy as np
 from gearte.labels import label
 from gearte.units import format_number, format_quantity, split_unit, unit_text
 
-__all__ = ["Table", "analysis_tables", "csv_files", "summarise_series", "is_series", "item_label"]
+__all__ = [
+    "Table",
+    "analysis_tables",
+    "csv_files",
+    "summarise_series",
+    "is_series",
+    "item_label",
+    "relative_change",
+]
 
 #: Series up to this length are written inline (``0.168, 0.832``) instead of summarised.
 INLINE_MAX = 8
@@ -268,8 +276,7 @@ def analysis_tables(analysis: Any) -> list[Table]:
             change = ""
             if _is_number(vb) and _is_number(va) and np.isfinite(vb) and np.isfinite(va):
                 change = format_quantity(va - vb, unit)
-                if vb != 0:
-                    change += f" ({100 * (va - vb) / abs(vb):+.3g} %)"
+                change += relative_change(vb, va)
             rows.append(
                 [label(stem), _scalar_text(vb, unit), _scalar_text(va, unit), change or "—"]
             )
@@ -312,6 +319,16 @@ def analysis_tables(analysis: Any) -> list[Table]:
 def item_label(key: str) -> str:
     """An item of a mapping (a factor, a stage) for people: identifiers get :func:`label`."""
     return label(key) if "_" in key and " " not in key else key
+
+
+def relative_change(before: float, after: float) -> str:
+    """The relative change for people: `` (+17 %)``; `` (×3110)`` over 1000 %; ``""`` from 0."""
+    if not before:
+        return ""
+    r = 100 * (after - before) / abs(before)
+    if abs(r) >= 1000:
+        return f" (×{format_number(after / before, 3)})"
+    return f" ({'+' if r > 0 else ''}{format_number(r, 2)} %)"
 
 
 def _records_table(key: str, name: str, records: list[dict[str, Any]]) -> Table:

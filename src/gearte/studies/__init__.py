@@ -9,10 +9,12 @@ it takes.
 from __future__ import annotations
 
 import contextlib
+import importlib.abc
+import importlib.util
 import os
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -63,13 +65,12 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
     t_imp = time.perf_counter()
     module = get_kind(case.case.kind)
     t0 = time.perf_counter()
-    with _numba_timer() as numba_s:
+    with _numba_timer() as numba:
         result = module.run(case, options or RunOptions())
     t_end = time.perf_counter()
     result.elapsed_s = t_end - t0
     result.timings["imports: study kind"] = t0 - t_imp
-    if numba_s:
-        result.timings["numba load/compile"] = numba_s[0]
+    result.timings.update(numba)
     result.timings.update(analysis_timings(result.analyses, t0, t_end))
     return result
 
@@ -91,17 +92,65 @@ def analysis_timings(analyses: list[Any], start: float, end: float) -> dict[str,
 
 
 @contextlib.contextmanager
-def _numba_timer() -> Iterator[list[float]]:
-    """Seconds numba spends loading kernels from its cache or compiling them (its
-    ``numba:compile`` event, outermost calls only), as a one-element list once the block ends;
-    empty if the study kind does not use numba (numba is not imported just to time it)."""
-    out: list[float] = []
-    if "numba" not in sys.modules:
-        yield out
-        return
-    from numba.core import event
+def _numba_timer() -> Iterator[dict[str, float]]:
+    """Seconds numba spends loading kernels from its cache or compiling them (it holds its
+    compiler lock for both: the ``numba:compiler_lock`` event, outermost holds only) and, if the
+    block imports numba, the import.
 
-    timer = event.TimingListener()
-    with event.install_listener("numba:compile", timer):
+    numba is not imported just to time it: if it is not imported yet, a one-shot import hook
+    starts the timer as soon as the study imports it. The mapping is filled when the block ends:
+    ``{"numba load/compile": s, "imports: numba": s}`` (keys absent where nothing happened).
+    """
+    out: dict[str, float] = {}
+    timer: list[Any] = []
+
+    def start() -> None:
+        from numba.core import event
+
+        timer.append(event.TimingListener())
+        event.register("numba:compiler_lock", timer[0])
+
+    hook = None
+    if "numba" in sys.modules:
+        start()
+    else:
+        hook = _AfterImport("numba", out, start)
+        sys.meta_path.insert(0, hook)
+    try:
         yield out
-    out.append(timer.duration if timer.done else 0.0)
+    finally:
+        if hook is not None and hook in sys.meta_path:
+            sys.meta_path.remove(hook)
+        if timer:
+            from numba.core import event
+
+            event.unregister("numba:compiler_lock", timer[0])
+            if timer[0].done:
+                out["numba load/compile"] = timer[0].duration
+
+
+class _AfterImport(importlib.abc.MetaPathFinder):
+    """Times the first import of module ``name`` (into ``out["imports: <name>"]``) and calls
+    ``then()`` right after it; removes itself from ``sys.meta_path`` on first use."""
+
+    def __init__(self, name: str, out: dict[str, float], then: Callable[[], None]) -> None:
+        self.name, self.out, self.then = name, out, then
+
+    def find_spec(self, fullname: str, path: Any, target: Any = None) -> Any:
+        if fullname != self.name:
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.util.find_spec(fullname)
+        if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
+            return spec
+        loader = spec.loader
+        inner = loader.exec_module
+
+        def exec_module(module: Any) -> None:
+            t0 = time.perf_counter()
+            inner(module)
+            self.out[f"imports: {self.name}"] = time.perf_counter() - t0
+            self.then()
+
+        loader.exec_module = exec_module  # type: ignore[method-assign]
+        return spec
