@@ -34,6 +34,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("gearte.solvers",),
     ("gearte.models",),
     ("gearte.runners",),
+    ("gearte.drives",),
     ("gearte.results", "gearte.io"),
     ("gearte.studies",),
     ("gearte.plotting",),

@@ -42,7 +42,9 @@ def format_validation_errors(exc: Any) -> list[tuple[str, str]]:
     return out
 
 
-def load_case_dict(data: Any, *, source: str = "<dict>", name: str | None = None) -> Any:
+def load_case_dict(
+    data: Any, *, source: str = "<dict>", name: str | None = None, base_dir: str | None = None
+) -> Any:
     """Validate a case given as a dictionary (the parsed TOML).
 
     Parameters
@@ -53,6 +55,9 @@ def load_case_dict(data: Any, *, source: str = "<dict>", name: str | None = None
         Where it came from, for messages.
     name : str, optional
         Default for ``case.name`` (the file stem).
+    base_dir : str, optional
+        Folder that relative paths inside the case (a chain stage's drive ``case``) are read
+        from; default: the working directory.
 
     Returns
     -------
@@ -86,7 +91,7 @@ def load_case_dict(data: Any, *, source: str = "<dict>", name: str | None = None
     if name is not None and "name" not in meta:
         data = {**data, "case": {**meta, "name": name}}
     try:
-        return module.Case.model_validate(data)
+        return module.Case.model_validate(data, context={"case_dir": base_dir})
     except ValidationError as exc:
         raise CaseFileError(source, format_validation_errors(exc)) from None
 
@@ -113,7 +118,9 @@ def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise CaseFileError(str(path), [("(file)", f"TOML syntax error: {exc}")]) from None
-    return load_case_dict(data, source=str(path), name=Path(path).stem)
+    return load_case_dict(
+        data, source=str(path), name=Path(path).stem, base_dir=str(Path(path).parent)
+    )
 
 
 def validate_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:

@@ -9,7 +9,14 @@ gives its return error in one of three ways:
 * ``backlash_{min,mean,max}_um`` with ``output_diameter_mm``: backlash values obtained
   elsewhere (measured, or the paper's 3DCS simulation, Tables 4 and 8) → eq. (14)/(29);
 * ``[chain.stages.pair]``: the pair's data and tolerances (same tables as the ``gear_pair``
-  kind) → gearte's backlash stack, min/mean/max at ``analysis.confidence`` → eq. (14)/(29).
+  kind) → gearte's backlash stack, min/mean/max at ``analysis.confidence`` → eq. (14)/(29);
+* ``[chain.stages.drive]``: any drive gearte models — ``kind`` = ``"rv_reducer"``,
+  ``"cycloid_stage"``, ``"planetary"`` or ``"gear_pair"`` and either ``case = "<file>"`` (a case
+  file of that kind, relative to this one) or that kind's sections inline
+  (``[chain.stages.drive.reducer]`` …). Its lost motion (and its spread where it has a tolerance
+  stack) and its torsional stiffness come from that drive's own model through the drive interface
+  (:mod:`gearte.drives`); a drive whose model has no lost motion (``planetary``) takes
+  ``lost_motion_max_arcmin`` beside it.
 
 Optional ``[shim]``: shim thickness under both gears of a bevel stage for a target minimum
 backlash (eq. 32), the backlash after shimming (shifted stack), and the chain after shimming.
@@ -48,8 +55,10 @@ from gearte.models.lost_motion import (
     shim_thickness,
 )
 from gearte.results import AnalysisResult, StudyResult
+from gearte.studies._drives import DriveSpec
 from gearte.studies.gear_pair import PairAnalysisSpec, PairSpec, analyse_pair
 from gearte.units import (
+    Nmm_to_Nm,
     arcmin_to_rad,
     deg_to_rad,
     format_dms,
@@ -88,6 +97,9 @@ class StageSpec(StrictModel):
     pressure_angle_deg: float = Field(default=20.0, gt=0, lt=45)
     min_backlash_limit_um: float = Field(default=0.0, ge=0, le=100_000)
     pair: PairSpec | None = None
+    drive: DriveSpec | None = Field(
+        default=None, description="A drive gearte models (rv_reducer, cycloid_stage, ...)."
+    )
 
     @model_validator(mode="after")
     def _one_source(self):
@@ -97,10 +109,14 @@ class StageSpec(StrictModel):
             for v in (self.backlash_min_um, self.backlash_mean_um, self.backlash_max_um)
         )
         pr = self.pair is not None
-        if lm + bl + pr != 1:
+        dr = self.drive is not None
+        if dr:
+            self._check_drive(lm, bl or pr)
+        if (lm and not dr) + bl + pr + dr != 1:
             raise ValueError(
                 f"stage {self.name!r}: give exactly one of lost_motion_max_arcmin, "
-                "backlash_{min,mean,max}_um (+ output_diameter_mm), or a [pair] table"
+                "backlash_{min,mean,max}_um (+ output_diameter_mm), a [pair] table or a "
+                "[drive] table"
             )
         if lm:
             vals = [
@@ -135,12 +151,39 @@ class StageSpec(StrictModel):
                     f"stage {self.name!r}: ratio {self.ratio} disagrees with the pair's teeth "
                     f"{p.driven.teeth}/{p.driving.teeth} = {z:.6g} (more than 0.1 %)"
                 )
-        if self.compensate and not (bl or pr or self.lost_motion_mean_arcmin is not None):
+        if self.compensate and not (
+            bl or pr or self.lost_motion_mean_arcmin is not None or self._drive_has_lost_motion()
+        ):
             raise ValueError(
                 f"stage {self.name!r}: compensate = true needs a mean return error "
-                "(lost_motion_mean_arcmin, backlash values or a pair)"
+                "(lost_motion_mean_arcmin, backlash values, a pair or a drive that models it)"
             )
         return self
+
+    def _drive_has_lost_motion(self) -> bool:
+        return self.drive is not None and self.drive.kind != "planetary"
+
+    def _check_drive(self, lost_given: bool, other: bool) -> None:
+        """A drive stage: ratio as the drive's; lost motion given only where unmodelled."""
+        assert self.drive is not None
+        if other:
+            return  # reported by the one-source rule
+        if self._drive_has_lost_motion() and lost_given:
+            raise ValueError(
+                f"stage {self.name!r}: the {self.drive.kind} drive's lost motion comes from its "
+                "own model; remove lost_motion_*_arcmin"
+            )
+        if not self._drive_has_lost_motion() and not lost_given:
+            raise ValueError(
+                f"stage {self.name!r}: the {self.drive.kind} model has no lost motion (no "
+                "backlash in it); give lost_motion_max_arcmin (e.g. the maker's value) beside it"
+            )
+        ratio = self.drive.build(self.name).ratio
+        if abs(ratio / self.ratio - 1) > 1e-3:
+            raise ValueError(
+                f"stage {self.name!r}: ratio {self.ratio} disagrees with the drive's own ratio "
+                f"{ratio:.6g} (more than 0.1 %)"
+            )
 
 
 class ChainSpec(StrictModel):
@@ -234,6 +277,11 @@ class Case(CaseBase):
             raise ValueError(
                 f"shim.stage = {self.shim.stage!r} is not a stage name; stages: {list(stages)}"
             )
+        if st.drive is not None:
+            raise ValueError(
+                f"shim.stage = {st.name!r} is a {st.drive.kind} drive; shims are for bevel pairs "
+                "given by a [pair] table or backlash values"
+            )
         if st.lost_motion_max_arcmin is not None:
             raise ValueError(
                 f"shim.stage = {st.name!r} gives only a lost motion; a shim needs its backlash"
@@ -306,6 +354,102 @@ def _statistical_joint_max(res, confidence: float) -> float:
     return mean + z * math.sqrt(var)
 
 
+def _given_lost_motion(st: StageSpec) -> tuple[float, float | None, float | None]:
+    """(max, mean, min) return error [rad] given in the case (mean/min optional)."""
+    assert st.lost_motion_max_arcmin is not None
+
+    def rad(v: float | None) -> float | None:
+        return None if v is None else float(arcmin_to_rad(v))
+
+    return (
+        float(arcmin_to_rad(st.lost_motion_max_arcmin)),
+        rad(st.lost_motion_mean_arcmin),
+        rad(st.lost_motion_min_arcmin),
+    )
+
+
+def _pair_drive(st: StageSpec, pair):
+    """The drive-interface view of a ``[pair]`` stage (its stiffness)."""
+    from gearte.drives.gear_pair import GearPairDrive
+
+    assert st.pair is not None
+    return GearPairDrive(pair, name=st.name, face_width=getattr(st.pair, "face_width_mm", None))
+
+
+def _drive_stage(st: StageSpec, drive, confidence: float):
+    """Lost motion of a ``[drive]`` stage from the drive's own model, and its result."""
+    assert st.drive is not None
+    values: dict = {
+        "drive_kind": drive.kind,
+        "drive_case": st.drive.case or "inline",
+        "ratio": st.ratio,
+        "drive_ratio": drive.ratio,
+    }
+    notes = [f"{drive.kind} drive; lost motion and stiffness from its own model (gearte.drives)."]
+    if st.lost_motion_max_arcmin is not None:  # a model without lost motion: the given values
+        mx, mean, lo = _given_lost_motion(st)
+        notes.append("Its model has no lost motion: the values given in the case are used.")
+    else:
+        spread = drive.lost_motion_spread(confidence)
+        if spread is None:
+            lm = drive.lost_motion()
+            assert lm is not None
+            mx = mean = lo = float(lm)
+            values["lost_motion [arcmin]"] = float(rad_to_arcmin(lm))
+            notes.append(
+                "No tolerance stack in this description: min = mean = max = the model's "
+                "lost motion (a deterministic reducer with its given errors)."
+            )
+        else:
+            mx, mean, lo = spread.max, spread.mean, spread.min
+            values["lost_motion_sd [arcmin]"] = float(rad_to_arcmin(spread.sd))
+            notes.append(
+                f"Lost motion mean and range at confidence {confidence} from the drive's "
+                "tolerance stack."
+            )
+    values.update(
+        {
+            "lost_motion_max [arcmin]": float(rad_to_arcmin(mx)),
+            "lost_motion_mean [arcmin]": None if mean is None else float(rad_to_arcmin(mean)),
+            "lost_motion_min [arcmin]": None if lo is None else float(rad_to_arcmin(lo)),
+            "lost_motion_max_dms": format_dms(mx),
+        }
+    )
+    k = drive.torsional_stiffness()
+    values["torsional_stiffness [N*m/arcmin]"] = None if k is None else _nm_per_arcmin(k)
+    result = AnalysisResult(
+        name=f"{_slug(st.name)}_drive",
+        title=f"{st.name}: {drive.kind} drive (its own model)",
+        values=values,
+        references=[],
+        notes=notes,
+    )
+    return StageLostMotion(st.name, st.ratio, mx, mean, lo, st.compensate), result
+
+
+def _nm_per_arcmin(k: float) -> float:
+    """Torsional stiffness N·mm/rad → N·m/arcmin."""
+    return float(Nmm_to_Nm(k) / rad_to_arcmin(1.0))
+
+
+def _joint_stiffness_values(stages, stiffness: dict[str, float | None]) -> dict:
+    """Stage stiffnesses and, when all are modelled, the chain's at the joint [N·m/arcmin]."""
+    from gearte.drives.chain import joint_stiffness
+
+    ks = [stiffness[s.name] for s in stages]
+    known = [k for k in ks if k is not None]
+    joint = None
+    if len(known) == len(ks):
+        joint = _nm_per_arcmin(joint_stiffness(known, [s.ratio for s in stages]))
+    return {
+        "stage_torsional_stiffness [N*m/arcmin]": {
+            s.name: None if k is None else _nm_per_arcmin(k)
+            for s, k in zip(stages, ks, strict=True)
+        },
+        "joint_torsional_stiffness [N*m/arcmin]": joint,
+    }
+
+
 def _round_shim(x: float, step: float, how: str) -> float:
     if step <= 0:
         return x
@@ -322,20 +466,19 @@ def run(case: Case, options) -> StudyResult:
     backlash: dict[str, tuple] = {}
 
     # -- stages ----------------------------------------------------------------------------------
+    stiffness: dict[str, float | None] = {}
     for st in case.chain.stages:
         slug = _slug(st.name)
+        stiffness[st.name] = None
+        if st.drive is not None:
+            drive = st.drive.build(st.name)
+            stage, result = _drive_stage(st, drive, conf)
+            stages.append(stage)
+            stiffness[st.name] = drive.torsional_stiffness()
+            analyses.append(result)
+            continue
         if st.lost_motion_max_arcmin is not None:
-            mx = float(arcmin_to_rad(st.lost_motion_max_arcmin))
-            mean = (
-                None
-                if st.lost_motion_mean_arcmin is None
-                else float(arcmin_to_rad(st.lost_motion_mean_arcmin))
-            )
-            mn = (
-                None
-                if st.lost_motion_min_arcmin is None
-                else float(arcmin_to_rad(st.lost_motion_min_arcmin))
-            )
+            mx, mean, mn = _given_lost_motion(st)
             stages.append(StageLostMotion(st.name, st.ratio, mx, mean, mn, st.compensate))
             analyses.append(
                 AnalysisResult(
@@ -354,6 +497,8 @@ def run(case: Case, options) -> StudyResult:
             continue
         trio, d, alpha, pair = _stage_backlash_mm(st, conf)
         backlash[st.name] = (trio, d, alpha, pair)
+        if pair is not None:
+            stiffness[st.name] = _pair_drive(st, pair).torsional_stiffness()
         lo, mean, mx = _lost(trio, d, alpha, st.name, warnings)
         stages.append(StageLostMotion(st.name, st.ratio, mx, mean, lo, st.compensate))
         if pair is not None:
@@ -419,6 +564,7 @@ def run(case: Case, options) -> StudyResult:
                 "joint_lost_motion_statistical_max [arcmin]": float(
                     rad_to_arcmin(_statistical_joint_max(before, conf))
                 ),
+                **_joint_stiffness_values(stages, stiffness),
             },
             references=["jiang2024"],
             notes=[
@@ -427,6 +573,10 @@ def run(case: Case, options) -> StudyResult:
                 "joint_lost_motion_statistical_max: not in the paper. Stages with a min and a max "
                 "taken as independent normals with σ = (max − min)/(2z) about their mean; stages "
                 "with only a maximum held at it; mean + z·σ at the same confidence.",
+                "joint_torsional_stiffness: not in the paper. The stages' output stiffnesses in "
+                "series, each referred to the joint by the square of the downstream ratios, "
+                "1/K = Σ 1/(K_k Π_(j>k) i_j²); given only when every stage's model has a "
+                "stiffness (stage_torsional_stiffness lists them, null where a model has none).",
             ],
             data={"chain": before},
         )

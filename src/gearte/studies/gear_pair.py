@@ -215,6 +215,12 @@ class SpurPairSpec(_Clearance, _Distributions):
     min_backlash_limit_um: float = Field(
         default=0.0, ge=0, le=10_000, description="Minimum limit normal backlash [µm]."
     )
+    face_width_mm: float | None = Field(
+        default=None,
+        gt=0,
+        le=1000,
+        description="Face width b [mm]; only for the pair's mesh stiffness as a drive (optional).",
+    )
     driving: SpurGearSpec
     driven: SpurGearSpec
 

@@ -1,0 +1,74 @@
+"""Drives in series: the chain's stiffness and transmission error at its last output (the joint).
+
+Stage ``k`` of a chain (motor side first) with reduction ``i_k`` turns ``f_k = 1/Π_(j>k) i_j``
+times as far as the joint (:func:`gearte.models.lost_motion.stage_transfer_factors`, the factor of
+Jiang 2024 eq. 30). The torque on its output is ``f_k T_joint``, its output twists ``f_k T / K_k``
+and the joint ``f_k² T / K_k``, so the stiffnesses add in series as
+
+    1/K_joint = Σ_k f_k² / K_k                                            [N·mm/rad]
+
+and the transmission errors as ``TE_joint(θ) = Σ_k f_k TE_k(θ / f_k)`` (stage ``k``'s output angle
+is ``θ / f_k`` when the joint is at ``θ``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from gearte.drives import Drive
+from gearte.errors import ParameterError
+from gearte.models.lost_motion import stage_transfer_factors
+
+__all__ = ["joint_stiffness", "joint_transmission_error"]
+
+
+def joint_stiffness(stiffness: Sequence[float], ratios: Sequence[float]) -> float:
+    """Torsional stiffness of stages in series at the chain's output [N·mm/rad].
+
+    Parameters
+    ----------
+    stiffness : sequence of float
+        Each stage's stiffness at its own output, motor side first [N·mm/rad] (> 0).
+    ratios : sequence of float
+        Each stage's reduction i = ω_in / ω_out [-] (> 0).
+
+    Returns
+    -------
+    float
+        ``1 / Σ_k f_k² / K_k`` with ``f_k = 1/Π_(j>k) i_j``.
+
+    Examples
+    --------
+    >>> round(joint_stiffness([1.0e6, 1.0e8], [10.0, 100.0]) / 1e6, 3)  # 1/(1e-10 + 1e-8)
+    99.01
+    """
+    k = np.asarray(stiffness, dtype=float)
+    if k.shape != (len(ratios),):
+        raise ParameterError("stiffness", list(stiffness), "needs one value per stage ratio")
+    if not np.all(np.isfinite(k)) or np.any(k <= 0):
+        raise ParameterError("stiffness", k.tolist(), "every stage stiffness must be > 0 N·mm/rad")
+    f = stage_transfer_factors(ratios)
+    return float(1.0 / np.sum(f * f / k))
+
+
+def joint_transmission_error(drives: Sequence[Drive], joint_angle: ArrayLike) -> np.ndarray:
+    """Transmission error of drives in series at the chain's output [rad].
+
+    Parameters
+    ----------
+    drives : sequence of Drive
+        Motor side first; a drive whose model has no TE (``None``) contributes nothing.
+    joint_angle : array_like
+        Output angles of the last drive [rad].
+    """
+    th = np.asarray(joint_angle, dtype=float)
+    f = stage_transfer_factors([d.ratio for d in drives])
+    total = np.zeros_like(th)
+    for d, fk in zip(drives, f, strict=True):
+        te = d.transmission_error(th / fk)
+        if te is not None:
+            total = total + fk * np.asarray(te, dtype=float)
+    return total
