@@ -59,7 +59,9 @@ def _decimate_lines(fig: Any) -> None:
     for ax in fig.axes:
         for line in ax.get_lines():
             x, y = line.get_xdata(orig=True), line.get_ydata(orig=True)
-            if np.ndim(x) != 1 or len(x) != len(y) or len(y) <= MAX_POINTS:
+            if np.ndim(x) != 1 or np.ndim(y) != 1 or len(x) != len(y) or len(y) <= MAX_POINTS:
+                continue
+            if np.asarray(x).dtype.kind not in "biuf" or np.asarray(y).dtype.kind not in "biuf":
                 continue
             keep = decimate(np.asarray(x), np.asarray(y))
             line.set_data(np.asarray(x)[keep], np.asarray(y)[keep])
@@ -88,16 +90,25 @@ def _integer_ticks(fig: Any) -> None:
         other = False
         for line in ax.get_lines():
             x, y = line.get_xdata(), line.get_ydata()
-            if len(x) <= 2 and np.ptp(np.asarray(y, dtype=float)) == 0:
+            if np.size(x) == 0 or np.size(y) == 0:
+                continue  # legend proxies
+            try:
+                xf, yf = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+            except (TypeError, ValueError):  # dates, categories: leave the axis alone
+                other = True
+                break
+            if len(xf) <= 2 and (np.ptp(yf) == 0 or np.ptp(xf) == 0):
                 continue  # reference lines (axhline/axvline)
-            xs.append(np.asarray(x, dtype=float))
-            ys.append(np.asarray(y, dtype=float))
+            xs.append(xf)
+            ys.append(yf)
         for c in ax.containers:
             if isinstance(c, BarContainer):
                 xs.append(np.array([r.get_x() + r.get_width() / 2 for r in c]))
                 ys.append(np.array([r.get_height() for r in c]))
-        other = bool(ax.images) or any(
-            type(c).__name__ not in ("LineCollection",) for c in ax.collections
+        other = (
+            other
+            or bool(ax.images)
+            or any(type(c).__name__ not in ("LineCollection",) for c in ax.collections)
         )
         if other or not (xs or ys):
             continue

@@ -154,6 +154,8 @@ def _analysis_headlines(a: Any) -> list[HeadlineRow]:
     for base, (_, v) in vals.items():
         if base.startswith("meets_") and isinstance(v, bool | np.bool_):
             limit = base[len("meets_") :]
+            if limit in checked:
+                continue  # its value was checked against it above
             spec = ""
             if limit in vals and _finite(vals[limit][1]):
                 spec = _text(vals[limit][1], vals[limit][0])
