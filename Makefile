@@ -40,6 +40,8 @@ demo: $(RUN_STAMP)
 test: $(DEV_STAMP)
 	@echo "==> ruff"
 	$(BIN)/ruff check src tests benchmarks
+	@echo "==> mypy (pydantic plugin; config in pyproject.toml)"
+	$(BIN)/mypy src/gearte
 	@echo "==> pytest"
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q
 
@@ -65,6 +67,9 @@ lock:
 lint: $(DEV_STAMP)
 	$(BIN)/ruff check src tests benchmarks
 	$(BIN)/ruff format --check src tests benchmarks
+
+typecheck: $(DEV_STAMP)
+	$(BIN)/mypy src/gearte
 
 bench: $(DEV_STAMP)
 	for b in benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done

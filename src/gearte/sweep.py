@@ -453,7 +453,7 @@ def run_sweep(
     t0 = time.perf_counter()
     with executor_scope(scheduler, workers) as ex:
         by_points = len(points) >= ex.workers or ex.workers == 1
-        inner = {"progress": False, "seed": seed, "samples": samples}
+        inner: dict[str, Any] = {"progress": False, "seed": seed, "samples": samples}
         if by_points:
             inner |= {"scheduler": None, "workers": 1}
             tasks = [(i, c, kind, kind_module, inner) for i, c in enumerate(cases)]

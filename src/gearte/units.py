@@ -8,8 +8,12 @@ e.g. ``"geometric_te_mean [arcmin]"``.
 
 from __future__ import annotations
 
+from typing import Any, TypeVar
+
 import numpy as np
-from numpy.typing import ArrayLike
+
+Quantity = TypeVar("Quantity", float, np.ndarray)
+"""A scalar [float] or an array of them: each converter returns the kind it was given."""
 
 __all__ = [
     "ARCMIN_PER_RAD",
@@ -51,54 +55,64 @@ NM_PER_RAD_TO_NMM_PER_RAD: float = 1e3
 """Torsional stiffness [N·m/rad] → [N·mm/rad]."""
 
 
-def rad_to_arcmin(x: ArrayLike) -> np.ndarray | float:
+def _scaled(x: Any, factor: float) -> Any:
+    """x × factor, an array for array input and a float for a scalar."""
+    return np.asarray(x, dtype=float) * factor if np.ndim(x) else float(x) * factor
+
+
+def _divided(x: Any, factor: float) -> Any:
+    """x / factor, an array for array input and a float for a scalar."""
+    return np.asarray(x, dtype=float) / factor if np.ndim(x) else float(x) / factor
+
+
+def rad_to_arcmin(x: Quantity) -> Quantity:
     """Angle [rad] → [arcmin]."""
-    return np.asarray(x, dtype=float) * ARCMIN_PER_RAD if np.ndim(x) else float(x) * ARCMIN_PER_RAD
+    return _scaled(x, ARCMIN_PER_RAD)
 
 
-def arcmin_to_rad(x: ArrayLike) -> np.ndarray | float:
+def arcmin_to_rad(x: Quantity) -> Quantity:
     """Angle [arcmin] → [rad]."""
-    return np.asarray(x, dtype=float) / ARCMIN_PER_RAD if np.ndim(x) else float(x) / ARCMIN_PER_RAD
+    return _divided(x, ARCMIN_PER_RAD)
 
 
-def rad_to_arcsec(x: ArrayLike) -> np.ndarray | float:
+def rad_to_arcsec(x: Quantity) -> Quantity:
     """Angle [rad] → [arcsec]."""
-    return np.asarray(x, dtype=float) * ARCSEC_PER_RAD if np.ndim(x) else float(x) * ARCSEC_PER_RAD
+    return _scaled(x, ARCSEC_PER_RAD)
 
 
-def arcsec_to_rad(x: ArrayLike) -> np.ndarray | float:
+def arcsec_to_rad(x: Quantity) -> Quantity:
     """Angle [arcsec] → [rad]."""
-    return np.asarray(x, dtype=float) / ARCSEC_PER_RAD if np.ndim(x) else float(x) / ARCSEC_PER_RAD
+    return _divided(x, ARCSEC_PER_RAD)
 
 
-def rad_to_deg(x: ArrayLike) -> np.ndarray | float:
+def rad_to_deg(x: Quantity) -> Quantity:
     """Angle [rad] → [deg]."""
-    return np.asarray(x, dtype=float) * DEG_PER_RAD if np.ndim(x) else float(x) * DEG_PER_RAD
+    return _scaled(x, DEG_PER_RAD)
 
 
-def deg_to_rad(x: ArrayLike) -> np.ndarray | float:
+def deg_to_rad(x: Quantity) -> Quantity:
     """Angle [deg] → [rad]."""
-    return np.asarray(x, dtype=float) / DEG_PER_RAD if np.ndim(x) else float(x) / DEG_PER_RAD
+    return _divided(x, DEG_PER_RAD)
 
 
-def um_to_mm(x: ArrayLike) -> np.ndarray | float:
+def um_to_mm(x: Quantity) -> Quantity:
     """Length [µm] → [mm]."""
-    return np.asarray(x, dtype=float) * 1e-3 if np.ndim(x) else float(x) * 1e-3
+    return _scaled(x, 1e-3)
 
 
-def mm_to_um(x: ArrayLike) -> np.ndarray | float:
+def mm_to_um(x: Quantity) -> Quantity:
     """Length [mm] → [µm]."""
-    return np.asarray(x, dtype=float) * 1e3 if np.ndim(x) else float(x) * 1e3
+    return _scaled(x, 1e3)
 
 
-def Nm_to_Nmm(x: ArrayLike) -> np.ndarray | float:  # noqa: N802 - unit names
+def Nm_to_Nmm(x: Quantity) -> Quantity:  # noqa: N802 - unit names
     """Torque [N·m] → [N·mm]."""
-    return np.asarray(x, dtype=float) * 1e3 if np.ndim(x) else float(x) * 1e3
+    return _scaled(x, 1e3)
 
 
-def Nmm_to_Nm(x: ArrayLike) -> np.ndarray | float:  # noqa: N802 - unit names
+def Nmm_to_Nm(x: Quantity) -> Quantity:  # noqa: N802 - unit names
     """Torque [N·mm] → [N·m]."""
-    return np.asarray(x, dtype=float) * 1e-3 if np.ndim(x) else float(x) * 1e-3
+    return _scaled(x, 1e-3)
 
 
 def format_dms(angle_rad: float, *, arcsec_decimals: int = 0) -> str:

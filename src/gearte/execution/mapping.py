@@ -20,7 +20,7 @@ _NOTHING: Any = object()
 
 
 def map_chunks(
-    func: Callable[[T], R],
+    func: Callable[..., R],
     tasks: Iterable[T],
     *,
     workers: int | None = None,

@@ -73,7 +73,7 @@ def chunk_sizes(total: int, chunk: int) -> list[int]:
 class Chunk(NamedTuple):
     """One chunk of a sampled study: its position, its sample count and its own random stream."""
 
-    index: int
+    index: int  # type: ignore[assignment]  # the field shadows tuple.index, by design
     size: int
     seed: np.random.SeedSequence
 

@@ -518,7 +518,7 @@ class CycloidStage:
     dr_rp: float = 0.0
     dr_p: float = 0.0
     rotation: float = 0.0
-    z_c: int | None = None
+    z_c: int = None  # type: ignore[assignment]  # z_p - 1 when omitted (__post_init__)
 
     def __post_init__(self) -> None:
         for name in ("r_p", "r_rp", "a", "b", "dr_rp", "dr_p", "rotation"):

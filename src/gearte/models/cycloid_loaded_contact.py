@@ -318,7 +318,7 @@ class LoadedContact:
     pressure_angle: np.ndarray
     mesh_stiffness: np.ndarray
     torsional_stiffness: np.ndarray
-    pins_in_contact: np.ndarray = field(default=None)  # type: ignore[assignment]
+    pins_in_contact: np.ndarray = field(default=None)  # type: ignore[arg-type]  # set in __post_init__
 
 
 def loaded_contact(

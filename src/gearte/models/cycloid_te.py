@@ -311,8 +311,8 @@ def factor_tolerances(
                 out[k] = 0.0
                 continue
             xs = m[k] + np.linspace(-0.5, 0.5, 41) * t[k]
-            v = eccentricity_te(stage, xs)
-            out[k] = float(np.max(v) - np.min(v))
+            te = eccentricity_te(stage, xs)
+            out[k] = float(np.max(te) - np.min(te))
         else:
             out[k] = abs(g[k]) * t[k]
     return out

@@ -250,7 +250,7 @@ def terms_from_table(
     terms = []
     for k, r in enumerate(rows):
         angle = r.get("angle")
-        coeff = int(r.get("angle_coeff", 1 if angle else 0))  # type: ignore[arg-type]
+        coeff = int(r.get("angle_coeff", 1 if angle else 0))  # type: ignore[call-overload]  # row values are checked below
         if angle is not None and coeff not in (-1, 1):
             raise ParameterError(f"terms[{k}].angle_coeff", coeff, "must be +1 or -1")
         gain = float(r.get("gain", 1.0))  # type: ignore[arg-type]

@@ -180,9 +180,9 @@ def compensate(
 
     axes = [np.linspace(*bounds[n], grid) for n in names]
     x = np.array(min(itertools.product(*axes), key=cost), dtype=float)
-    lo = np.array([bounds[n][0] for n in names])
-    hi = np.array([bounds[n][1] for n in names])
-    step = (hi - lo) / (2.0 * max(grid - 1, 1))
+    lower = np.array([bounds[n][0] for n in names])
+    upper = np.array([bounds[n][1] for n in names])
+    step = (upper - lower) / (2.0 * max(grid - 1, 1))
     fx = cost(x)
     # compass (pattern) search: robust to the backlash cliff and to infeasible profiles
     for _ in range(maxiter):
@@ -190,7 +190,7 @@ def compensate(
         for i in range(len(names)):
             for sgn in (1.0, -1.0):
                 y = x.copy()
-                y[i] = np.clip(y[i] + sgn * step[i], lo[i], hi[i])
+                y[i] = np.clip(y[i] + sgn * step[i], lower[i], upper[i])
                 fy = cost(y)
                 if fy < fx - 1e-12:
                     x, fx, improved = y, fy, True

@@ -220,6 +220,7 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     a = reducer.cranks.eccentricity
     Rdc = reducer.cranks.circle_radius
     err = reducer.errors
+    assert err is not None  # RVReducer.__post_init__ fills in zero errors
     ex, ey = np.array([1.0, 0.0]), np.array([0.0, 1.0])
     zero2 = np.zeros((P, 2))
 

@@ -169,9 +169,9 @@ def paper_rule_assembly(
         F = 0j
         for k in fixed:
             t = terms.terms[k]
-            a = t.gain * mags[t.magnitude]
+            amp = t.gain * mags[t.magnitude]
             ph = t.phase + (t.angle_coeff * ang[t.angle] if t.angle is not None else 0.0)
-            F += a * np.exp(1j * ph) if t.frequency > 0 else -a * np.exp(-1j * ph)
+            F += amp * np.exp(1j * ph) if t.frequency > 0 else -amp * np.exp(-1j * ph)
         phasors = {v: _unit_phasor(terms, mags, idx, v) for v, idx in units.items()}
         free = [v for v in phasors if abs(phasors[v][0]) > 0]
         if abs(F) == 0:

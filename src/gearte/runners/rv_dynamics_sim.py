@@ -116,7 +116,7 @@ def simulate_dte(
             names.append(f"{b}.{lab}")
     if method == "rk4" and dt is None:
         dt = default_step(model)
-    if method == "rk4" and record_dt is not None:
+    if method == "rk4" and record_dt is not None and dt is not None:
         record_dt = max(1, round(record_dt / dt)) * dt
     res = integrate(
         system,

@@ -359,7 +359,7 @@ def _source_key(*funcs) -> str:
         py = getattr(f, "py_func", f)
         h.update(py.__module__.encode())
         h.update(py.__qualname__.encode())
-        h.update(Path(inspect.getsourcefile(py)).read_bytes())
+        h.update(Path(inspect.getsourcefile(py) or "").read_bytes())
     return h.hexdigest()[:16]
 
 
@@ -382,6 +382,8 @@ _LIMITS: dict[int, tuple[Any, float]] = {}
 def _cached_limit(system: ODESystem) -> float:
     """RK4 stability limit of a system, computed once per eigenvalue array."""
     ev = system.stability_eigenvalues
+    if ev is None:
+        raise ParameterError("stability_eigenvalues", None, "needed for the RK4 stability limit")
     hit = _LIMITS.get(id(ev))
     if hit is not None and hit[0] is ev:
         return hit[1]
@@ -539,8 +541,7 @@ def integrate(
             raise DivergenceError(f"solve_ivp failed or diverged: {sol.message}")
         out_fn = system.output_python or (lambda t, yy: system.output.py_func(t, yy, a))
         outs = np.array([out_fn(tt, sol.y[:, c]) for c, tt in enumerate(sol.t)])
-        st = np.array([outs.size, outs.min(), outs.max(), outs.sum(), np.sum(outs**2)])
-        stats = st
+        stats = np.array([outs.size, outs.min(), outs.max(), outs.sum(), np.sum(outs**2)])
         y = sol.y[:, -1]
         rec = np.column_stack([outs] + [sol.y[i] for i in idx]) if outs.size else np.zeros((0, 1))
         nrec = outs.size

@@ -120,7 +120,7 @@ def sincos(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return s.reshape(x.shape), c.reshape(x.shape)
 
 
-def grid_points(harmonics: Sequence[int]) -> int:
+def grid_points(harmonics: Sequence[int] | np.ndarray) -> int:
     """Nodes of the dense stage: 8 per period of the highest harmonic (>= 16), so that
     ``n_max h = pi/4`` bounds the rotation angles of the refinement."""
     return max(16, 8 * int(max(harmonics)) if len(harmonics) else 16)

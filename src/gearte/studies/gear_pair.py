@@ -376,7 +376,7 @@ def analyse_pair(
     rss = stack.rss()
 
     def lm(jn: float) -> float:
-        return float(rad_to_arcmin(return_error(jn, d_out, alpha)))
+        return rad_to_arcmin(float(return_error(jn, d_out, alpha)))
 
     um = mm_to_um
     kind = "spur" if isinstance(spec, SpurPairSpec) else "bevel"
@@ -398,8 +398,8 @@ def analyse_pair(
         "lost_motion_mean [arcmin]": lm(summ.mean),
         "lost_motion_min [arcmin]": lm(summ.min),
         "lost_motion_max [arcmin]": lm(summ.max),
-        "lost_motion_mean_dms": format_dms(return_error(summ.mean, d_out, alpha)),
-        "lost_motion_max_dms": format_dms(return_error(summ.max, d_out, alpha)),
+        "lost_motion_mean_dms": format_dms(float(return_error(summ.mean, d_out, alpha))),
+        "lost_motion_max_dms": format_dms(float(return_error(summ.max, d_out, alpha))),
         "backlash_mean_by_source [um]": {
             k: float(um(v)) for k, v in stack.contributor_means().items()
         },

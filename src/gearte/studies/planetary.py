@@ -16,7 +16,7 @@ Monte-Carlo scenario named ``mc_<scenario>`` with ``mc_mean [arcsec]``, ``mc_sd 
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -51,6 +51,16 @@ ANGLE_MEANING = {
     "gamma_p": "planet: pin-position error from its radial line",
     "beta_l": "ring (Wang's l): direction of its manufacturing eccentricity (the datum)",
 }
+
+
+Scenario = Literal[
+    "random_assembly",
+    "random_assembly_half_tolerance",
+    "allocated_assembly_random_magnitudes",
+    "optimal_assembly_random_magnitudes",
+    "random_magnitudes_random_assembly",
+]
+"""The Monte-Carlo scenarios of :mod:`gearte.runners.planetary_mc` (Wang 2013 §3.2)."""
 
 
 class GearSet(StrictModel):
@@ -177,23 +187,7 @@ class MonteCarloOptions(StrictModel):
     samples: int = Field(default=50_000, ge=1, le=100_000_000)
     seed: int = Field(default=2013, ge=0)
     chunk_size: int = Field(default=10_000, ge=100, le=10_000_000)
-    scenarios: list[
-        Literal[
-            "random_assembly",
-            "random_assembly_half_tolerance",
-            "allocated_assembly_random_magnitudes",
-            "optimal_assembly_random_magnitudes",
-            "random_magnitudes_random_assembly",
-        ]
-    ] = Field(
-        default_factory=lambda: [
-            "random_assembly",
-            "random_assembly_half_tolerance",
-            "allocated_assembly_random_magnitudes",
-            "optimal_assembly_random_magnitudes",
-            "random_magnitudes_random_assembly",
-        ]
-    )
+    scenarios: list[Scenario] = Field(default_factory=lambda: list(get_args(Scenario)))
     rayleigh_sigma_fraction: float = Field(
         default=0.5, gt=0, le=10, description="Rayleigh scale / tolerance (0.5: tol = 2 sigma)"
     )

@@ -188,10 +188,9 @@ class LinearStack(_StackBase):
 
     # -- sampling -------------------------------------------------------------------------------
     def evaluate(self, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
-        y = None
+        y: np.ndarray = np.asarray(0.0)
         for c in self.contributors:
-            term = c.sensitivity * np.asarray(inputs[c.name], dtype=float)
-            y = term if y is None else y + term
+            y = y + c.sensitivity * np.asarray(inputs[c.name], dtype=float)
         return self.constant + y
 
     def kernel_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:

@@ -16,6 +16,7 @@ doi:10.3390/machines11060626
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -181,11 +182,11 @@ class RVErrors:
     sun_eccentricity: tuple[float, float] = (0.0, 0.0)
     sun_assembly: tuple[float, float] = (0.0, 0.0)
     output_assembly: tuple[float, float] = (0.0, 0.0)
-    planet_eccentricity: np.ndarray | None = None  # (M, 2)
-    carrier_hole: np.ndarray | None = None  # (M, 2)
-    disc_hole: np.ndarray | None = None  # (M, N, 2)
-    cam: np.ndarray | None = None  # (M, N, 2)
-    pin_composite: np.ndarray | None = None  # (N, 2)
+    planet_eccentricity: np.ndarray = None  # type: ignore[assignment]  # (M, 2); None → zeros
+    carrier_hole: np.ndarray = None  # type: ignore[assignment]  # (M, 2); None → zeros
+    disc_hole: np.ndarray = None  # type: ignore[assignment]  # (M, N, 2); None → zeros
+    cam: np.ndarray = None  # type: ignore[assignment]  # (M, N, 2); None → zeros
+    pin_composite: np.ndarray = None  # type: ignore[assignment]  # (N, 2); None → zeros
     turning_arm_clearance_mm: float = 0.0
     crank_bearing_clearance_mm: float = 0.0
     output_bearing_clearance_mm: float = 0.0
@@ -227,7 +228,7 @@ class RVErrors:
         crank_count: int = 3,
         disc_count: int = 2,
         placement: str = "first",
-        **clearances: float,
+        **clearances: Any,
     ) -> RVErrors:
         """Paper 004 Table 3 with an explicit placement of the per-crank/per-disc errors.
 
