@@ -331,7 +331,7 @@ def relative_change(before: float, after: float) -> str:
     return f" ({'+' if r > 0 else ''}{format_number(r, 2)} %)"
 
 
-def _records_table(key: str, name: str, records: list[dict[str, Any]]) -> Table:
+def _records_table(key: str, name: str, records: Any) -> Table:
     cols: list[str] = []
     for r in records:
         cols += [c for c in map(str, r) if c not in cols]
