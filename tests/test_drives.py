@@ -18,7 +18,7 @@ from gearte.io.case_file import load_case, load_case_dict
 from gearte.studies import RunOptions
 from gearte.studies._drives import drive_from_case
 from gearte.tolerance.stackup import z_for_confidence
-from gearte.units import arcmin_to_rad, rad_to_arcmin, rad_to_arcsec
+from gearte.units import arcmin_to_rad, arcsec_to_rad, rad_to_arcmin, rad_to_arcsec
 
 OPTS = RunOptions(progress=False)
 
@@ -66,6 +66,22 @@ def test_robot_joint_chain_end_to_end(robot_joint):
     series = 1.0 / (1.0 / k["RV reducer"] + 1.0 / (k["spur pair"] * 81.0**2))
     assert ch["joint_torsional_stiffness [N*m/arcmin]"] == pytest.approx(series, rel=1e-12)
     assert robot_joint.warnings == []
+
+
+def test_robot_joint_te_is_the_rv_models_own_geometric_te(robot_joint):
+    """The spur pair has no TE model; the joint TE is the rv_reducer kind's unloaded TE."""
+    data = _toml("han2023_rv110e")
+    data["analyses"] = {
+        "transmission_error": {**data["analyses"]["transmission_error"], "positions": 360}
+    }
+    own = gearte.run_case(load_case_dict(data), OPTS)["transmission_error"].values
+    te = robot_joint["chain_te"].values
+    assert te["stages_with_te"] == ["RV reducer"] and te["stages_without_te"] == ["spur pair"]
+    assert np.allclose(te["joint_te [arcsec]"], own["geometric_te [arcsec]"], rtol=0, atol=1e-9)
+    pp = te["joint_te_peak_to_peak_sampled [arcsec]"]
+    assert te["end_effector_te_peak_to_peak_sampled [mm]"] == pytest.approx(
+        float(arcsec_to_rad(pp)) * 800.0, rel=1e-12
+    )
 
 
 # ------------------------------------------------------------------------------- each adapter
@@ -199,8 +215,8 @@ def test_joint_te_sums_each_drives_te_referred_to_the_joint():
             return None
 
     th = np.linspace(0, 1, 5)
-    te = joint_transmission_error([Sine(), Rigid()], th)
-    assert np.allclose(te, 1e-4 * np.sin(th * 4.0) / 4.0)
+    te = joint_transmission_error([Sine(), Rigid(), None], [4.0, 3.0, 2.0], th)
+    assert np.allclose(te, 1e-4 * np.sin(th * 6.0) / 6.0)  # f_1 = 1/(3*2)
 
 
 # ------------------------------------------------------------------------------- bad input

@@ -22,7 +22,7 @@ from gearte.drives import Drive
 from gearte.errors import ParameterError
 from gearte.models.lost_motion import stage_transfer_factors
 
-__all__ = ["joint_stiffness", "joint_transmission_error"]
+__all__ = ["joint_stiffness", "joint_te_contributions", "joint_transmission_error"]
 
 
 def joint_stiffness(stiffness: Sequence[float], ratios: Sequence[float]) -> float:
@@ -54,21 +54,47 @@ def joint_stiffness(stiffness: Sequence[float], ratios: Sequence[float]) -> floa
     return float(1.0 / np.sum(f * f / k))
 
 
-def joint_transmission_error(drives: Sequence[Drive], joint_angle: ArrayLike) -> np.ndarray:
-    """Transmission error of drives in series at the chain's output [rad].
+def joint_te_contributions(
+    drives: Sequence[Drive | None], ratios: Sequence[float], joint_angle: ArrayLike
+) -> list[np.ndarray | None]:
+    """Each stage's transmission error referred to the chain's output, ``f_k TE_k(θ/f_k)`` [rad].
 
     Parameters
     ----------
-    drives : sequence of Drive
-        Motor side first; a drive whose model has no TE (``None``) contributes nothing.
+    drives : sequence of Drive or None
+        Motor side first; ``None`` for a stage that is not a drive.
+    ratios : sequence of float
+        Each stage's reduction i = ω_in / ω_out [-] (> 0).
     joint_angle : array_like
-        Output angles of the last drive [rad].
+        Output angles of the last stage [rad].
+
+    Returns
+    -------
+    list
+        One array per stage [rad], or ``None`` where the stage has no TE model.
     """
     th = np.asarray(joint_angle, dtype=float)
-    f = stage_transfer_factors([d.ratio for d in drives])
-    total = np.zeros_like(th)
+    if len(drives) != len(ratios):
+        raise ParameterError("drives", len(drives), f"needs one per stage ratio ({len(ratios)})")
+    f = stage_transfer_factors(ratios)
+    out: list[np.ndarray | None] = []
     for d, fk in zip(drives, f, strict=True):
-        te = d.transmission_error(th / fk)
+        te = None if d is None else d.transmission_error(th / fk)
+        out.append(None if te is None else fk * np.asarray(te, dtype=float))
+    return out
+
+
+def joint_transmission_error(
+    drives: Sequence[Drive | None], ratios: Sequence[float], joint_angle: ArrayLike
+) -> np.ndarray:
+    """Transmission error of stages in series at the chain's output [rad].
+
+    ``Σ_k f_k TE_k(θ / f_k)`` over the stages with a TE model (:func:`joint_te_contributions`);
+    the others count as exact. Parameters as there.
+    """
+    th = np.asarray(joint_angle, dtype=float)
+    total = np.zeros_like(th)
+    for te in joint_te_contributions(drives, ratios, th):
         if te is not None:
-            total = total + fk * np.asarray(te, dtype=float)
+            total = total + te
     return total

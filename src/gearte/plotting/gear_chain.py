@@ -3,7 +3,8 @@
 * backlash histogram of the Monte-Carlo samples with the analytic normal overlaid;
 * contribution Pareto of each pair (variance shares, cumulative line);
 * chain diagram with each stage's share of the joint's return error;
-* return error at the joint and end error before/after shim and motor compensation.
+* return error at the joint and end error before/after shim and motor compensation;
+* transmission error at the joint from the drives that model one (``chain_te``).
 
 matplotlib is imported lazily (through :func:`gearte.plotting.new_figure`); nothing calls show().
 """
@@ -17,7 +18,14 @@ import numpy as np
 
 from gearte.plotting import PALETTE, Figure, new_figure
 
-__all__ = ["figures", "backlash_histogram", "contribution_pareto", "chain_diagram", "compensation"]
+__all__ = [
+    "figures",
+    "backlash_histogram",
+    "contribution_pareto",
+    "chain_diagram",
+    "compensation",
+    "joint_te",
+]
 
 
 def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:
@@ -155,6 +163,25 @@ def compensation(result: Any) -> Figure:
     )
 
 
+def joint_te(chain_te: Any) -> Figure:
+    """Transmission error at the joint [arcsec] over one joint turn (``chain_te`` analysis)."""
+    v = chain_te.values
+    fig, ax = new_figure()
+    ax.plot(
+        np.asarray(v["joint_angle [deg]"]), np.asarray(v["joint_te [arcsec]"]), color=PALETTE[0]
+    )
+    ax.set_xlabel("joint angle [deg]")
+    ax.set_ylabel("TE at the joint [arcsec]")
+    ax.set_title("Transmission error at the joint")
+    return Figure(
+        "Transmission error at the joint",
+        f"From the drives with a TE model ({', '.join(v['stages_with_te']) or 'none'}); "
+        f"peak to peak {v['joint_te_peak_to_peak_sampled [arcsec]']:.2f}″ at the sampled "
+        "positions.",
+        fig,
+    )
+
+
 def figures(result: Any) -> list[Figure]:
     """All figures of a gear_pair or gear_chain result."""
     figs: list[Figure] = []
@@ -180,5 +207,9 @@ def figures(result: Any) -> list[Figure]:
         figs.append(f)
         f = compensation(result)
         f.analysis = "compensation" if "compensation" in result else "chain"
+        figs.append(f)
+    if "chain_te" in result:
+        f = joint_te(result["chain_te"])
+        f.analysis = "chain_te"
         figs.append(f)
     return figs

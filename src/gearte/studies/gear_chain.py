@@ -64,6 +64,7 @@ from gearte.units import (
     format_dms,
     mm_to_um,
     rad_to_arcmin,
+    rad_to_arcsec,
     rad_to_deg,
     um_to_mm,
 )
@@ -193,6 +194,13 @@ class ChainSpec(StrictModel):
         gt=0, le=1e6, description="Distance L from the joint axis to the end effector [mm]."
     )
     stages: list[StageSpec] = Field(min_length=1, description="Stages from motor to joint.")
+    te_positions: int | None = Field(
+        default=None,
+        ge=8,
+        le=7200,
+        description="Joint positions over one joint turn for the chain's transmission error "
+        "from the drives that model one (not in Jiang 2024; default: not computed).",
+    )
 
     @model_validator(mode="after")
     def _unique(self):
@@ -427,6 +435,43 @@ def _drive_stage(st: StageSpec, drive, confidence: float):
     return StageLostMotion(st.name, st.ratio, mx, mean, lo, st.compensate), result
 
 
+def _chain_te(case: Case, drives: dict) -> AnalysisResult:
+    """Transmission error at the joint over one joint turn from the stages that model one."""
+    import numpy as np
+
+    from gearte.drives.chain import joint_te_contributions
+
+    n = case.chain.te_positions
+    assert n is not None
+    sts = case.chain.stages
+    th = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    parts = joint_te_contributions([drives.get(s.name) for s in sts], [s.ratio for s in sts], th)
+    te = sum((p for p in parts if p is not None), np.zeros_like(th))
+    with_te = [s.name for s, p in zip(sts, parts, strict=True) if p is not None]
+    without = [s.name for s, p in zip(sts, parts, strict=True) if p is None]
+    pp = float(np.ptp(te))
+    return AnalysisResult(
+        name="chain_te",
+        title="Transmission error at the joint from the drives' own models",
+        values={
+            "joint_te_peak_to_peak_sampled [arcsec]": float(rad_to_arcsec(pp)),
+            "end_effector_te_peak_to_peak_sampled [mm]": pp * case.chain.lever_length_mm,
+            "stages_with_te": with_te,
+            "stages_without_te": without,
+            "joint_angle [deg]": rad_to_deg(th),
+            "joint_te [arcsec]": rad_to_arcsec(te),
+        },
+        references=[],
+        notes=[
+            "Not in Jiang 2024. TE_joint(θ) = Σ_k f_k TE_k(θ/f_k), f_k = 1/Π_(j>k) i_j, each "
+            "stage's unloaded TE from its drive's own model (gearte.drives); stages listed in "
+            "stages_without_te have no TE model and count as exact.",
+            f"Peak-to-peak over {n} equally spaced joint positions (sampled: a mesh ripple "
+            "between the samples is not resolved).",
+        ],
+    )
+
+
 def _nm_per_arcmin(k: float) -> float:
     """Torsional stiffness N·mm/rad → N·m/arcmin."""
     return float(Nmm_to_Nm(k) / rad_to_arcmin(1.0))
@@ -467,11 +512,13 @@ def run(case: Case, options) -> StudyResult:
 
     # -- stages ----------------------------------------------------------------------------------
     stiffness: dict[str, float | None] = {}
+    drives: dict[str, object] = {}
     for st in case.chain.stages:
         slug = _slug(st.name)
         stiffness[st.name] = None
         if st.drive is not None:
             drive = st.drive.build(st.name)
+            drives[st.name] = drive
             stage, result = _drive_stage(st, drive, conf)
             stages.append(stage)
             stiffness[st.name] = drive.torsional_stiffness()
@@ -581,6 +628,9 @@ def run(case: Case, options) -> StudyResult:
             data={"chain": before},
         )
     )
+
+    if case.chain.te_positions is not None:
+        analyses.append(_chain_te(case, drives))
 
     # -- shim (eq. 32) ---------------------------------------------------------------------------
     comp_stages = stages
