@@ -15,7 +15,7 @@ DEV_STAMP := $(VENV)/.installed-dev-$(HASH)
 PIP    := $(BIN)/python -m pip install --disable-pip-version-check -c $(CONSTRAINTS)
 DEMO_CASE ?= hu2020_rv80e_initial
 
-.PHONY: demo test test-slow test-latest lint typecheck bench lock clean
+.PHONY: demo test test-slow test-latest lint typecheck bench lock clean fuzz
 
 $(VENV)/bin/python:
 	@echo "==> creating $(VENV) with $(PYTHON)"
@@ -44,6 +44,11 @@ test: $(DEV_STAMP)
 	$(BIN)/mypy src/gearte
 	@echo "==> pytest"
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q
+
+# The long fuzzing job (issue 13): FUZZ_COUNT mutants of the bundled cases through validation.
+FUZZ_COUNT ?= 10000
+fuzz: $(DEV_STAMP)
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python tests/fuzzing.py --count $(FUZZ_COUNT)
 
 test-slow: $(DEV_STAMP)
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q -m slow

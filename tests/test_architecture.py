@@ -23,6 +23,7 @@ LAYERS: list[tuple[str, ...]] = [
     (
         "gearte._version",
         "gearte.errors",
+        "gearte.limits",
         "gearte.units",
         "gearte.labels",
         "gearte.references",

@@ -268,3 +268,16 @@ def test_sweep_output_is_one_set_with_its_plots(tmp_path):
     assert r.exit_code == 0, r.output
     assert (tmp_path / "s" / "sweep.csv").is_file() and (tmp_path / "s" / MARKER).is_file()
     assert _left_over(tmp_path) == []
+
+
+def test_nonfinite_values_are_written_as_null_with_a_warning():
+    """Issue 13: NaN was written as ``null`` without saying so."""
+    import math
+
+    from gearte.studies import run_case
+
+    result = run_case({"case": {"kind": "foundation_test"}, "demo": {"length_mm": 1.0}})
+    result["demo"].values["ratio"] = math.nan
+    doc = json.loads(result.to_json())
+    assert doc["analyses"]["demo"]["values"]["ratio"] is None
+    assert any("ratio" in w and "null" in w for w in doc["warnings"])

@@ -44,8 +44,11 @@ def case_path(name_or_path: str | os.PathLike[str]) -> Path:
         Naming the bundled cases when neither a file nor a bundled name matches.
     """
     p = Path(name_or_path)
-    if p.is_file():
-        return p
+    try:
+        if p.is_file():
+            return p
+    except (OSError, ValueError) as exc:  # a NUL byte, a name too long: not a path at all
+        raise FileNotFoundError(f"no case file {str(name_or_path)!r}: {exc}") from None
     cases = list_cases()
     key = p.stem if p.suffix == ".toml" else str(name_or_path)
     if key in cases:

@@ -5,7 +5,9 @@ so ``gearte --help`` answers fast.
 
 Exit codes (docs/errors.md): 0 ok · 1 the analysis failed (non-convergence, divergence) · 2 bad
 input · 3 internal error (a bug: please report it, ``--debug`` shows the traceback) · 4 the outputs
-cannot be written (read-only, disk full, file-size limit, a path under a file).
+cannot be written (read-only, disk full, file-size limit, a path under a file) · 130 / 143
+stopped by SIGINT (Ctrl-C) / SIGTERM: previous outputs kept; an interrupted sweep writes the points
+that finished, marked partial.
 """
 
 from __future__ import annotations
@@ -22,6 +24,21 @@ EXIT_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
 EXIT_OUTPUT = 4
+EXIT_SIGINT = 130  # 128 + SIGINT
+EXIT_SIGTERM = 143  # 128 + SIGTERM
+
+
+def _stop_on_sigterm() -> None:
+    """SIGTERM stops like Ctrl-C (an exception, so ``finally`` blocks and pools clean up)."""
+    import signal
+
+    from gearte.errors import Interrupted
+
+    def handler(signum: int, _frame: Any) -> None:
+        raise Interrupted(signum)
+
+    with contextlib.suppress(ValueError):  # not the main thread (embedded use): leave it
+        signal.signal(signal.SIGTERM, handler)
 
 
 def _error(title: str, message: str) -> None:
@@ -47,8 +64,16 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
         SchedulerError,
     )
 
+    _stop_on_sigterm()
     try:
         return fn()
+    except KeyboardInterrupt as exc:
+        import signal
+
+        signum = int(getattr(exc, "signum", signal.SIGINT))
+        name = signal.Signals(signum).name
+        _error("interrupted", f"stopped by {name}; nothing written, previous outputs kept")
+        sys.exit(128 + signum)
     except BrokenPipeError:  # output piped into `head` and closed: not an error of ours
         sys.stderr.close()
         sys.exit(0)
@@ -245,16 +270,32 @@ def sweep(
         c = load_case(case)
         default = os.path.join("out", f"sweep_{safe_label(c.case.name or c.case.kind)}")
         target = check_output_dir(out_dir if out_dir is not None else default)
-        with _executor(scheduler, workers) as executor:
-            result = run_sweep(
-                case,
-                varies,
-                seed=seed,
-                samples=samples,
-                scheduler=executor,
-                workers=workers,
-                progress=not no_progress,
-            )
+        from gearte.errors import Interrupted
+
+        try:
+            with _executor(scheduler, workers) as executor:
+                result = run_sweep(
+                    case,
+                    varies,
+                    seed=seed,
+                    samples=samples,
+                    scheduler=executor,
+                    workers=workers,
+                    progress=not no_progress,
+                )
+        except Interrupted as exc:
+            if exc.partial is not None and exc.partial.points:
+                paths = write_sweep(exc.partial, target, plots=False)
+                import signal
+
+                name = signal.Signals(exc.signum).name
+                _error(
+                    "interrupted",
+                    f"stopped by {name}: {len(exc.partial.points)} finished point(s) written to "
+                    f'{paths["json"].parent} marked partial ("partial": true)',
+                )
+                sys.exit(128 + exc.signum)
+            raise
         paths = write_sweep(result, target, plots=not no_plots)
         failed = [e for e in result.errors if e]
         click.echo(
@@ -287,6 +328,12 @@ def validate(cases: tuple[str, ...]) -> None:
             except CaseFileError as exc:
                 bad += 1
                 click.echo(str(exc), err=True)
+                continue
+            except FileNotFoundError as exc:  # report it and go on with the next file
+                bad += 1
+                click.echo(
+                    f"{c}: 1 error(s)\n  (file): {str(exc).strip(chr(39) + chr(34))}", err=True
+                )
                 continue
             click.echo(f"{c}: ok ({case.case.kind})")
         if bad:

@@ -16,6 +16,7 @@ __all__ = [
     "DivergenceError",
     "SchedulerError",
     "OutputError",
+    "Interrupted",
 ]
 
 
@@ -93,3 +94,18 @@ class OutputError(GearteError):
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (type(self), (self.path, self.reason))
+
+
+class Interrupted(KeyboardInterrupt):
+    """A run was stopped by SIGINT (Ctrl-C) or SIGTERM.
+
+    A ``KeyboardInterrupt``, so code that does not know it stops as on Ctrl-C. ``partial`` holds
+    what finished before the signal where the work is made of independent parts (the points of a
+    sweep), marked partial; the CLI writes it and exits with 128 + the signal number (130 for
+    SIGINT, 143 for SIGTERM).
+    """
+
+    def __init__(self, signum: int, partial: Any = None) -> None:
+        self.signum = signum
+        self.partial = partial
+        super().__init__(f"interrupted by signal {signum}")

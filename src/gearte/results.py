@@ -41,6 +41,21 @@ def to_jsonable(obj: Any) -> Any:
     return str(obj)
 
 
+def _count_nonfinite(obj: Any) -> int:
+    """Number of NaN/inf numbers in a value (scalars, arrays, lists, mappings)."""
+    if isinstance(obj, dict):
+        return sum(_count_nonfinite(v) for v in obj.values())
+    if isinstance(obj, list | tuple):
+        return sum(_count_nonfinite(v) for v in obj)
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.kind in "fc":
+            return int(np.count_nonzero(~np.isfinite(obj)))
+        return sum(_count_nonfinite(v) for v in obj.ravel()) if obj.dtype.kind == "O" else 0
+    if isinstance(obj, float | np.floating | complex | np.complexfloating):
+        return int(not np.isfinite(obj))
+    return 0
+
+
 @dataclass
 class AnalysisResult:
     """One analysis of a study.
@@ -143,11 +158,24 @@ class StudyResult:
                 "input": to_jsonable(self.case.model_dump(mode="json")),
             },
             "references": {k: REFERENCES.get(k, k) for k in self.references},
-            "warnings": list(self.warnings),
+            "warnings": list(self.warnings) + self._nonfinite_warnings(),
             "elapsed [s]": round(self.elapsed_s, 4),
             "timings [s]": {k: round(v, 4) for k, v in self.timings.items()},
             "analyses": {a.name: a.to_dict() for a in self.analyses},
         }
+
+    def _nonfinite_warnings(self) -> list[str]:
+        """Say where non-finite numbers became ``null`` in JSON (never silently)."""
+        out = []
+        for a in self.analyses:
+            names = [k for k, v in a.values.items() if _count_nonfinite(v)]
+            if names:
+                n = sum(_count_nonfinite(a.values[k]) for k in names)
+                shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+                out.append(
+                    f"{a.name}: {n} non-finite value(s) (NaN/inf) written as null in {shown}"
+                )
+        return out
 
     def to_json(self, indent: int | None = 1) -> str:
         return json.dumps(self.to_dict(), indent=indent, ensure_ascii=False, allow_nan=False)

@@ -75,6 +75,9 @@ def _range_values(key: str, spec: str) -> tuple[Any, ...]:
     if not _NUM_RE.match(n_text) or int(n_text) < 1:
         raise ParameterError(f"--vary {key}", spec, f"N = {n_text!r} must be an integer ≥ 1")
     n = int(n_text)
+    from gearte.limits import check_sweep_points
+
+    check_sweep_points(n)
     try:
         a, b = float(start), float(stop)
     except ValueError:
@@ -295,6 +298,8 @@ class SweepResult:
     samples: int | None = None
     elapsed_s: float = 0.0
     point_elapsed_s: list[float] = field(default_factory=list)
+    #: True when the sweep was interrupted: only the points that finished are here.
+    partial: bool = False
     backend: str = ""
 
     @property
@@ -353,6 +358,7 @@ class SweepResult:
                 "source": self.source,
             },
             "vary": {v.key: list(v.values) for v in self.vary},
+            "partial": self.partial,
             "seed": self.seed,
             "samples": self.samples,
             "backend": self.backend,
@@ -434,6 +440,9 @@ def run_sweep(
     if dup:
         raise ParameterError("vary", dup[0], "key given more than once")
 
+    from gearte.limits import check_sweep_points
+
+    check_sweep_points(math.prod(len(v.values) for v in varies))
     base, source, name = _base_case(case)
     points = grid_points(varies)
     cases: list[dict[str, Any]] = []
@@ -446,31 +455,48 @@ def run_sweep(
         validated = load_case_dict(data, source=f"{source} at {where}")
         cases.append(data)
     assert validated is not None
+    from gearte.studies import check_samples_override
+
+    check_samples_override(validated, samples)
     kind = str(validated.case.kind)
     kind_module = get_kind(kind).__name__
     title = str(validated.case.title)
 
     t0 = time.perf_counter()
-    with executor_scope(scheduler, workers) as ex:
-        by_points = len(points) >= ex.workers or ex.workers == 1
-        inner: dict[str, Any] = {"progress": False, "seed": seed, "samples": samples}
-        if by_points:
-            inner |= {"scheduler": None, "workers": 1}
-            tasks = [(i, c, kind, kind_module, inner) for i, c in enumerate(cases)]
-            out = map_chunks(
-                _run_point, tasks, scheduler=ex, progress=progress, description=f"sweep {name}"
-            )
-        else:  # few points: one after another, each spreading its samples over the workers
-            inner |= {"scheduler": ex, "workers": workers}
-            out = [_run_point((i, c, kind, kind_module, inner)) for i, c in enumerate(cases)]
-        backend = ex.name
-    return SweepResult(
+    done: dict[int, dict[str, Any]] = {}
+    interrupted: KeyboardInterrupt | None = None
+    by_points, backend = False, "?"
+    try:
+        with executor_scope(scheduler, workers) as ex:
+            backend = ex.name
+            by_points = len(points) >= ex.workers or ex.workers == 1
+            inner: dict[str, Any] = {"progress": False, "seed": seed, "samples": samples}
+            if by_points:
+                inner |= {"scheduler": None, "workers": 1}
+                tasks = [(i, c, kind, kind_module, inner) for i, c in enumerate(cases)]
+                map_chunks(
+                    _run_point,
+                    tasks,
+                    scheduler=ex,
+                    progress=progress,
+                    description=f"sweep {name}",
+                    on_result=done.__setitem__,
+                )
+            else:  # few points: one after another, each spreading its samples over the workers
+                inner |= {"scheduler": ex, "workers": workers}
+                for i, c in enumerate(cases):
+                    done[i] = _run_point((i, c, kind, kind_module, inner))
+    except KeyboardInterrupt as exc:  # keep what finished, marked partial
+        interrupted = exc
+    order = sorted(done)
+    out = [done[i] for i in order]
+    result = SweepResult(
         name=name,
         kind=kind,
         title=title,
         source=source,
         vary=varies,
-        points=points,
+        points=[points[i] for i in order],
         values=[o["values"] for o in out],
         errors=[o["error"] for o in out],
         warnings=[o["warnings"] for o in out],
@@ -479,7 +505,14 @@ def run_sweep(
         elapsed_s=time.perf_counter() - t0,
         point_elapsed_s=[o["elapsed"] for o in out],
         backend=f"{backend} ({'points' if by_points else 'samples'} in parallel)",
+        partial=interrupted is not None,
     )
+    if interrupted is not None:
+        from gearte.errors import Interrupted
+
+        signum = getattr(interrupted, "signum", 2)
+        raise Interrupted(signum, partial=result) from None
+    return result
 
 
 def _count(items: Sequence[str]) -> dict[str, int]:

@@ -185,6 +185,8 @@ class PoolExecutor(ChunkExecutor):
 
     #: Pool replacements after dead worker processes before giving up with SchedulerError.
     allowed_failures = 3
+    #: Seconds worker processes get to finish at shutdown before they are terminated.
+    shutdown_timeout_s = 10.0
 
     def __init__(self, kind: str = "threads", workers: int | None = None) -> None:
         nw = default_workers() if workers is None else int(workers)
@@ -217,7 +219,7 @@ class PoolExecutor(ChunkExecutor):
                     f"local worker processes died {self.failures} times; a chunk likely runs out "
                     "of memory or crashes the interpreter — try a smaller chunk size"
                 )
-            self._pool.shutdown(wait=False, cancel_futures=True)
+            _shutdown_pool(self._pool, self.shutdown_timeout_s)
             self._pool = self._new_pool()
             self._generation += 1
 
@@ -225,7 +227,28 @@ class PoolExecutor(ChunkExecutor):
         return _PoolBatch(self, (shared,) if has_shared else ())
 
     def close(self) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)
+        _shutdown_pool(self._pool, self.shutdown_timeout_s)
+
+
+def _shutdown_pool(pool: cf.Executor, timeout_s: float) -> None:
+    """Shut a pool down without hanging: queued chunks are cancelled; worker processes get
+    ``timeout_s`` to finish, then are terminated, then killed, and always reaped (no orphans).
+    Threads cannot be killed: a thread pool is waited for (its chunks are finite)."""
+    if not isinstance(pool, cf.ProcessPoolExecutor):
+        pool.shutdown(wait=True, cancel_futures=True)
+        return
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    deadline = time.monotonic() + timeout_s
+    for p in procs:
+        p.join(max(0.0, deadline - time.monotonic()))
+    for p in procs:
+        if p.is_alive():
+            p.terminate()
+            p.join(2.0)
+        if p.is_alive():  # pragma: no cover - SIGTERM ignored
+            p.kill()
+            p.join()
 
 
 def _import_distributed() -> Any:

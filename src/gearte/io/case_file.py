@@ -14,7 +14,33 @@ from typing import Any
 
 from gearte.errors import CaseFileError
 
-__all__ = ["load_case", "load_case_dict", "validate_case", "format_validation_errors"]
+__all__ = [
+    "load_case",
+    "load_case_dict",
+    "validate_case",
+    "format_validation_errors",
+    "MAX_NESTING",
+    "MAX_FILE_BYTES",
+]
+
+#: Deepest nesting of tables/arrays a case file may have (the deepest bundled case has 4).
+MAX_NESTING = 32
+#: Largest case file read [bytes] (the largest bundled case is < 10 kB).
+MAX_FILE_BYTES = 1_000_000
+
+
+def _too_deep(data: Any, limit: int = MAX_NESTING) -> str | None:
+    """Dotted path of the first value nested deeper than ``limit``, or ``None`` (iterative)."""
+    stack: list[tuple[Any, tuple[str, ...]]] = [(data, ())]
+    while stack:
+        value, path = stack.pop()
+        if len(path) > limit:
+            return ".".join(path[:4]) + ".…"
+        if isinstance(value, dict):
+            stack.extend((v, (*path, str(k))) for k, v in value.items())
+        elif isinstance(value, list):
+            stack.extend((v, (*path, str(i))) for i, v in enumerate(value))
+    return None
 
 
 def _short(value: Any, limit: int = 60) -> str:
@@ -22,11 +48,116 @@ def _short(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def format_validation_errors(exc: Any) -> list[tuple[str, str]]:
-    """Turn a pydantic ``ValidationError`` into ``(field, message)`` pairs, one per problem."""
+_UNITS = {
+    "mm": "mm",
+    "um": "µm",
+    "m": "m",
+    "Nm": "N·m",
+    "Nmm": "N·mm",
+    "N": "N",
+    "kN": "kN",
+    "MPa": "MPa",
+    "GPa": "GPa",
+    "deg": "degrees",
+    "rad": "rad",
+    "arcmin": "arcmin",
+    "arcsec": "arcsec",
+    "rpm": "rpm",
+    "s": "s",
+    "Hz": "Hz",
+}
+
+
+def _model_classes(annotation: Any) -> list[Any]:
+    """The pydantic model classes an annotation may hold (through Optional, lists, dicts)."""
+    import typing
+
+    from pydantic import BaseModel
+
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    out: list[Any] = []
+    for arg in typing.get_args(annotation):
+        out += _model_classes(arg)
+    return out
+
+
+def _user_loc(root: Any, loc: tuple[Any, ...]) -> tuple[Any, ...]:
+    """``loc`` as the user wrote it: without the tags pydantic adds for tagged unions
+    (``pair.spur.module_mm`` → ``pair.module_mm``)."""
+    if root is None:
+        return loc
+    models, out = [root], []
+    for i, part in enumerate(loc):
+        if isinstance(part, int):
+            out.append(part)
+            continue
+        nxt: list[Any] = []
+        for m in models:
+            info = m.model_fields.get(part)
+            if info is not None:
+                nxt += _model_classes(info.annotation)
+        if any(part in m.model_fields for m in models):
+            out.append(part)
+            models = nxt or models
+            continue
+        tagged = [m for m in models if part in _tags(m)]
+        if len(models) > 1 and tagged and i + 1 < len(loc):
+            models = tagged  # a union tag: not part of the file's keys
+            continue
+        out.append(part)  # a dict key (a source name, a pair name): keep
+    return tuple(out)
+
+
+def _tags(model: Any) -> set[str]:
+    """Literal values of the model's fields (candidates for a union's discriminator)."""
+    import typing
+
+    tags: set[str] = set()
+    for info in model.model_fields.values():
+        if typing.get_origin(info.annotation) is typing.Literal:
+            tags |= {str(a) for a in typing.get_args(info.annotation)}
+    return tags
+
+
+def _fields_at(root: Any, loc: tuple[Any, ...]) -> set[str]:
+    """Field names of the section at ``loc`` (a pydantic error location) of ``root``."""
+    models = [root]
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        nxt: list[Any] = []
+        for m in models:
+            info = m.model_fields.get(part)
+            if info is not None:
+                nxt += _model_classes(info.annotation)
+        if not nxt:  # a dict key (e.g. a pair name) or a discriminator tag: stay
+            continue
+        models = nxt
+    return {name for m in models for name in m.model_fields}
+
+
+def did_you_mean(key: str, known: set[str]) -> str:
+    """A hint for an unknown key: the field with another unit suffix, or a close spelling."""
+    import difflib
+
+    stem, _, unit = key.rpartition("_")
+    if stem:
+        same_stem = sorted(k for k in known if k.rpartition("_")[0] == stem and k != key)
+        if same_stem:
+            k = same_stem[0]
+            given = _UNITS.get(k.rpartition("_")[2], k.rpartition("_")[2])
+            return f"did you mean {k!r}? (this field is given in {given}, not {unit})"
+    close = difflib.get_close_matches(key, sorted(known), n=1, cutoff=0.6)
+    return f"did you mean {close[0]!r}?" if close else ""
+
+
+def format_validation_errors(exc: Any, root: Any = None) -> list[tuple[str, str]]:
+    """Turn a pydantic ``ValidationError`` into ``(field, message)`` pairs, one per problem;
+    with ``root`` (the ``Case`` class), unknown keys get a "did you mean" hint."""
     out: list[tuple[str, str]] = []
     for err in exc.errors(include_url=False):
-        loc = ".".join(str(p) for p in err.get("loc", ())) or "(case)"
+        loc = ".".join(str(p) for p in _user_loc(root, tuple(err.get("loc", ())))) or "(case)"
         msg = str(err.get("msg", "invalid"))
         for prefix in ("Value error, ", "Assertion failed, "):
             if msg.startswith(prefix):
@@ -36,6 +167,11 @@ def format_validation_errors(exc: Any) -> list[tuple[str, str]]:
             msg = "required field is missing"
         elif kind == "extra_forbidden":
             msg = "unknown key (not allowed here; check spelling and section)"
+            loc_t = _user_loc(root, tuple(err.get("loc", ())))
+            if root is not None and loc_t:
+                hint = did_you_mean(str(loc_t[-1]), _fields_at(root, loc_t[:-1]))
+                if hint:
+                    msg = f"unknown key; {hint}"
         if "input" in err and kind not in ("missing",) and not isinstance(err["input"], dict):
             msg = f"{msg} (got {_short(err['input'])})"
         out.append((loc, msg))
@@ -76,6 +212,11 @@ def load_case_dict(
     if not isinstance(data, dict):
         got = type(data).__name__
         raise CaseFileError(source, [("(case)", f"a case must be a table, got {got}")])
+    deep = _too_deep(data)
+    if deep is not None:
+        raise CaseFileError(
+            source, [(deep, f"nested deeper than {MAX_NESTING} levels (tables or arrays)")]
+        )
     meta = data.get("case")
     if not isinstance(meta, dict):
         raise CaseFileError(
@@ -93,7 +234,7 @@ def load_case_dict(
     try:
         return module.Case.model_validate(data, context={"case_dir": base_dir})
     except ValidationError as exc:
-        raise CaseFileError(source, format_validation_errors(exc)) from None
+        raise CaseFileError(source, format_validation_errors(exc, module.Case)) from None
 
 
 def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
@@ -111,6 +252,10 @@ def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
 
     path = case_path(case)
     try:
+        size = os.stat(path).st_size
+        if size > MAX_FILE_BYTES:
+            reason = f"{size} bytes; a case file is at most {MAX_FILE_BYTES} bytes"
+            raise CaseFileError(str(path), [("(file)", reason)])
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise CaseFileError(str(path), [("(file)", f"cannot read: {exc}")]) from None
@@ -118,6 +263,9 @@ def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise CaseFileError(str(path), [("(file)", f"TOML syntax error: {exc}")]) from None
+    except RecursionError:
+        reason = f"nested deeper than {MAX_NESTING} levels (arrays or inline tables)"
+        raise CaseFileError(str(path), [("(file)", reason)]) from None
     return load_case_dict(
         data, source=str(path), name=Path(path).stem, base_dir=str(Path(path).parent)
     )

@@ -7,22 +7,75 @@ errors, nothing is coerced silently. A kind of case (``gearte.studies.<kind>``) 
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+import types
+import typing
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 __all__ = ["StrictModel", "CaseMeta", "CaseBase"]
 
 
+def _arrays_as_tuples(annotation: Any, value: Any) -> Any:
+    """TOML has arrays, not tuples: turn the lists of ``value`` that ``annotation`` types as
+    tuples into tuples (recursively), touching nothing else. Strict mode then checks the items."""
+    origin = typing.get_origin(annotation)
+    args = typing.get_args(annotation)
+    if origin is typing.Annotated:
+        return _arrays_as_tuples(args[0], value)
+    if origin in (typing.Union, types.UnionType):
+        for arm in args:
+            converted = _arrays_as_tuples(arm, value)
+            if converted is not value:
+                return converted
+        return value
+    if isinstance(value, list):
+        if origin is tuple:
+            if len(args) == 2 and args[1] is Ellipsis:
+                return tuple(_arrays_as_tuples(args[0], v) for v in value)
+            if len(args) == len(value):
+                return tuple(_arrays_as_tuples(a, v) for a, v in zip(args, value, strict=True))
+            return tuple(value)
+        if origin is list and args:
+            new = [_arrays_as_tuples(args[0], v) for v in value]
+            return new if any(n is not v for n, v in zip(new, value, strict=True)) else value
+    if isinstance(value, dict) and origin is dict and len(args) == 2:
+        new_d = {k: _arrays_as_tuples(args[1], v) for k, v in value.items()}
+        return new_d if any(new_d[k] is not value[k] for k in value) else value
+    return value
+
+
 class StrictModel(BaseModel):
-    """Base of every case-file section: unknown keys, NaN/inf and lax coercions are errors."""
+    """Base of every case-file section: unknown keys, NaN/inf and lax coercions are errors.
+
+    Strict mode: ``true`` is not a number, ``"1.3"`` is not a float, ``2.0`` is not an integer;
+    an integer is accepted where a float is expected (``2`` for 2.0 changes no type category).
+    TOML arrays are accepted where a tuple is expected.
+    """
 
     model_config = ConfigDict(
         extra="forbid",
         frozen=True,
         allow_inf_nan=False,
-        strict=False,
+        strict=True,
         validate_default=True,
         str_strip_whitespace=True,
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _toml_arrays_as_tuples(cls, data: Any) -> Any:
+        if not isinstance(data, dict):
+            return data
+        fixed: dict[str, Any] | None = None
+        for name, info in cls.model_fields.items():
+            key = info.alias or name
+            if key in data:
+                new = _arrays_as_tuples(info.annotation, data[key])
+                if new is not data[key]:
+                    fixed = fixed if fixed is not None else dict(data)
+                    fixed[key] = new
+        return fixed if fixed is not None else data
 
 
 class CaseMeta(StrictModel):
@@ -30,7 +83,12 @@ class CaseMeta(StrictModel):
 
     kind: str = Field(description="Study kind, e.g. 'cycloid_stage' (see `gearte cases --kinds`).")
     name: str | None = Field(
-        default=None, description="Case name; defaults to the file name without '.toml'."
+        default=None,
+        max_length=200,
+        pattern=r"^[^\x00-\x1f\x7f]*$",
+        description="Case name, a label (no control characters); defaults to the file name "
+        "without '.toml'. The default output folder is out/<name> with unsafe characters "
+        "replaced.",
     )
     title: str = Field(default="", description="One-line human title.")
     description: str = Field(default="", description="Free text: source, assumptions.")

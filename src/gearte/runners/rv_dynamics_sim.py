@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -36,11 +37,18 @@ __all__ = [
 ]
 
 
+def _dte_python(t: float, y: np.ndarray, n_dof: int, ratio: float) -> float:
+    """Plain twin of :func:`rv_dte` [rad] (module level, so the system pickles)."""
+    return float(y[n_dof - 1] - y[2] / ratio)
+
+
 def ode_system(model: RVDynamicModel, errors: RVErrors | None = None) -> ODESystem:
     """The model as a :class:`gearte.solvers.ode.ODESystem` with DTE [rad] as output.
 
     Compiled right-hand side :func:`~gearte.models.rv_dynamics.rhs.rv_rhs` with its plain twin
     :meth:`RVDynamicModel.rhs_numpy`; ``errors`` [mm, rad] replace the model's errors.
+    Everything in it pickles (no local closures), so it crosses process boundaries
+    (``--scheduler processes``, Dask workers).
     """
     args = model.kernel_args(errors)
     m = model if errors is None else model.with_errors(errors)
@@ -50,7 +58,7 @@ def ode_system(model: RVDynamicModel, errors: RVErrors | None = None) -> ODESyst
         args=args,
         key=RHS_SOURCE_KEY,
         rhs_python=m.rhs_numpy,
-        output_python=lambda t, y: float(y[m.n_dof - 1] - y[2] / m.params.ratio),
+        output_python=partial(_dte_python, n_dof=m.n_dof, ratio=m.params.ratio),
         stability_eigenvalues=model.damped_eigenvalues(mesh="max"),
         work_size=RHS_WORK_SIZE,
     )

@@ -20,7 +20,14 @@ from typing import Any
 
 from gearte.io.kinds import available_kinds, get_kind, register_kind
 
-__all__ = ["RunOptions", "available_kinds", "get_kind", "register_kind", "run_case"]
+__all__ = [
+    "RunOptions",
+    "available_kinds",
+    "get_kind",
+    "register_kind",
+    "run_case",
+    "check_samples_override",
+]
 
 
 @dataclass(frozen=True)
@@ -51,6 +58,42 @@ class RunOptions:
     workers: int | None = None
 
 
+def _sample_caps(model: Any, prefix: str = "") -> list[tuple[str, int]]:
+    """``(dotted field, upper bound)`` of every sample-count field of a validated case."""
+    from pydantic import BaseModel
+
+    caps: list[tuple[str, int]] = []
+    for name, info in type(model).model_fields.items():
+        value = getattr(model, name, None)
+        path = f"{prefix}{name}"
+        if isinstance(value, BaseModel):
+            caps += _sample_caps(value, path + ".")
+        elif "samples" in name and isinstance(value, int) and not isinstance(value, bool):
+            bounds = [getattr(m, "le", None) for m in info.metadata]
+            bounds += [getattr(m, "lt", None) for m in info.metadata]
+            caps += [(path, int(b)) for b in bounds if b is not None]
+    return caps
+
+
+def check_samples_override(case: Any, samples: int | None) -> None:
+    """``--samples`` obeys the cap of every sample count it overrides (checked before work).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``--samples``, the value and the case field whose cap it exceeds.
+    """
+    if samples is None:
+        return
+    from gearte.errors import ParameterError
+
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 0:
+        raise ParameterError("--samples", samples, "must be an integer >= 0 (0: skip)")
+    for path, cap in _sample_caps(case):
+        if samples > cap:
+            raise ParameterError("--samples", samples, f"over the cap of {path} (<= {cap})")
+
+
 def run_case(case: Any, options: RunOptions | None = None) -> Any:
     """Run a case: a validated ``Case``, a path to a TOML file, a bundled name or a dict.
 
@@ -64,6 +107,7 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
         case = load_case(case)
     t_imp = time.perf_counter()
     module = get_kind(case.case.kind)
+    check_samples_override(case, (options or RunOptions()).samples)
     t0 = time.perf_counter()
     with _numba_timer() as numba:
         result = module.run(case, options or RunOptions())

@@ -199,12 +199,29 @@ class _Distributions(StrictModel):
             )
         return self
 
+    @model_validator(mode="after")
+    def _assemblable(self):
+        """Refuse a pair whose mean normal backlash is negative: most pairs of the lot jam."""
+        from gearte.units import mm_to_um
+
+        stack = self.backlash_stack()
+        if stack.mean < 0:
+            lo, hi = (float(mm_to_um(v)) for v in stack.worst_case())
+            raise ValueError(
+                f"the pair cannot be assembled: mean normal backlash "
+                f"{float(mm_to_um(stack.mean)):.1f} µm < 0 (worst case {lo:.1f} to {hi:.1f} µm); "
+                "the tooth-thickness deviations leave no clearance (make them more negative)"
+            )
+        return self
+
 
 class SpurPairSpec(_Clearance, _Distributions):
     """A spur pair and its mounting (Jiang et al. 2024, Tables 1–2)."""
 
     type: Literal["spur"] = "spur"
-    module_mm: float = Field(gt=0, le=100, description="Module m [mm].")
+    module_mm: float = Field(
+        ge=0.05, le=100, description="Module m [mm] (0.05 mm: the finest instrument gears)."
+    )
     pressure_angle_deg: float = Field(default=20.0, gt=0, lt=45, description="Pressure angle α.")
     centre_distance_tol_um: float = Field(
         ge=0, le=10_000, description="Centre-distance limit deviation fa [µm] (±fa)."
@@ -266,7 +283,9 @@ class BevelPairSpec(_Distributions):
     """A straight bevel pair and its mounting (Jiang et al. 2024, Tables 5–6)."""
 
     type: Literal["bevel"] = "bevel"
-    module_mm: float = Field(gt=0, le=100, description="Outer transverse module m [mm].")
+    module_mm: float = Field(
+        ge=0.05, le=100, description="Outer transverse module m [mm] (0.05 mm: the finest gears)."
+    )
     pressure_angle_deg: float = Field(default=20.0, gt=0, lt=45, description="Pressure angle α.")
     face_width_mm: float = Field(gt=0, le=1000, description="Face width B [mm].")
     shaft_angle_deg: float = Field(default=90.0, gt=0, lt=180, description="Shaft angle Σ.")

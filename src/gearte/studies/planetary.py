@@ -15,6 +15,7 @@ Monte-Carlo scenario named ``mc_<scenario>`` with ``mc_mean [arcsec]``, ``mc_sd 
 
 from __future__ import annotations
 
+import os
 from fractions import Fraction
 from typing import Literal, get_args
 
@@ -103,6 +104,12 @@ class GearSet(StrictModel):
         )
 
 
+#: Largest |frequency| of a published term [x input speed].
+MAX_TERM_FREQUENCY = 10_000
+#: Largest denominator of a term frequency 'p/q'.
+MAX_TERM_DENOMINATOR = 10_000
+
+
 class TermRow(StrictModel):
     """One published term ``gain * M sin(q w_in t + phase + angle_coeff * angle)``."""
 
@@ -118,9 +125,17 @@ class TermRow(StrictModel):
     @classmethod
     def _frac(cls, v: float | str) -> float | str:
         try:
-            Fraction(str(v).replace(" ", ""))
+            q = Fraction(str(v).replace(" ", ""))
         except (ValueError, ZeroDivisionError):
             raise ValueError("must be a number or a fraction 'p/q'") from None
+        # Bounds: the evaluation grid grows with the largest harmonic of the common period.
+        if abs(q) > MAX_TERM_FREQUENCY:
+            raise ValueError(f"|frequency| must be <= {MAX_TERM_FREQUENCY} x input speed")
+        if q.denominator > MAX_TERM_DENOMINATOR:
+            raise ValueError(
+                f"is the fraction {q} (denominator {q.denominator}); the denominator must be "
+                f"<= {MAX_TERM_DENOMINATOR}: write the frequency as 'p/q' (e.g. '7/8')"
+            )
         return v
 
 
@@ -209,8 +224,39 @@ class Case(CaseBase):
 
     @model_validator(mode="after")
     def _keys(self) -> Case:
-        build_terms(self)  # unknown/missing keys raise ParameterError (ValueError)
+        terms, _, _ = build_terms(self)  # unknown/missing keys raise ParameterError (ValueError)
+        _check_resources(self, terms)
         return self
+
+
+def _check_resources(case: Case, terms: TermSet) -> None:
+    """Memory and time of the extremes over the common period, estimated before any work.
+
+    The dense stage of :func:`gearte.solvers.trig_extremes.exact_extremes` holds ``2 G + 1`` rows
+    of ``8 n_max`` nodes per worker (``G`` harmonics, ``n_max`` the largest harmonic number of the
+    common period); each evaluation costs about ``8 n_max G`` sine-table products.
+    """
+    from gearte.limits import check_memory, check_time
+    from gearte.solvers.trig_extremes import grid_points
+
+    _, harm, _ = frequency_basis(terms)
+    if not harm:
+        return
+    nodes, g = grid_points(harm), len(harm)
+    cores = os.cpu_count() or 1
+    field = "errors.terms.frequency" if case.errors.source == "terms" else "gearset (teeth)"
+    what = f"the common period's grid ({nodes} nodes, largest harmonic {max(harm)})"
+    check_memory(field, f"largest harmonic {max(harm)}", 8.0 * nodes * (2 * g + 1) * cores, what)
+    a = case.analyses
+    evaluations = 1
+    if a.assembly is not None:
+        evaluations += a.assembly.starts * (1 + a.assembly.polish)
+    if a.monte_carlo is not None:
+        evaluations += a.monte_carlo.samples * len(a.monte_carlo.scenarios)
+    seconds = evaluations * nodes * g * 2e-9 / cores
+    check_time(
+        field, f"largest harmonic {max(harm)}", seconds, f"{evaluations} evaluations of {what}"
+    )
 
 
 # --------------------------------------------------------------------------- building
