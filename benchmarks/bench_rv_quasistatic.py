@@ -19,12 +19,12 @@ from scipy.optimize import fsolve
 
 from gearte.io.case_file import load_case
 from gearte.models.rv_load_sharing import assemble, contact_law, output_positions
-from gearte.solvers.rv_equilibrium import _hu_delta, _linear_parts, solve_positions
+from gearte.solvers.rv_equilibrium import _law_delta, _linear_parts, solve_positions
 from gearte.studies.rv_reducer import build_reducer
 
 
 def baseline(system, torque, law):
-    """fsolve per position, cold start, outer fixed point on the per-disc stiffness."""
+    """fsolve per position, cold start, outer fixed point on the per-disc stiffness (Hu 2020)."""
     P = system.theta.size
     load = torque * system.unit_load[None, :]
     K0s, f0s = _linear_parts(
@@ -32,7 +32,7 @@ def baseline(system, torque, law):
     )  # no clearance
     group = system.contact_group
     ng = int(group.max()) + 1
-    params = law.params()
+    coef = law.coefficients(P, system.contact_gap.shape[1])
     out = np.zeros((P, K0s.shape[1]))
     for p in range(P):
         K0, f0, Bc, gc = K0s[p], f0s[p], system.contact_B[p], system.contact_gap[p]
@@ -54,7 +54,8 @@ def baseline(system, torque, law):
             for g in range(ng):
                 fm = f[group == g].max()
                 if fm > 0:
-                    knew[g] = fm / _hu_delta(fm, params)
+                    a0, a1 = coef[p][group == g][np.argmax(f[group == g])]
+                    knew[g] = fm / _law_delta(fm, a0, a1)
             done = np.max(np.abs(knew / k - 1.0)) < 1e-9
             k = knew
             if done:
@@ -65,9 +66,9 @@ def baseline(system, torque, law):
 
 def main() -> None:
     red = build_reducer(load_case("han2023_rv110e").reducer)
-    law = contact_law(red)
     T = red.rated_torque
     system = assemble(red, output_positions(360))
+    law = contact_law(red, "hu2020").for_system(system)  # the per-disc scheme the baseline codes
     solve_positions(system, T, law)  # compile / load the numba cache outside the timing
 
     t0 = time.perf_counter()

@@ -25,7 +25,7 @@ from gearte.solvers.contact import solve_load_sharing, solve_load_sharing_plain
 TABLE3 = dict(z_p=40, r_p=76.0, r_rp=3.0, a=1.5, b=11.0, dr_rp=-0.022, dr_p=-0.0437)
 TABLE6 = dict(z_p=40, r_p=76.0, r_rp=2.9721, a=1.5, b=11.0, dr_rp=-0.022, dr_p=-0.0266)
 TORQUE = 1011.5e3  # N·mm
-LOAD = dict(disc_share=0.55, E=2.06e5, mu=0.3)
+LOAD = dict(disc_share=0.55, E=2.06e5, mu=0.3, contact_law="hu2020")
 
 TABLE5 = [0.0103, 0.0113, 0.0116, 0.0115, 0.0112, 0.0108, 0.0103, 0.0097, 0.0091]  # pins 3..11
 TABLE8_LOADED = [

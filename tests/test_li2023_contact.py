@@ -113,9 +113,9 @@ def test_modification_clearance_sign():
     phi = np.linspace(0.01, np.pi - 0.01, 500)
     gap = modification_clearance(LI2023_PAIR_MODIFIED, phi)
     assert gap.min() >= -1e-12
-    assert modification_clearance(LI2023_PAIR_MODIFIED, np.arccos(LI2023_PAIR.K1)) == pytest.approx(
-        0.0, abs=1e-15
-    )
+    assert modification_clearance(
+        LI2023_PAIR_MODIFIED, np.arccos(LI2023_PAIR_MODIFIED.K1)
+    ) == pytest.approx(0.0, abs=1e-15)
     with pytest.raises(ParameterError, match="interferes"):
         CycloidPinPair(pin_radius_modification_mm=0.01, pin_position_modification_mm=0.05)
 

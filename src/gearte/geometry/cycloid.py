@@ -35,6 +35,8 @@ from gearte.errors import ParameterError
 
 __all__ = [
     "CycloidStage",
+    "K1_DEFINITIONS",
+    "geometry_radii",
     "short_width_coefficient",
     "meshing_phase",
     "pin_phases",
@@ -79,6 +81,41 @@ def short_width_coefficient(z_p: int, r_p: float, a: float, dr_p: float = 0.0) -
     0.78993
     """
     return a * z_p / (r_p + dr_p)
+
+
+#: Where the papers differ on K1 (and the radii of the curvature formula): ``"ground"`` (Hu 2020
+#: eq 3: K1 = a z_p / (r_p + Δr_p), curvature of the profile as ground with R = r_p + Δr_p and
+#: r = r_rp + Δr_rp — gearte's default, the profile actually made) or ``"nominal"`` (Li 2023
+#: section 2: K1 = a z_p / r_p and the curvature with r_p, r_rp, the modification entering only
+#: through the clearance). They differ by O(Δr_p / r_p): 0.60641 vs 0.60606 for Li's prototype.
+K1_DEFINITIONS = ("ground", "nominal")
+
+
+def geometry_radii(
+    r_p: float, r_rp: float, dr_rp: float, dr_p: float, k1_definition: str = "ground"
+) -> tuple[float, float]:
+    """Pin-circle and pin radii (R, r) [mm] that enter K1, S(φ) and ρ(φ) for a K1 definition.
+
+    Parameters
+    ----------
+    r_p, r_rp : float
+        Nominal pin-centre-circle and pin radius [mm].
+    dr_rp, dr_p : float
+        Equidistant and shifted modifications [mm].
+    k1_definition : {"ground", "nominal"}
+        See :data:`K1_DEFINITIONS`: ``"ground"`` gives (r_p + Δr_p, r_rp + Δr_rp) (Hu 2020 eq 3,
+        40), ``"nominal"`` gives (r_p, r_rp) (Li 2023).
+
+    References
+    ----------
+    Hu et al. (2020) eq 3, doi:10.3390/app10020481; Li et al. (2023) section 2,
+    doi:10.3390/machines11060626.
+    """
+    if k1_definition == "ground":
+        return r_p + dr_p, r_rp + dr_rp
+    if k1_definition == "nominal":
+        return r_p, r_rp
+    raise ParameterError("k1_definition", k1_definition, "must be 'ground' or 'nominal'")
 
 
 def _S(K1: float, phi: ArrayLike) -> np.ndarray:
@@ -227,6 +264,7 @@ def curvature_radius(
     a: float,
     dr_rp: float = 0.0,
     dr_p: float = 0.0,
+    k1_definition: str = "ground",
 ) -> np.ndarray:
     """Curvature radius of the (modified) cycloid profile (Hu et al. 2020, eq 40).
 
@@ -236,6 +274,8 @@ def curvature_radius(
         Meshing phase φ [rad].
     z_p, r_p, r_rp, a, dr_rp, dr_p
         As in :func:`profile_xy` ([-], [mm]).
+    k1_definition : {"ground", "nominal"}
+        Radii used in K1 and eq 40 (:func:`geometry_radii`); default the profile as ground.
 
     Returns
     -------
@@ -251,11 +291,11 @@ def curvature_radius(
     reduces to ``ρ(φ0) = −R (1 − K1²)^½ + r``.
     """
     phi = np.asarray(phi, dtype=float)
-    R = r_p + dr_p
-    r = r_rp + dr_rp
+    R, r = geometry_radii(r_p, r_rp, dr_rp, dr_p, k1_definition)
     K1 = a * z_p / R
     S = _S(K1, phi)
-    return R * S**3 / (K1 * (z_p + 1) * np.cos(phi) - (1.0 + z_p * K1 * K1)) + r
+    with np.errstate(divide="ignore"):
+        return R * S**3 / (K1 * (z_p + 1) * np.cos(phi) - (1.0 + z_p * K1 * K1)) + r
 
 
 def min_convex_curvature_radius(z_p: int, R: float, a: float) -> float:
@@ -292,29 +332,38 @@ def normal_clearance_unclosed(
     dr_rp: float = 0.0,
     dr_p: float = 0.0,
     rotation: float = 0.0,
+    k1_definition: str = "ground",
 ) -> np.ndarray:
     """Normal clearance of each flank before the closing rotation [mm] (first order).
 
     ``Δ_n(φ) = Δr_rp − Δr_p (1 − K1 cos φ)/S + l(φ) δ_rot`` — the normal distance between the
     modified profile and a nominal pin (radius r_rp on radius r_p) at the disc's nominal position,
-    the same on both flanks (the profile is symmetric about φ = 0).
+    the same on both flanks (the profile is symmetric about φ = 0). ``k1_definition`` as in
+    :func:`geometry_radii`.
     """
     phi = np.asarray(phi, dtype=float)
-    K1 = a * z_p / (r_p + dr_p)
+    K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
     S = _S(K1, phi)
     l_abs = np.abs(normal_arm(phi, z_p=z_p, a=a, K1=K1))
     return dr_rp - dr_p * (1.0 - K1 * np.cos(phi)) / S + l_abs * rotation
 
 
 def closing_rotation(
-    *, z_p: int, r_p: float, a: float, dr_rp: float = 0.0, dr_p: float = 0.0, rotation: float = 0.0
+    *,
+    z_p: int,
+    r_p: float,
+    a: float,
+    dr_rp: float = 0.0,
+    dr_p: float = 0.0,
+    rotation: float = 0.0,
+    k1_definition: str = "ground",
 ) -> float:
     """Rotation of the disc [rad] that closes the first contact on the loaded flank.
 
     β0 = Δ_n(φ0) / r_c = (Δr_rp − Δr_p (1 − K1²)^½)/(a z_c) + δ_rot. Negative when the nominal
     modification leaves no backlash (the disc is then preloaded on both flanks).
     """
-    K1 = a * z_p / (r_p + dr_p)
+    K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
     return (dr_rp - dr_p * math.sqrt(1.0 - K1 * K1)) / (a * (z_p - 1)) + rotation
 
 
@@ -331,6 +380,7 @@ def initial_clearance(
     a: float,
     dr_rp: float = 0.0,
     dr_p: float = 0.0,
+    k1_definition: str = "ground",
 ) -> np.ndarray:
     """Initial normal clearance per pin after the closing rotation (Hu et al. 2020, eq 32).
 
@@ -346,6 +396,8 @@ def initial_clearance(
         Eccentricity [mm].
     dr_rp, dr_p : float
         Equidistant Δr_rp and shifted Δr_p modifications [mm].
+    k1_definition : {"ground", "nominal"}
+        K1 of eq 3 (Hu 2020, default) or a z_p / r_p (Li 2023); see :func:`geometry_radii`.
 
     Returns
     -------
@@ -364,7 +416,7 @@ def initial_clearance(
     same to the closing rotation, so it cancels here. Δ(φ0) = 0 at φ0 = arccos K1 (eq 33–34).
     """
     phi = np.asarray(phi, dtype=float)
-    K1 = a * z_p / (r_p + dr_p)
+    K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
     S = _S(K1, phi)
     s = np.sin(phi)
     return (
@@ -494,6 +546,10 @@ class CycloidStage:
         Rotation modification δ_rot [rad] (≥ 0 thins the teeth; see module notes).
     z_c : int or None
         Number of cycloid teeth; ``None`` means z_p − 1. Any other value is rejected.
+    k1_definition : {"ground", "nominal"}
+        Where the papers differ: K1 and the radii of eq 40 from the profile as ground (Hu 2020
+        eq 3, default) or from the nominal pin circle (Li 2023); see :data:`K1_DEFINITIONS`.
+        Every analysis of one stage reads K1, S, ρ and the clearances from this object.
 
     Raises
     ------
@@ -519,8 +575,10 @@ class CycloidStage:
     dr_p: float = 0.0
     rotation: float = 0.0
     z_c: int = None  # type: ignore[assignment]  # z_p - 1 when omitted (__post_init__)
+    k1_definition: str = "ground"
 
     def __post_init__(self) -> None:
+        geometry_radii(0.0, 0.0, 0.0, 0.0, self.k1_definition)  # validates the name
         for name in ("r_p", "r_rp", "a", "b", "dr_rp", "dr_p", "rotation"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
@@ -572,9 +630,7 @@ class CycloidStage:
                 f"smallest convex curvature radius of the pin-centre path, {rho_min:.4g} mm",
             )
         phi = np.linspace(0.0, np.pi, 721)[1:-1]
-        delta = initial_clearance(
-            phi, z_p=self.z_p, r_p=self.r_p, a=self.a, dr_rp=self.dr_rp, dr_p=self.dr_p
-        )
+        delta = self.initial_clearance(phi)
         tol = 1e-9 * max(1.0, abs(self.dr_rp) + abs(self.dr_p))
         if np.min(delta) < -tol:
             k = int(np.argmin(delta))
@@ -600,8 +656,9 @@ class CycloidStage:
 
     @property
     def K1(self) -> float:  # noqa: N802 - paper symbol
-        """Short-width coefficient after shifted modification (eq 3) [-]."""
-        return short_width_coefficient(self.z_p, self.r_p, self.a, self.dr_p)
+        """Short-width coefficient (eq 3, or a z_p / r_p with ``k1_definition="nominal"``) [-]."""
+        R_k1 = geometry_radii(self.r_p, self.r_rp, self.dr_rp, self.dr_p, self.k1_definition)[0]
+        return self.a * self.z_p / R_k1
 
     @property
     def i_h(self) -> float:
@@ -643,7 +700,18 @@ class CycloidStage:
             dr_rp=self.dr_rp,
             dr_p=self.dr_p,
             rotation=self.rotation,
+            k1_definition=self.k1_definition,
         )
+
+    @property
+    def curvature_cap(self) -> float:
+        """Cap on |ρ| in the line-contact logarithm: the tip radius R + a − r [mm].
+
+        The flank curvature radius passes through infinity at the inflection of the profile; the
+        deforming body is no larger than the disc, so |ρ| is bounded by its tip radius there
+        (Li 2023's treatment, gearte's choice for every line-contact analysis).
+        """
+        return self.tip_radius
 
     # bound functions -------------------------------------------------------------------------
     def pin_phases(self, mesh_angle: ArrayLike = 0.0) -> np.ndarray:
@@ -676,7 +744,12 @@ class CycloidStage:
             a=self.a,
             dr_rp=self.dr_rp,
             dr_p=self.dr_p,
+            k1_definition=self.k1_definition,
         )
+
+    def S(self, phi: ArrayLike) -> np.ndarray:  # noqa: N802 - paper symbol
+        """S(φ) = (1 + K1² − 2 K1 cos φ)^½ [-] (eq 4); |pitch point − pin centre| = r_p S."""
+        return _S(self.K1, phi)
 
     def normal_arm(self, phi: ArrayLike) -> np.ndarray:
         """Arm of the contact normal l(φ) [mm] (eq 36)."""
@@ -685,5 +758,24 @@ class CycloidStage:
     def initial_clearance(self, phi: ArrayLike) -> np.ndarray:
         """Initial normal clearance after the closing rotation, eq 32 [mm]."""
         return initial_clearance(
-            phi, z_p=self.z_p, r_p=self.r_p, a=self.a, dr_rp=self.dr_rp, dr_p=self.dr_p
+            phi,
+            z_p=self.z_p,
+            r_p=self.r_p,
+            a=self.a,
+            dr_rp=self.dr_rp,
+            dr_p=self.dr_p,
+            k1_definition=self.k1_definition,
+        )
+
+    def normal_clearance_unclosed(self, phi: ArrayLike) -> np.ndarray:
+        """Normal clearance of each flank before the closing rotation [mm]."""
+        return normal_clearance_unclosed(
+            phi,
+            z_p=self.z_p,
+            r_p=self.r_p,
+            a=self.a,
+            dr_rp=self.dr_rp,
+            dr_p=self.dr_p,
+            rotation=self.rotation,
+            k1_definition=self.k1_definition,
         )

@@ -234,6 +234,9 @@ class Discs:
         ``E`` [MPa] of disc and pins.
     poisson_ratio : float
         ``mu`` [-].
+    contact_law : str
+        Name of the pin-contact law (``gearte.models.contact_law``: ``"line_contact"``, the
+        textbook default, or ``"hu2020"``); every analysis of the reducer uses it.
     """
 
     count: int
@@ -242,6 +245,7 @@ class Discs:
     shift_modification: float = 0.0
     youngs_modulus: float = 2.06e5
     poisson_ratio: float = 0.3
+    contact_law: str = "line_contact"
 
     def __post_init__(self) -> None:
         _check_int("discs.count", self.count, 1, 3)

@@ -36,6 +36,15 @@ from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
 from gearte.geometry.cycloid import CycloidStage
+from gearte.models.contact_law import (
+    DEFAULT_LAW,
+    HU2020_HALF_WIDTH_FACTOR,
+    approach,
+    check_law,
+    force_from_coefficients,
+    log_law_coefficients,
+    max_contact_pressure,
+)
 from gearte.solvers.contact import solve_load_sharing, solve_load_sharing_plain
 
 __all__ = [
@@ -49,19 +58,19 @@ __all__ = [
     "tooth_contact",
 ]
 
-#: The constant of eq 39 as printed.
-HALF_WIDTH_FACTOR = 4.99e-3
+#: The constant of eq 39 as printed (defined in :mod:`gearte.models.contact_law`).
+HALF_WIDTH_FACTOR = HU2020_HALF_WIDTH_FACTOR
 
 
 def compliance_constants(
-    rho: float, r: float, E: float, mu: float, b: float
+    rho: float, r: float, E: float, mu: float, b: float, law: str = "hu2020"
 ) -> tuple[float, float]:
-    """Constants (A [mm/N], B [N]) with δ_max(F) = A F (2/3 + ln(B/F)) (eq 38–39).
+    """Constants (A [mm/N], B [N]) with δ(F) = A F (2/3 + ln(B/F)) for a contact law.
 
     Parameters
     ----------
     rho : float
-        Curvature radius of the disc profile at φ0 [mm] (sign ignored).
+        Curvature radius of the disc profile at the contact [mm] (ρ < 0 convex).
     r : float
         Pin radius [mm].
     E : float
@@ -70,23 +79,31 @@ def compliance_constants(
         Poisson's ratio [-].
     b : float
         Face width of one disc [mm].
+    law : {"hu2020", "line_contact"}
+        The law of :mod:`gearte.models.contact_law` (Hu 2020 eq 38–39 by default, as printed).
+
+    Notes
+    -----
+    Both laws have the form δ = F (a0 − a1 ln F) (:func:`gearte.models.contact_law.
+    log_law_coefficients`); here A = a1 and B = exp(a0/a1 − 2/3), the form the compiled solver
+    of eq 42–44 takes.
     """
     for name, v in (("rho", abs(rho)), ("r", r), ("E", E), ("b", b)):
         if not (math.isfinite(v) and v > 0.0):
             raise ParameterError(name, v, "must be finite and > 0")
     if not (0.0 <= mu < 0.5):
         raise ParameterError("mu", mu, "Poisson's ratio must be in [0, 0.5)")
-    rho = abs(rho)
-    A = 2.0 * (1.0 - mu * mu) / (math.pi * E * b)
-    c2_per_F = HALF_WIDTH_FACTOR**2 * 4.0 * (1.0 - mu * mu) * rho * r / (E * b * (rho + r))
-    B = 16.0 * r * rho / c2_per_F
-    return A, B
+    a0, a1 = log_law_coefficients(law, rho, r, E, mu, b)
+    A = float(a1)
+    return A, float(math.exp(float(a0) / A - 2.0 / 3.0))
 
 
 def half_width(F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float) -> np.ndarray:
     """Contact 'half-width' c of eq 39 as printed [mm].
 
     ``c = 4.99e-3 (4 (1−μ²) F |ρ| r / (E b (|ρ| + r)))^½`` with F [N], ρ, r, b [mm], E [MPa].
+    Not Hertz's half-width (:func:`gearte.models.contact_law.hertz_half_width`); see
+    docs/contact-law.md.
     """
     F = np.asarray(F, dtype=float)
     rho = abs(rho)
@@ -94,7 +111,7 @@ def half_width(F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float
 
 
 def max_normal_deformation(
-    F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float
+    F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float, law: str = "hu2020"
 ) -> np.ndarray:
     """Maximum normal deformation δ_max [mm] under the pin force F [N] (eq 38).
 
@@ -104,21 +121,15 @@ def max_normal_deformation(
         Maximum contact force F_max [N].
     rho, r, E, mu, b
         As in :func:`compliance_constants`.
+    law : {"hu2020", "line_contact"}
+        :func:`gearte.models.contact_law.approach` of this law (Hu 2020 eq 38–39 by default).
 
     Examples
     --------
     >>> round(float(max_normal_deformation(1910.3, -43.598, 2.978, 2.06e5, 0.3, 11.0)), 4)
     0.0116
     """
-    F = np.asarray(F, dtype=float)
-    c = half_width(F, rho, r, E, mu, b)
-    return (
-        2.0
-        * F
-        * (1.0 - mu * mu)
-        / (math.pi * E * b)
-        * (2.0 / 3.0 + np.log(16.0 * r * abs(rho) / c**2))
-    )
+    return approach(F, law, rho, r, E, mu, b)
 
 
 def pin_approach(lr: ArrayLike, delta_max: ArrayLike) -> np.ndarray:
@@ -173,6 +184,12 @@ class ToothContact:
         Torque on the disc [N·mm].
     rho : float
         Curvature radius at φ0 [mm].
+    curvature : ndarray (n, z_p)
+        Signed flank curvature radius where each pin touches (eq 40 at φ_i) [mm].
+    pressure : ndarray (n, z_p)
+        Hertz pressure of each pin with its own curvature [MPa] (0 out of mesh).
+    contact_law : str
+        Name of the contact law (:mod:`gearte.models.contact_law`).
     """
 
     mesh_angle: np.ndarray
@@ -186,6 +203,9 @@ class ToothContact:
     n_eval: np.ndarray
     T_c: float
     rho: float
+    curvature: np.ndarray
+    pressure: np.ndarray
+    contact_law: str
 
     @property
     def pins_in_mesh(self) -> np.ndarray:
@@ -196,6 +216,11 @@ class ToothContact:
     def max_pin_force(self) -> np.ndarray:
         """Largest force carried by a pin at each position [N] (≤ F_max)."""
         return self.force.max(axis=-1)
+
+    @property
+    def max_contact_pressure(self) -> np.ndarray:
+        """Largest Hertz pin pressure at each position [MPa]."""
+        return self.pressure.max(axis=-1)
 
 
 def tooth_contact(
@@ -211,6 +236,7 @@ def tooth_contact(
     max_iter: int = 200,
     implementation: str = "numba",
     clearance_model: str = "eq32",
+    contact_law: str = DEFAULT_LAW,
 ) -> ToothContact:
     """Tooth contact analysis of one disc (Hu et al. 2020, section 4).
 
@@ -241,6 +267,14 @@ def tooth_contact(
         Initial clearances from eq 32 (the paper, first order in the modifications) or from the
         exact envelope construction (:func:`gearte.geometry.cycloid.envelope_clearance`), both
         closed at φ0.
+    contact_law : {"line_contact", "hu2020"}
+        ``"hu2020"``: the paper's scheme as printed — eq 38–39 at ρ(φ0) for F_max and the
+        secant stiffness F_max/δ_max for every pin (eq 41–44). ``"line_contact"`` (default): the
+        textbook law (:mod:`gearte.models.contact_law`) with each pin's own flank curvature ρ(φ_i)
+        (capped at the tip radius in the logarithm), each pin on its own nonlinear law, the disc
+        rotation found from the same compatibility and equilibrium (eq 37, 42;
+        :func:`gearte.models.cycloid_loaded_contact.solve_rotation`). ``F_max`` and ``δ_max`` are
+        then those of a virtual pin at φ0 (l = r_c), as in the paper.
 
     Returns
     -------
@@ -255,6 +289,7 @@ def tooth_contact(
         raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
     if clearance_model not in ("eq32", "envelope"):
         raise ParameterError("clearance_model", clearance_model, "must be 'eq32' or 'envelope'")
+    check_law(contact_law, "contact_law")
     T_c = disc_share * torque
     theta = np.atleast_1d(np.asarray(mesh_angle, dtype=float))
     if not np.all(np.isfinite(theta)):
@@ -271,22 +306,38 @@ def tooth_contact(
 
         clr = np.where(loaded, envelope_clearance(stage, theta), np.inf)
     rho = stage.rho0
-    A, B = compliance_constants(rho, stage.r, E, mu, stage.b)
-    if F_start is None:
-        F_start = start_force(T_c, K1, stage.z_c, stage.r_p)
-    solve = solve_load_sharing if implementation == "numba" else solve_load_sharing_plain
-    F, nev = solve(
-        lr,
-        np.where(loaded, clr, 1e300),
-        T_c=T_c,
-        r_c=stage.r_c,
-        A=A,
-        B=B,
-        F_start=F_start,
-        rtol=rtol,
-        max_iter=max_iter,
-    )
-    dmax = A * F * (2.0 / 3.0 + np.log(B / F))
+    curvature = stage.curvature_radius(phase)
+    if contact_law == "hu2020":
+        A, B = compliance_constants(rho, stage.r, E, mu, stage.b, law="hu2020")
+        if F_start is None:
+            F_start = start_force(T_c, K1, stage.z_c, stage.r_p)
+        solve = solve_load_sharing if implementation == "numba" else solve_load_sharing_plain
+        F, nev = solve(
+            lr,
+            np.where(loaded, clr, 1e300),
+            T_c=T_c,
+            r_c=stage.r_c,
+            A=A,
+            B=B,
+            F_start=F_start,
+            rtol=rtol,
+            max_iter=max_iter,
+        )
+        k_sec = 1.0 / (A * (2.0 / 3.0 + math.log(B) - np.log(F)))  # F_max/δ_max, eq 41 [N/mm]
+        dmax = F / k_sec
+    else:
+        from gearte.models.cycloid_loaded_contact import solve_rotation
+
+        cap = stage.curvature_cap
+        a0, a1 = log_law_coefficients(
+            "line_contact", curvature, stage.r, E, mu, stage.b, rho_cap=cap
+        )
+        arm = np.where(loaded, lr * stage.r_c, 0.0)
+        rot, _ = solve_rotation(arm, np.where(loaded, clr, 0.0), a0, a1, T_c, rtol=max(rtol, 1e-13))
+        dmax = stage.r_c * rot
+        b0, b1 = log_law_coefficients("line_contact", rho, stage.r, E, mu, stage.b, rho_cap=cap)
+        F = force_from_coefficients(dmax, b0, b1)
+        nev = np.zeros(theta.shape, dtype=np.int64)
     if np.max(dmax) > 0.1 * stage.r:
         raise ParameterError(
             "torque",
@@ -294,14 +345,20 @@ def tooth_contact(
             f"gives a normal deformation of {np.max(dmax):.3g} mm, beyond the elastic contact "
             f"model's range (at most 0.1 x pin radius = {0.1 * stage.r:.3g} mm)",
         )
-    approach = lr * dmax[:, None]
-    in_mesh = loaded & (approach > clr)
-    force = np.where(in_mesh, (approach - clr) / dmax[:, None] * F[:, None], 0.0)
+    approach_i = lr * dmax[:, None]
+    in_mesh = loaded & (approach_i > clr)
+    if contact_law == "hu2020":
+        force = np.where(in_mesh, (approach_i - clr) * k_sec[:, None], 0.0)
+    else:
+        force = np.where(
+            in_mesh, force_from_coefficients(np.where(in_mesh, approach_i - clr, 0.0), a0, a1), 0.0
+        )
+    pressure = max_contact_pressure(force, curvature, stage.r, E, mu, stage.b)
     return ToothContact(
         mesh_angle=theta,
         phase=phase,
         clearance=np.where(loaded, clr, np.nan),
-        approach=approach,
+        approach=approach_i,
         force=force,
         in_mesh=in_mesh,
         F_max=F,
@@ -309,4 +366,7 @@ def tooth_contact(
         n_eval=nev,
         T_c=T_c,
         rho=rho,
+        curvature=curvature,
+        pressure=pressure,
+        contact_law=contact_law,
     )

@@ -7,7 +7,9 @@ dynamic model (:mod:`gearte.models.rv_dynamics`). Sweeping the mesh position ove
 (2π/z_p of the meshing phase) gives the time-varying stiffness, fitted by a Fourier series.
 
 This is paper 004's method; the paper-000 contact analysis (Hu et al. 2020) lives in
-``gearte.models.cycloid_contact`` and is kept separate on purpose (different deflection formula).
+``gearte.models.cycloid_contact``. Both read the geometry (K1, S, arms, eq 32 clearance,
+curvature) from one :class:`gearte.geometry.cycloid.CycloidStage` and the pin law from
+:mod:`gearte.models.contact_law`.
 
 Units: mm, N, N·mm, MPa, rad. Stiffnesses are returned in N/mm (``*1e3`` → N/m at the edge).
 
@@ -26,6 +28,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gearte.errors import ConvergenceError, ParameterError
+from gearte.geometry.cycloid import CycloidStage
+from gearte.models.contact_law import (
+    DEFAULT_LAW,
+    check_law,
+    force_from_coefficients,
+    log_law_coefficients,
+)
 
 __all__ = [
     "CycloidPinPair",
@@ -37,6 +46,7 @@ __all__ = [
     "hertz_line_deflection",
     "hertz_line_force",
     "loaded_contact",
+    "solve_rotation",
     "mesh_period_contact",
     "fourier_fit",
     "fourier_eval",
@@ -47,7 +57,11 @@ __all__ = [
 
 @dataclass(frozen=True)
 class CycloidPinPair:
-    """Cycloid–pin pair of one disc (paper 004, Table 1).
+    """Cycloid–pin pair of one disc (paper 004, Table 1) with its material.
+
+    The geometry (K1, S, arms, eq 32 clearance, curvature) is that of the
+    :class:`gearte.geometry.cycloid.CycloidStage` built from these fields (:attr:`stage`), the
+    contact law that of :mod:`gearte.models.contact_law` — one implementation of each.
 
     Parameters
     ----------
@@ -71,7 +85,13 @@ class CycloidPinPair:
         Upper bound of |ρ_c| in the Hertz logarithm [mm]. The profile's curvature radius passes
         through infinity at its inflection (≈ 50.8° for Table 1), next to the most loaded pins;
         the log term of eq 2 would then send the pin stiffness to zero. ``None`` caps at the
-        disc's tip radius r_p + e − r_rp, the largest dimension of the body that deforms.
+        disc's tip radius (:attr:`gearte.geometry.cycloid.CycloidStage.curvature_cap`).
+    k1_definition : {"ground", "nominal"}
+        K1 = e z_p / (r_p + Δr_p) as for every other analysis of the stage (default) or Li's
+        e z_p / r_p (:data:`gearte.geometry.cycloid.K1_DEFINITIONS`).
+    contact_law : {"line_contact", "hu2020"}
+        The pin contact law (:mod:`gearte.models.contact_law`); eq 2 of the paper is the
+        textbook line contact.
     """
 
     pin_count: int = 40
@@ -84,6 +104,8 @@ class CycloidPinPair:
     pin_radius_modification_mm: float = 0.0
     pin_position_modification_mm: float = 0.0
     curvature_cap_mm: float | None = None
+    k1_definition: str = "ground"
+    contact_law: str = DEFAULT_LAW
 
     def __post_init__(self) -> None:
         if self.pin_count < 3:
@@ -100,23 +122,42 @@ class CycloidPinPair:
                 raise ParameterError(name, v, "must be finite and > 0")
         if not 0.0 <= self.poisson_ratio < 0.5:
             raise ParameterError("poisson_ratio", self.poisson_ratio, "must be in [0, 0.5)")
-        if not self.K1 < 1.0:
+        if self.curvature_cap_mm is not None and not self.curvature_cap_mm > 0:
+            raise ParameterError("curvature_cap_mm", self.curvature_cap_mm, "must be > 0")
+        check_law(self.contact_law, "contact_law")
+        k1 = self.eccentricity_mm * self.pin_count / self.pin_circle_radius_mm
+        if not k1 < 1.0:
             raise ParameterError(
                 "eccentricity_mm",
                 self.eccentricity_mm,
-                f"short-width coefficient K1 = e z_p / r_p = {self.K1:.4f} must be < 1",
+                f"short-width coefficient K1 = e z_p / r_p = {k1:.4f} must be < 1",
             )
-        if self.curvature_cap_mm is not None and not self.curvature_cap_mm > 0:
-            raise ParameterError("curvature_cap_mm", self.curvature_cap_mm, "must be > 0")
-        phi = np.linspace(1e-4, np.pi - 1e-4, 2001)
-        gap = modification_clearance(self, phi)
-        if np.min(gap) < -1e-12:
+        try:
+            stage = CycloidStage(
+                z_p=self.pin_count,
+                r_p=self.pin_circle_radius_mm,
+                r_rp=self.pin_radius_mm,
+                a=self.eccentricity_mm,
+                b=self.face_width_mm,
+                dr_rp=self.pin_radius_modification_mm,
+                dr_p=self.pin_position_modification_mm,
+                k1_definition=self.k1_definition,
+            )
+        except ParameterError as exc:
+            if exc.field != "dr_rp/dr_p":
+                raise
             raise ParameterError(
                 "pin_radius_modification_mm/pin_position_modification_mm",
                 (self.pin_radius_modification_mm, self.pin_position_modification_mm),
-                f"the modification interferes (clearance {np.min(gap):.4g} mm < 0 on the loaded "
-                "flank); use Δr_rp ≤ 0 with Δr_p ≤ Δr_rp·(…) as in paper 004 (−0.01, −0.05)",
-            )
+                f"the modification interferes ({exc.reason}); use Δr_rp ≤ 0 with "
+                "Δr_p ≤ Δr_rp·(…) as in paper 004 (−0.01, −0.05)",
+            ) from None
+        object.__setattr__(self, "_stage", stage)
+
+    @property
+    def stage(self) -> CycloidStage:
+        """The pair's cycloid stage (geometry shared with every other analysis)."""
+        return self._stage  # type: ignore[attr-defined]
 
     @property
     def tooth_count(self) -> int:
@@ -125,13 +166,13 @@ class CycloidPinPair:
 
     @property
     def K1(self) -> float:  # noqa: N802 - paper symbol
-        """Short-width coefficient K1 = e z_p / r_p [-]."""
-        return self.eccentricity_mm * self.pin_count / self.pin_circle_radius_mm
+        """Short-width coefficient of the stage (:attr:`CycloidStage.K1`) [-]."""
+        return self.stage.K1
 
     @property
     def pitch_radius_mm(self) -> float:
         """r_c = e z_c, pitch radius of the disc [mm] (paper 004 after eq 5)."""
-        return self.eccentricity_mm * self.tooth_count
+        return self.stage.r_c
 
     @property
     def mesh_pitch_rad(self) -> float:
@@ -143,7 +184,7 @@ class CycloidPinPair:
         """Cap on |ρ_c| used in the Hertz logarithm [mm]."""
         if self.curvature_cap_mm is not None:
             return float(self.curvature_cap_mm)
-        return self.pin_circle_radius_mm + self.eccentricity_mm - self.pin_radius_mm
+        return self.stage.curvature_cap
 
     @property
     def modified(self) -> bool:
@@ -169,85 +210,61 @@ def pin_geometry(pair: CycloidPinPair, phi: ArrayLike) -> tuple[np.ndarray, np.n
 
     Notes
     -----
-    Every contact normal passes through the pitch point P at distance r_c = e z_c from the disc
-    centre; |P − pin centre| = r_p S. Hence l = r_c sin φ / S ≤ r_c, with equality at
-    φ0 = arccos K1.
+    :meth:`CycloidStage.normal_arm` and :meth:`CycloidStage.S` (Hu 2020 eq 36, 4). Every contact
+    normal passes through the pitch point P at distance r_c = e z_c from the disc centre;
+    |P − pin centre| = r_p S, hence l = r_c sin φ / S ≤ r_c, with equality at φ0 = arccos K1.
     """
-    phi = np.asarray(phi, dtype=float)
-    k1 = pair.K1
-    S = np.sqrt(1.0 + k1 * k1 - 2.0 * k1 * np.cos(phi))
-    return pair.pitch_radius_mm * np.sin(phi) / S, S
+    return pair.stage.normal_arm(phi), pair.stage.S(phi)
 
 
 def modification_clearance(pair: CycloidPinPair, phi: ArrayLike) -> np.ndarray:
     """Initial normal clearance of each pin from the profile modification [mm].
 
-    Δ(φ) = Δr_rp (1 − sin φ / S) − Δr_p (1 − K1 cos φ − sqrt(1 − K1²) sin φ) / S,
-    zero at φ0 = arccos K1 (after the rigid rotation that closes the first contact); the same
-    expression as Hu et al. (2020) eq 32, which paper 004 uses through its ref. [31].
+    Hu et al. (2020) eq 32 (:meth:`CycloidStage.initial_clearance`), which paper 004 uses through
+    its ref. [31]; zero at φ0 = arccos K1.
     """
-    phi = np.asarray(phi, dtype=float)
-    k1 = pair.K1
-    S = np.sqrt(1.0 + k1 * k1 - 2.0 * k1 * np.cos(phi))
-    drr = pair.pin_radius_modification_mm
-    drp = pair.pin_position_modification_mm
-    return (
-        drr * (1.0 - np.sin(phi) / S)
-        - drp * (1.0 - k1 * np.cos(phi) - np.sqrt(1.0 - k1 * k1) * np.sin(phi)) / S
-    )
+    return pair.stage.initial_clearance(phi)
 
 
 def profile_curvature_radius(pair: CycloidPinPair, phi: ArrayLike) -> np.ndarray:
     """Signed curvature radius of the cycloid profile at the contact with pin φ [mm].
 
-    ρ(φ) = r_p S³ / (K1 (z_p + 1) cos φ − (1 + z_p K1²)) + r_rp  (Hu et al. 2020 eq 40);
-    ρ > 0: concave flank (root side), ρ < 0: convex (tip side); |ρ| → ∞ at the inflection.
+    Hu et al. 2020 eq 40 (:meth:`CycloidStage.curvature_radius`); ρ > 0: concave flank (root
+    side), ρ < 0: convex (tip side); |ρ| → ∞ at the inflection.
     """
-    phi = np.asarray(phi, dtype=float)
-    k1, zp = pair.K1, pair.pin_count
-    S = np.sqrt(1.0 + k1 * k1 - 2.0 * k1 * np.cos(phi))
-    den = k1 * (zp + 1) * np.cos(phi) - (1.0 + zp * k1 * k1)
-    with np.errstate(divide="ignore"):
-        rho = pair.pin_circle_radius_mm * S**3 / den + pair.pin_radius_mm
-    return rho
+    return pair.stage.curvature_radius(phi)
 
 
-def _hertz_coefficients(pair: CycloidPinPair, rho_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """a0, a1 of δ(F) = F (a0 − a1 ln F) for a pin–tooth pair (eq 2), see hertz_line_deflection."""
-    B = pair.face_width_mm
-    c = (1.0 - pair.poisson_ratio**2) / pair.youngs_modulus_MPa  # per body [1/MPa]
-    e_star = 1.0 / (2.0 * c)
-    r_r = pair.pin_radius_mm
-    # relative curvature: convex pin against a concave (ρ>0) or convex (ρ<0) flank
-    curv = 1.0 / r_r - np.where(np.isfinite(rho_c), 1.0 / rho_c, 0.0)
-    r_star = 1.0 / curv
-    rho_abs = np.minimum(np.abs(rho_c), pair.rho_cap_mm)
-    # b = sqrt(q F) with q = 4 R* / (π B E*)  →  ln(4ρ/b) = ln(4ρ) − ½ ln q − ½ ln F
-    lnq = np.log(4.0 * r_star / (np.pi * B * e_star))
-    pref = 2.0 / (np.pi * B)
-    a0 = pref * c * (np.log(4.0 * rho_abs) + np.log(4.0 * r_r) - lnq - 1.0)
-    a1 = pref * c  # two bodies × ½ ln F
-    return a0, np.broadcast_to(a1, np.shape(a0))
+def _law_coefficients(pair: CycloidPinPair, rho_c: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    return log_law_coefficients(
+        pair.contact_law,
+        rho_c,
+        pair.stage.r,
+        pair.youngs_modulus_MPa,
+        pair.poisson_ratio,
+        pair.face_width_mm,
+        rho_cap=pair.rho_cap_mm,
+    )
 
 
 def hertz_line_deflection(pair: CycloidPinPair, force_N: ArrayLike, rho_c: ArrayLike) -> np.ndarray:
     """Normal deflection of a pin–tooth pair under load F (paper 004 eq 2) [mm].
 
     δ = (2F / (π B)) Σ_{k=c,r} (1 − ν_k²)/E_k · (ln(4 ρ_k / b) − 1/2),
-    b = sqrt(4 F R* / (π B E*)),  1/R* = 1/r_rp − 1/ρ_c,  1/E* = Σ (1 − ν_k²)/E_k,
+    b = sqrt(4 F R* / (π B E*)),  1/R* = 1/r − 1/ρ_c,  1/E* = Σ (1 − ν_k²)/E_k,
 
-    with ρ_r = r_rp for the pin and ρ_c = min(|ρ_c|, cap) for the disc. The pin stiffness of eq 2
-    is k_n = F / δ. ``force_N`` must be > 0.
+    with ρ_r = r for the pin and ρ_c = min(|ρ_c|, cap) for the disc: the ``"line_contact"`` law of
+    :mod:`gearte.models.contact_law` (or the pair's other law). ``force_N`` must be > 0.
 
     Notes
     -----
     Eq 2 prints ``ln 4ρ/b − 1/2``; b is read as the *half* width of the Hertz strip (the
     classical line-contact approach of a cylinder, Johnson 1985 §5.6), since the full width would
     only shift the log by ln 2. The relative radius uses the sign of ρ_c (concave root flank vs
-    convex tip flank).
+    convex tip flank). The pin radius is that of the ground profile, r_rp + Δr_rp.
     """
     f = np.asarray(force_N, dtype=float)
-    a0, a1 = _hertz_coefficients(pair, np.asarray(rho_c, dtype=float))
+    a0, a1 = _law_coefficients(pair, rho_c)
     return f * (a0 - a1 * np.log(f))
 
 
@@ -256,36 +273,10 @@ def hertz_line_force(
 ) -> np.ndarray:
     """Inverse of :func:`hertz_line_deflection`: pin force F [N] for a deflection δ [mm].
 
-    δ(F) = F (a0 − a1 ln F) is increasing for b < 4ρ/e (any realistic load), so a safeguarded
-    Newton iteration from the linear estimate converges in a few steps. δ ≤ 0 gives F = 0.
+    :func:`gearte.models.contact_law.force_from_coefficients`; δ ≤ 0 gives F = 0.
     """
-    d = np.asarray(deflection_mm, dtype=float)
-    a0, a1 = _hertz_coefficients(pair, np.asarray(rho_c, dtype=float))
-    d, a0, a1 = np.broadcast_arrays(d, a0, a1)
-    out = np.zeros(d.shape)
-    pos = d > 0
-    if not np.any(pos):
-        return out
-    dd, b0, b1 = d[pos], a0[pos], a1[pos]
-    f = dd / b0
-    for _ in range(6):  # fixed point on the slowly varying log (contracting: a1/(a0-a1 ln F) ≪ 1)
-        f = dd / (b0 - b1 * np.log(f))
-    for _ in range(50):
-        r = f * (b0 - b1 * np.log(f)) - dd
-        dr = b0 - b1 * np.log(f) - b1
-        step = r / dr
-        f_new = np.where(f - step > 0, f - step, 0.5 * f)
-        if np.all(np.abs(f_new - f) <= rtol * f_new):
-            f = f_new
-            break
-        f = f_new
-    else:
-        raise ConvergenceError(
-            f"hertz_line_force: Newton did not converge in 50 iterations (max residual "
-            f"{np.max(np.abs(r)):.3g} mm, tolerance {rtol:g} relative)"
-        )
-    out[pos] = f
-    return out
+    a0, a1 = _law_coefficients(pair, rho_c)
+    return force_from_coefficients(deflection_mm, a0, a1, rtol=rtol)
 
 
 @dataclass(frozen=True)
@@ -319,6 +310,93 @@ class LoadedContact:
     mesh_stiffness: np.ndarray
     torsional_stiffness: np.ndarray
     pins_in_contact: np.ndarray = field(default=None)  # type: ignore[arg-type]  # set in __post_init__
+
+
+def solve_rotation(
+    arm: np.ndarray,
+    clearance: np.ndarray,
+    a0: np.ndarray,
+    a1: np.ndarray,
+    torque_Nmm: float,
+    *,
+    rtol: float = 1e-11,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Disc rotation and pin forces that carry ``torque_Nmm`` (compatibility + equilibrium).
+
+    Pin i is compressed by ``δ_i = l_i Δφ − c_i`` (compatibility, Li 2023 eq 3 / Hu 2020 eq 37),
+    carries ``F_i = F(δ_i)`` of the law ``δ = F (a0_i − a1_i ln F)`` with its own coefficients
+    (its own flank curvature), and ``T = Σ F_i l_i`` (eq 4 / eq 42). T(Δφ) is increasing, so
+    Δφ is bracketed by doubling and found by bisection, vectorised over positions.
+
+    Parameters
+    ----------
+    arm : ndarray (n, z)
+        Arm l_i of each pin's contact normal [mm]; 0 for pins that cannot carry load.
+    clearance : ndarray (n, z)
+        Normal clearance c_i at Δφ = 0 [mm] (finite).
+    a0, a1 : ndarray (n, z)
+        Contact-law coefficients (:func:`gearte.models.contact_law.log_law_coefficients`) [mm/N].
+    torque_Nmm : float
+        Torque on the disc [N·mm], > 0.
+    rtol : float
+        Relative tolerance on Δφ [-].
+
+    Returns
+    -------
+    rotation : ndarray (n,)
+        Δφ [rad]; force : ndarray (n, z) [N].
+
+    Raises
+    ------
+    ParameterError
+        A pin would be loaded beyond the range of the law (δ(F) no longer increasing).
+
+    References
+    ----------
+    Li et al. (2023) eq 3–4, doi:10.3390/machines11060626; Hu et al. (2020) eq 37–44,
+    doi:10.3390/app10020481.
+    """
+    n = arm.shape[0]
+
+    def torque_at(rot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        delta = np.where(arm > 0.0, rot[:, None] * arm - clearance, 0.0)
+        f = force_from_coefficients(delta, a0, a1)
+        return np.sum(f * arm, axis=1), f
+
+    lo = np.zeros(n)
+    hi = np.full(n, 1e-6)
+    for _ in range(200):
+        t_hi, _ = torque_at(hi)
+        short = t_hi < torque_Nmm
+        if not np.any(short):
+            break
+        lo = np.where(short, hi, lo)
+        hi = np.where(short, hi * 2.0, hi)
+    else:  # pragma: no cover - only for absurd loads
+        raise ConvergenceError("solve_rotation: could not bracket the elastic rotation")
+    for it in range(200):  # noqa: B007 - reported on failure
+        mid = 0.5 * (lo + hi)
+        t_mid, _ = torque_at(mid)
+        above = t_mid > torque_Nmm
+        hi = np.where(above, mid, hi)
+        lo = np.where(above, lo, mid)
+        if np.all(hi - lo <= rtol * hi):
+            break
+    else:  # pragma: no cover
+        raise ConvergenceError(
+            f"solve_rotation: bisection stopped after {it + 1} iterations "
+            f"(bracket {np.max((hi - lo) / hi):.3g} relative, tolerance {rtol:g})"
+        )
+    rot = 0.5 * (lo + hi)
+    force = torque_at(rot)[1]
+    if not np.all(np.isfinite(force)):
+        raise ParameterError(
+            "torque",
+            torque_Nmm,
+            "[N·mm] loads a pin beyond the range of the elastic contact law (its approach δ(F) "
+            "stops increasing); the stage is far too small for this torque",
+        )
+    return rot, force
 
 
 def loaded_contact(
@@ -375,42 +453,10 @@ def loaded_contact(
     ang = np.where(loaded, gap / np.where(loaded, arm, 1.0), np.inf)
     backlash = np.where(loaded, ang - np.min(ang, axis=1, keepdims=True), 0.0)
     rho = profile_curvature_radius(pair, phi)
-
-    def torque_at(rot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        delta = np.where(loaded, (rot[:, None] - backlash) * arm, 0.0)
-        f = hertz_line_force(pair, delta, rho)
-        return np.sum(f * np.where(loaded, arm, 0.0), axis=1), f
-
-    # bracket: grow the rotation until the torque exceeds T
-    n = p.size
-    lo = np.zeros(n)
-    hi = np.full(n, 1e-6)
-    for _ in range(200):
-        t_hi, _ = torque_at(hi)
-        short = t_hi < torque_Nmm
-        if not np.any(short):
-            break
-        lo = np.where(short, hi, lo)
-        hi = np.where(short, hi * 2.0, hi)
-    else:  # pragma: no cover - only for absurd loads
-        raise ConvergenceError("loaded_contact: could not bracket the elastic rotation")
-    for it in range(200):  # noqa: B007 - reported on failure
-        mid = 0.5 * (lo + hi)
-        t_mid, _ = torque_at(mid)
-        above = t_mid > torque_Nmm
-        hi = np.where(above, mid, hi)
-        lo = np.where(above, lo, mid)
-        if np.all(hi - lo <= rtol * hi):
-            break
-    else:  # pragma: no cover
-        raise ConvergenceError(
-            f"loaded_contact: bisection stopped after {it + 1} iterations "
-            f"(bracket {np.max((hi - lo) / hi):.3g} relative, tolerance {rtol:g})"
-        )
-    rot = 0.5 * (lo + hi)
-    _, force = torque_at(rot)
-    rc = pair.pitch_radius_mm
+    a0, a1 = _law_coefficients(pair, rho)
     la = np.where(loaded, arm, 0.0)
+    rot, force = solve_rotation(la, backlash * la, a0, a1, torque_Nmm, rtol=rtol)
+    rc = pair.pitch_radius_mm
     f_t = np.sum(force * la, axis=1) / rc
     f_r = np.sum(force * np.sqrt(np.clip(1.0 - (la / rc) ** 2, 0.0, None)), axis=1)
     f_r_signed = np.sum(force * (pair.K1 - np.cos(phi)) / S, axis=1)

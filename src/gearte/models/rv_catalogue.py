@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer
-from gearte.models.rv_load_sharing import assemble, contact_law
+from gearte.models.rv_load_sharing import PinContactLaw, assemble, contact_law, solver_law
 from gearte.solvers.rv_equilibrium import ContactLaw, solve_positions
 
 __all__ = [
@@ -88,7 +88,7 @@ class TorsionTest:
 
 def _follow(reducer, theta, torques, law):
     system = assemble(reducer, np.full(torques.size, float(theta)))
-    sol = solve_positions(system, torques, law)
+    sol = solve_positions(system, torques, solver_law(reducer, system, law))
     # the torque resists the drive: the output turns against it; report angle along the torque
     return -sol.q[:, system.layout.output_rotation]
 
@@ -99,7 +99,7 @@ def torsion_test(
     *,
     theta: float = 0.0,
     steps_per_segment: int = 20,
-    law: ContactLaw | None = None,
+    law: PinContactLaw | ContactLaw | None = None,
 ) -> TorsionTest:
     """Hysteresis curve: output torsion angle along a torque sweep (fractions of rated torque)."""
     frac = torque_path(turning_points, steps_per_segment)
@@ -117,7 +117,9 @@ def torsion_test(
     )
 
 
-def backlash(reducer: RVReducer, *, theta: ArrayLike = 0.0, law: ContactLaw | None = None) -> float:
+def backlash(
+    reducer: RVReducer, *, theta: ArrayLike = 0.0, law: PinContactLaw | ContactLaw | None = None
+) -> float:
     """Backlash θ(0⁺) − θ(0⁻) [rad]; the smallest over the output angles ``theta`` [rad].
 
     0 (to the elastic deflection at ±1e-4 T_r) when the reducer is preloaded.
@@ -127,8 +129,9 @@ def backlash(reducer: RVReducer, *, theta: ArrayLike = 0.0, law: ContactLaw | No
     eps = 1e-4 * reducer.rated_torque
     system = assemble(reducer, th)
     out = system.layout.output_rotation
-    pos = -solve_positions(system, eps, law).q[:, out]
-    neg = -solve_positions(system, -eps, law).q[:, out]
+    slaw = solver_law(reducer, system, law)
+    pos = -solve_positions(system, eps, slaw).q[:, out]
+    neg = -solve_positions(system, -eps, slaw).q[:, out]
     return float(np.min(pos - neg))
 
 
@@ -150,7 +153,7 @@ def catalogue_values(
     turning_points: ArrayLike = (0.0, 1.0, 0.0, -1.0, 0.0, 1.0),
     steps_per_segment: int = 20,
     lost_motion_fraction: float = 0.03,
-    law: ContactLaw | None = None,
+    law: PinContactLaw | ContactLaw | None = None,
 ) -> CatalogueValues:
     """Torsional rigidity, lost motion, backlash and hysteresis loss from a virtual test.
 

@@ -48,7 +48,18 @@ from numpy.typing import ArrayLike
 from gearte.errors import ParameterError
 from gearte.geometry.cycloid import CycloidStage, normal_clearance_unclosed
 from gearte.geometry.rv import RVReducer
-from gearte.solvers.rv_equilibrium import CLEARANCE_RESIDUAL, ContactLaw, solve_positions
+from gearte.models.contact_law import (
+    DEFAULT_LAW,
+    check_law,
+    log_law_coefficients,
+    max_contact_pressure,
+)
+from gearte.solvers.rv_equilibrium import (
+    CLEARANCE_RESIDUAL,
+    ContactLaw,
+    as_solver_law,
+    solve_positions,
+)
 
 __all__ = [
     "DofLayout",
@@ -56,6 +67,8 @@ __all__ = [
     "dof_layout",
     "cycloid_stage",
     "contact_law",
+    "PinContactLaw",
+    "solver_law",
     "assemble",
     "LoadSharing",
     "load_sharing",
@@ -86,23 +99,95 @@ def cycloid_stage(reducer: RVReducer) -> CycloidStage:
     )
 
 
-def contact_law(reducer: RVReducer, kind: str = "hu2020", stiffness: float = 2.0e5) -> ContactLaw:
-    """Pin-contact law of the reducer: Hu 2020 eq 38–40 with ρ(φ0) and the grinding pin radius.
+@dataclass(frozen=True)
+class PinContactLaw:
+    """The pin-contact law of a reducer, by name, with the stage it acts on.
 
-    The same constants as :func:`gearte.models.cycloid_contact.compliance_constants` use in the
-    cycloid-stage contact analysis (``stage.rho0``, ``stage.r``), so both analyses share one law.
+    Attributes
+    ----------
+    name : {"line_contact", "hu2020", "linear"}
+        ``"line_contact"``: the textbook law (:mod:`gearte.models.contact_law`) with each contact's
+        own flank curvature, secant stiffness per contact. ``"hu2020"``: Hu 2020 eq 38–39 as
+        printed with ρ(φ0) for every pin, one secant stiffness per disc (the paper's scheme).
+        ``"linear"``: constant ``stiffness``.
+    stage : CycloidStage
+        The reducer's cycloid stage (K1, ρ(φ), pin radius r_rp + Δr_rp).
+    youngs_modulus, poisson_ratio, face_width : float
+        E [MPa], ν [-], b [mm] of the discs and pins.
+    stiffness : float
+        Start value (or the constant of ``"linear"``) [N/mm].
     """
-    st = cycloid_stage(reducer)
+
+    name: str
+    stage: CycloidStage
+    youngs_modulus: float
+    poisson_ratio: float
+    face_width: float
+    stiffness: float = 2.0e5
+
+    def flank_curvature(self, phase: ArrayLike) -> np.ndarray:
+        """Signed flank curvature radius [mm] where each pin touches, at meshing phase ``phase``."""
+        return self.stage.curvature_radius(phase)
+
+    def coefficients(self, phase: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """(a0, a1) of ``δ = F (a0 − a1 ln F)`` per contact at meshing phase ``phase`` [mm/N]."""
+        phase = np.asarray(phase, dtype=float)
+        rho = (
+            np.full(phase.shape, self.stage.rho0)
+            if self.name == "hu2020"
+            else self.flank_curvature(phase)
+        )
+        return log_law_coefficients(
+            self.name,
+            rho,
+            self.stage.r,
+            self.youngs_modulus,
+            self.poisson_ratio,
+            self.face_width,
+            rho_cap=None if self.name == "hu2020" else self.stage.curvature_cap,
+        )
+
+    def for_system(self, system: RVSystem) -> ContactLaw:
+        """The solver's :class:`~gearte.solvers.rv_equilibrium.ContactLaw` for ``system``."""
+        if self.name == "linear":
+            return ContactLaw(kind="linear", stiffness=self.stiffness, name="linear")
+        a0, a1 = self.coefficients(contact_phase(system))
+        kind = "secant_per_disc" if self.name == "hu2020" else "secant_per_contact"
+        return ContactLaw(kind=kind, stiffness=self.stiffness, a0=a0, a1=a1, name=self.name)
+
+
+def contact_law(
+    reducer: RVReducer, law: str | None = None, stiffness: float = 2.0e5
+) -> PinContactLaw:
+    """Pin-contact law of the reducer by name (``"line_contact"``, ``"hu2020"`` or ``"linear"``).
+
+    ``None`` takes the reducer's own law (``reducer.discs.contact_law``, default the textbook
+    ``"line_contact"``).
+
+    The constants (ρ from :meth:`CycloidStage.curvature_radius`, pin radius ``stage.r``, E, ν,
+    b) are those the cycloid-stage contact analysis uses, so both analyses share one law.
+    """
+    if law is None:
+        law = getattr(reducer.discs, "contact_law", DEFAULT_LAW)
+        check_law(law, "discs.contact_law")
+    elif law != "linear":
+        check_law(law, "contact_law")
     d = reducer.discs
-    return ContactLaw(
-        kind=kind,
-        stiffness=stiffness,
-        rho=abs(st.rho0),
-        pin_radius=st.r,
+    return PinContactLaw(
+        name=law,
+        stage=cycloid_stage(reducer),
         youngs_modulus=d.youngs_modulus,
         poisson_ratio=d.poisson_ratio,
         face_width=d.face_width,
+        stiffness=stiffness,
     )
+
+
+def solver_law(
+    reducer: RVReducer, system: RVSystem, law: PinContactLaw | ContactLaw | None
+) -> ContactLaw:
+    """The solver law for ``system``: ``law`` as given, or built from a :class:`PinContactLaw`."""
+    return as_solver_law(contact_law(reducer) if law is None else law, system)
 
 
 # ------------------------------------------------------------------------------------------
@@ -156,6 +241,8 @@ class RVSystem:
     consecutive; 0 = linear spring).
     contact_B : (P, nc, nd) rows; contact_gap : (P, nc) clearances [mm];
     contact_group : (nc,) disc index of each contact; contact_pin : (nc,) pin index.
+    contact_phase : (P, nc) meshing phase φ of each contact [rad] (where its flank curvature is
+    read).
     unit_load : (nd,) generalised force of a unit output torque [1/mm per N·mm].
     labels : dict of slices into the spring rows (``"cam"``, ``"carrier_bearing"``, ``"mesh"``...).
     """
@@ -172,6 +259,16 @@ class RVSystem:
     labels: dict
     layout: DofLayout
     spring_c: np.ndarray | None = None
+    contact_phase: np.ndarray | None = None
+
+
+def contact_phase(system: RVSystem) -> np.ndarray:
+    """Meshing phase of every contact of ``system`` [rad], shape (P, nc)."""
+    if system.contact_phase is None:
+        raise ParameterError(
+            "system.contact_phase", None, "needed for the flank curvature; build it with assemble()"
+        )
+    return system.contact_phase
 
 
 def _u(a: np.ndarray) -> np.ndarray:
@@ -327,6 +424,7 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     ] * _u(alpha_k + np.pi / 2)
     cB = np.zeros((P, N * zp, nd))
     cg = np.zeros((P, N * zp))
+    cphase = np.zeros((P, N * zp))
     group = np.repeat(np.arange(N), zp)
     pin_index = np.tile(np.arange(zp), N)
     for j in range(N):
@@ -353,6 +451,7 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
         )
         gap = gap - pins.radius_errors[None, :] + np.sum(n * pin_err[None], axis=-1)
         cg[:, sl] = gap
+        cphase[:, sl] = phi
 
     unit = np.zeros(nd)
     unit[lay.output_rotation] = -1.0  # load torque resists the drive
@@ -369,6 +468,7 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
         labels,
         lay,
         np.asarray(cs),
+        cphase,
     )
 
 
@@ -394,6 +494,9 @@ class LoadSharing:
         (negative = output lags).
     contact_stiffness : (P, N) secant pin stiffness per disc [N/mm].
     q : (P, nd) all displacements [mm, rad].
+    contact_pressure : (P, N, z_p) Hertz pressure of every pin with its own flank curvature [MPa].
+    contact_law : str
+        Name of the pin-contact law used.
     """
 
     theta: np.ndarray
@@ -407,14 +510,23 @@ class LoadSharing:
     output_error: np.ndarray
     contact_stiffness: np.ndarray
     q: np.ndarray
+    contact_pressure: np.ndarray
+    contact_law: str
 
     @property
     def peak_pin_load(self) -> float:
         """Largest pin force over the revolution [N]."""
         return float(self.pin_force.max())
 
+    @property
+    def max_contact_pressure(self) -> float:
+        """Largest Hertz pin pressure over the revolution [MPa]."""
+        return float(np.max(self.contact_pressure))
 
-def _postprocess(reducer: RVReducer, system: RVSystem, sol, torque: float) -> LoadSharing:
+
+def _postprocess(
+    reducer: RVReducer, system: RVSystem, sol, torque: float, law_name: str = ""
+) -> LoadSharing:
     M, N, zp = reducer.cranks.count, reducer.discs.count, reducer.pins.count
     P = system.theta.size
     w = np.einsum("psi,pi->ps", system.spring_B, sol.q) + system.spring_e
@@ -438,6 +550,12 @@ def _postprocess(reducer: RVReducer, system: RVSystem, sol, torque: float) -> Lo
         [system.contact_B[:, j * zp : (j + 1) * zp, lay.disc(j) + 2] for j in range(N)], axis=1
     )  # (P, N, zp)
     disc_torque = -np.sum(pin * arm, axis=-1)
+    stage = cycloid_stage(reducer)
+    d = reducer.discs
+    rho = stage.curvature_radius(contact_phase(system)).reshape(P, N, zp)
+    pressure = max_contact_pressure(
+        pin, rho, stage.r, d.youngs_modulus, d.poisson_ratio, d.face_width
+    )
     return LoadSharing(
         theta=system.theta,
         torque=float(torque),
@@ -450,6 +568,8 @@ def _postprocess(reducer: RVReducer, system: RVSystem, sol, torque: float) -> Lo
         output_error=sol.q[:, lay.output_rotation].copy(),
         contact_stiffness=sol.contact_stiffness,
         q=sol.q,
+        contact_pressure=pressure,
+        contact_law=law_name,
     )
 
 
@@ -465,7 +585,7 @@ def load_sharing(
     torque: float,
     theta: ArrayLike | None = None,
     *,
-    law: ContactLaw | None = None,
+    law: PinContactLaw | ContactLaw | None = None,
     system: RVSystem | None = None,
     compiled: bool = True,
 ) -> LoadSharing:
@@ -478,8 +598,8 @@ def load_sharing(
         Output torque [N·mm]; positive resists the drive direction.
     theta : array_like, optional
         Output angles [rad]; default 360 positions over one revolution.
-    law : ContactLaw, optional
-        Pin-contact law; default :func:`contact_law` (Hu 2020).
+    law : PinContactLaw or ContactLaw, optional
+        Pin-contact law; default :func:`contact_law` (the textbook line contact).
     system : RVSystem, optional
         Pre-assembled rows (re-used across torques).
     compiled : bool
@@ -489,9 +609,9 @@ def load_sharing(
         raise ParameterError("torque", torque, "must be finite [N·mm]")
     if system is None:
         system = assemble(reducer, output_positions(360) if theta is None else theta)
-    law = contact_law(reducer) if law is None else law
-    sol = solve_positions(system, torque, law, compiled=compiled)
-    return _postprocess(reducer, system, sol, torque)
+    slaw = solver_law(reducer, system, law)
+    sol = solve_positions(system, torque, slaw, compiled=compiled)
+    return _postprocess(reducer, system, sol, torque, slaw.name)
 
 
 def mesh_period(reducer: RVReducer) -> float:
@@ -537,7 +657,7 @@ def transmission_error(
     *,
     zero_load_fraction: float = 1e-3,
     mesh_samples: int = 24,
-    law: ContactLaw | None = None,
+    law: PinContactLaw | ContactLaw | None = None,
 ) -> TransmissionError:
     """Total (loaded), geometric (zero-load) and elastic output angle error [rad].
 

@@ -9,11 +9,15 @@ unilateral pin contacts. For a fixed contact stiffness Π is convex and piecewis
 is minimised by an active-set (semismooth) Newton method with a backtracking line search on Π,
 which terminates when the active set repeats — the solution is then exact to round-off.
 
-The contact stiffness is load dependent (Hu et al. 2020 section 4): for each disc
-``k_g = F_max,g / δ(F_max,g)`` with ``δ`` the contact law of
-:func:`gearte.models.cycloid_contact.max_normal_deformation`. This outer fixed point is a
-contraction (the secant stiffness varies with ``ln F``) and is iterated to a relative change
-below ``tol``. Positions are solved in sequence, each warm-started from the previous one.
+The contact stiffness is load dependent: a contact law ``δ(F) = F (a0 − a1 ln F)`` whose
+coefficients ``(a0, a1)`` per position and contact are computed by the caller
+(:func:`gearte.models.contact_law.log_law_coefficients`, the one implementation of every pin law;
+this solver only evaluates that form). Two secant schemes: ``"secant_per_disc"`` — one stiffness
+per disc ``k_g = F_max,g / δ(F_max,g)`` (Hu et al. 2020 section 4, with ρ(φ0)) — and
+``"secant_per_contact"`` — each contact its own ``k_c = F_c / δ_c(F_c)`` with its own
+coefficients (its own flank curvature). This outer fixed point is a contraction (the secant
+stiffness varies with ``ln F``) and is iterated to a relative change below ``tol``. Positions are
+solved in sequence, each warm-started from the previous one.
 
 A compiled kernel (numba) and its plain-Python twin (``_solve_position.py_func``) run the same
 algorithm; :func:`solve_reference` is an independent scipy check.
@@ -32,7 +36,13 @@ from gearte.errors import ConvergenceError, ParameterError
 __all__ = ["ContactLaw", "EquilibriumSolution", "solve_positions", "solve_reference"]
 
 LAW_LINEAR = 0
-LAW_HU2020 = 1
+LAW_SECANT_PER_DISC = 1
+LAW_SECANT_PER_CONTACT = 2
+_SCHEMES = {
+    "linear": LAW_LINEAR,
+    "secant_per_disc": LAW_SECANT_PER_DISC,
+    "secant_per_contact": LAW_SECANT_PER_CONTACT,
+}
 #: Stiffness left inside a bearing clearance, relative to the bearing's stiffness. It keeps the
 #: equilibrium unique when parts float in their clearances (at zero load); its force is below
 #: 1e-6 k c (< 1 N for 10 µm at 1e5 N/mm).
@@ -43,40 +53,44 @@ _TWIN_LOCK = threading.Lock()
 
 @dataclass(frozen=True)
 class ContactLaw:
-    """Pin-contact stiffness law.
+    """Pin-contact stiffness law as the solver sees it.
 
     Attributes
     ----------
     kind : str
-        ``"hu2020"`` (per-disc secant stiffness ``F_max/δ(F_max)``, Hu 2020 eq 33–36) or
-        ``"linear"`` (constant ``stiffness``).
+        ``"linear"`` (constant ``stiffness``), ``"secant_per_disc"`` (per-disc secant stiffness at
+        the disc's largest pin force) or ``"secant_per_contact"`` (each contact its own secant).
     stiffness : float
-        Constant stiffness for ``"linear"`` [N/mm]; starting value for ``"hu2020"``.
-    rho, pin_radius, youngs_modulus, poisson_ratio, face_width : float
-        Parameters of the Hu law: curvature radius at ``φ₀`` [mm], ``r_rp`` [mm], ``E`` [MPa],
-        ``μ`` [-], ``b`` [mm].
+        Constant stiffness for ``"linear"`` [N/mm]; starting value otherwise.
+    a0, a1 : array_like
+        Coefficients of ``δ(F) = F (a0 − a1 ln F)`` [mm/N], broadcastable to (positions,
+        contacts); from :func:`gearte.models.contact_law.log_law_coefficients`.
+    name : str
+        Name of the physical law (echoed in results; ``"linear"`` for a constant stiffness).
     """
 
-    kind: str = "hu2020"
+    kind: str = "secant_per_contact"
     stiffness: float = 2.0e5
-    rho: float = 40.0
-    pin_radius: float = 3.0
-    youngs_modulus: float = 2.06e5
-    poisson_ratio: float = 0.3
-    face_width: float = 10.0
-
-    def params(self) -> np.ndarray:
-        return np.array(
-            [self.rho, self.pin_radius, self.youngs_modulus, self.poisson_ratio, self.face_width]
-        )
+    a0: np.ndarray | float = 0.0
+    a1: np.ndarray | float = 0.0
+    name: str = ""
 
     @property
     def code(self) -> int:
-        if self.kind == "linear":
-            return LAW_LINEAR
-        if self.kind == "hu2020":
-            return LAW_HU2020
-        raise ParameterError("contact_law.kind", self.kind, "must be 'hu2020' or 'linear'")
+        if self.kind not in _SCHEMES:
+            raise ParameterError("contact_law.kind", self.kind, f"must be one of {list(_SCHEMES)}")
+        return _SCHEMES[self.kind]
+
+    def coefficients(self, n_positions: int, n_contacts: int) -> np.ndarray:
+        """``(P, nc, 2)`` array of (a0, a1) per position and contact."""
+        shape = (n_positions, n_contacts)
+        if self.code == LAW_LINEAR:
+            return np.zeros(shape + (2,))
+        a0 = np.broadcast_to(np.asarray(self.a0, dtype=float), shape)
+        a1 = np.broadcast_to(np.asarray(self.a1, dtype=float), shape)
+        if not (np.all(np.isfinite(a0)) and np.all(a1 > 0.0)):
+            raise ParameterError("contact_law.a0/a1", (self.a0, self.a1), "must be finite, a1 > 0")
+        return np.ascontiguousarray(np.stack([a0, a1], axis=-1))
 
 
 @dataclass(frozen=True)
@@ -87,7 +101,9 @@ class EquilibriumSolution:
     ----------
     q : (P, nd) displacements [mm, rad].
     contact_force : (P, nc) [N].
-    contact_stiffness : (P, ngroups) [N/mm].
+    contact_stiffness : (P, ngroups) [N/mm] (per disc; with a per-contact law the stiffest
+        loaded contact's secant).
+    pin_stiffness : (P, nc) secant stiffness of every contact [N/mm].
     iterations : (P,) Newton iterations used (summed over the stiffness fixed point).
     """
 
@@ -95,17 +111,13 @@ class EquilibriumSolution:
     contact_force: np.ndarray
     contact_stiffness: np.ndarray
     iterations: np.ndarray
+    pin_stiffness: np.ndarray | None = None
 
 
 @njit(cache=True, nogil=True)
-def _hu_delta(f, p):
-    rho = abs(p[0])
-    r = p[1]
-    e = p[2]
-    mu2 = 1.0 - p[3] * p[3]
-    b = p[4]
-    c2 = 4.99e-3**2 * (4.0 * mu2 * f * rho * r / (e * b * (rho + r)))
-    return 2.0 * f * mu2 / (np.pi * e * b) * (2.0 / 3.0 + np.log(16.0 * r * rho / c2))
+def _law_delta(f, a0, a1):
+    """Approach δ = F (a0 − a1 ln F) [mm] of the log contact law."""
+    return f * (a0 - a1 * np.log(f))
 
 
 @njit(cache=True, nogil=True)
@@ -214,52 +226,77 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
 
 @njit(cache=True, nogil=True)
 def _solve_position(
-    K0, f0, Bn, en, kn, cn, Bc, gc, group, ngroups, law, params, k0, q0, tol, maxit
+    K0, f0, Bn, en, kn, cn, Bc, gc, group, ngroups, law, coef, k0, kc0, q0, tol, maxit
 ):
-    """One position: Newton inside, fixed point on the per-disc contact stiffness outside."""
+    """One position: Newton inside, fixed point on the contact stiffness outside.
+
+    ``law``: LAW_LINEAR (``k0`` per disc, fixed), LAW_SECANT_PER_DISC (per-disc secant at the
+    disc's largest force, with that contact's coefficients) or LAW_SECANT_PER_CONTACT (``kc``
+    per contact). Returns (q, k per disc, kc per contact, forces, iterations, ok).
+    """
     q = q0.copy()
     k = k0.copy()
     nc = gc.size
     kc = np.empty(nc)
+    for c in range(nc):
+        kc[c] = kc0[c] if law == LAW_SECANT_PER_CONTACT else k[group[c]]
     total = 0
     qtol = 1e-13 * max(1.0, np.max(np.abs(q0)))
     for _outer in range(200):
-        for c in range(nc):
-            kc[c] = k[group[c]]
         q, its, ok = _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, qtol, maxit)
         total += its
         if not ok:
-            return q, k, kc * 0.0, total, False
+            return q, k, kc, kc * 0.0, total, False
         d = Bc @ q - gc
         force = np.zeros(nc)
         for c in range(nc):
             if d[c] > 0.0:
                 force[c] = kc[c] * d[c]
         if law == LAW_LINEAR:
-            return q, k, force, total, True
+            return q, k, kc, force, total, True
         change = 0.0
-        for g in range(ngroups):
-            fmax = 0.0
-            for c in range(nc):
-                if group[c] == g and force[c] > fmax:
-                    fmax = force[c]
-            if fmax > 0.0:
-                knew = fmax / _hu_delta(fmax, params)
-                change = max(change, abs(knew / k[g] - 1.0))
-                k[g] = knew
-        if change < tol:
+        if law == LAW_SECANT_PER_DISC:
+            for g in range(ngroups):
+                fmax = 0.0
+                cm = -1
+                for c in range(nc):
+                    if group[c] == g and force[c] > fmax:
+                        fmax = force[c]
+                        cm = c
+                if fmax > 0.0:
+                    if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
+                        return q, k, kc, kc * 0.0, total, False  # beyond the law's range
+                    knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
+                    change = max(change, abs(knew / k[g] - 1.0))
+                    k[g] = knew
             for c in range(nc):
                 kc[c] = k[group[c]]
+        else:
+            for c in range(nc):
+                if force[c] > 0.0:
+                    if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
+                        return q, k, kc, kc * 0.0, total, False  # beyond the law's range
+                    knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
+                    change = max(change, abs(knew / kc[c] - 1.0))
+                    kc[c] = knew
+            for g in range(ngroups):  # reported per disc: the stiffest loaded contact's secant
+                kg = 0.0
+                for c in range(nc):
+                    if group[c] == g and force[c] > 0.0 and kc[c] > kg:
+                        kg = kc[c]
+                if kg > 0.0:
+                    k[g] = kg
+        if change < tol:
             d = Bc @ q - gc
             for c in range(nc):
                 force[c] = kc[c] * d[c] if d[c] > 0.0 else 0.0
-            return q, k, force, total, True
-    return q, k, kc * 0.0, total, False
+            return q, k, kc, force, total, True
+    return q, k, kc, kc * 0.0, total, False
 
 
 @njit(cache=True, nogil=True)
 def _solve_all(
-    K0s, f0s, Bns, ens, kn, cn, Bcs, gcs, group, ngroups, law, params, k0, q0, tol, maxit
+    K0s, f0s, Bns, ens, kn, cn, Bcs, gcs, group, ngroups, law, coefs, k0, q0, tol, maxit
 ):
     P = K0s.shape[0]
     nd = q0.size
@@ -267,22 +304,42 @@ def _solve_all(
     Q = np.zeros((P, nd))
     F = np.zeros((P, nc))
     Ks = np.zeros((P, ngroups))
+    KC = np.zeros((P, nc))
     its = np.zeros(P, dtype=np.int64)
     q = q0.copy()
     k = k0.copy()
+    kc = np.empty(nc)
+    for c in range(nc):
+        kc[c] = k[group[c]]
     for p in range(P):
-        q, k, f, n, ok = _solve_position(
-            K0s[p], f0s[p], Bns[p], ens[p], kn, cn, Bcs[p], gcs[p], group, ngroups, law, params,
-            k, q, tol, maxit,
+        q, k, kc, f, n, ok = _solve_position(
+            K0s[p], f0s[p], Bns[p], ens[p], kn, cn, Bcs[p], gcs[p], group, ngroups, law,
+            coefs[p], k, kc, q, tol, maxit,
         )  # fmt: skip
         if not ok:
             its[p] = -1
-            return Q, F, Ks, its
+            return Q, F, Ks, KC, its
         Q[p] = q
         F[p] = f
         Ks[p] = k
+        KC[p] = kc
         its[p] = n
-    return Q, F, Ks, its
+    return Q, F, Ks, KC, its
+
+
+def as_solver_law(law, system) -> ContactLaw:
+    """``law`` itself, or the solver law a model-level law builds for ``system``.
+
+    A model-level law (e.g. :class:`gearte.models.rv_load_sharing.PinContactLaw`) provides
+    ``for_system(system) -> ContactLaw`` (the law's coefficients at the system's contacts); the
+    solver does not import the model.
+    """
+    if isinstance(law, ContactLaw):
+        return law
+    build = getattr(law, "for_system", None)
+    if build is None:
+        raise ParameterError("law", law, "must be a ContactLaw or provide for_system(system)")
+    return build(system)
 
 
 def _split_springs(system):
@@ -328,7 +385,7 @@ def solve_positions(
         Spring and contact rows at ``P`` positions.
     torque : float or (P,) array
         Output load torque [N·mm] (positive resists the drive; may change sign along a sweep).
-    law : ContactLaw
+    law : ContactLaw or a model-level law with ``for_system(system)``
     q0, k0 : arrays, optional
         Warm start for the first position (displacements, per-disc contact stiffness).
     tol : float
@@ -342,6 +399,7 @@ def solve_positions(
         If Newton or the stiffness fixed point fails at some position.
     """
     P = system.theta.size
+    law = as_solver_law(law, system)
     torque = np.broadcast_to(np.asarray(torque, dtype=float), (P,))
     load = torque[:, None] * system.unit_load[None, :]
     lin, Bn, en, kn, cn = _split_springs(system)
@@ -352,20 +410,21 @@ def solve_positions(
     nd = K0.shape[1]
     q0 = np.zeros(nd) if q0 is None else np.asarray(q0, dtype=float)
     k0 = np.full(ngroups, law.stiffness) if k0 is None else np.asarray(k0, dtype=float)
+    coefs = law.coefficients(P, system.contact_gap.shape[1])
     fn = _solve_all if compiled else _solve_all.py_func
     if not compiled:
         # the twin calls the plain-Python versions of the inner kernels too (swapped in under a
         # lock for the duration of the call; compiled callers do not look these names up)
         g = _solve_all.py_func.__globals__
         _TWIN_LOCK.acquire()
-        saved = {n: g[n] for n in ("_solve_position", "_newton", "_energy", "_hu_delta")}
+        saved = {n: g[n] for n in ("_solve_position", "_newton", "_energy", "_law_delta")}
         for n in saved:
             g[n] = saved[n].py_func
         try:
             out = fn(
                 K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
                 np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
-                ngroups, law.code, law.params(), k0, q0, tol, maxit,
+                ngroups, law.code, coefs, k0, q0, tol, maxit,
             )  # fmt: skip
         finally:
             g.update(saved)
@@ -374,22 +433,23 @@ def solve_positions(
         out = fn(
             K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
             np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
-            ngroups, law.code, law.params(), k0, q0, tol, maxit,
+            ngroups, law.code, coefs, k0, q0, tol, maxit,
         )  # fmt: skip
-    Q, F, Ks, its = out
+    Q, F, Ks, KC, its = out
     if np.any(its < 0):
         p = int(np.argmax(its < 0))
         raise ConvergenceError(
             f"rv_equilibrium: no equilibrium at position {p} (theta = {system.theta[p]:.6f} rad) "
-            f"within {maxit} Newton iterations / 200 stiffness iterations, tolerance {tol:g}"
+            f"within {maxit} Newton iterations / 200 stiffness iterations, tolerance {tol:g} "
+            "(or a pin force beyond the range of the contact law)"
         )
-    return EquilibriumSolution(Q, F, Ks, its)
+    return EquilibriumSolution(Q, F, Ks, its, KC)
 
 
 def solve_reference(system, torque: float, law: ContactLaw, p: int = 0, k=None, tol: float = 1e-10):
     """Independent check at one position with ``scipy.optimize.root`` on the equilibrium.
 
-    Uses the *given* per-disc contact stiffness ``k`` (fixed), residual
+    Uses the *given* contact stiffness ``k`` (fixed; per disc, or per contact), residual
     ``K0 q − f0 + Σ k max(Bq − g, 0) B + Σ_bearings k (|w| − c)₊ ŵ·B``. Returns ``q``.
 
     The residual is only piecewise smooth (contacts open and close), so MINPACK's ``hybr`` may
@@ -399,6 +459,7 @@ def solve_reference(system, torque: float, law: ContactLaw, p: int = 0, k=None, 
     """
     from scipy.optimize import root
 
+    law = as_solver_law(law, system)
     load = torque * system.unit_load[None, :]
     lin, Bn, en, kn, cn = _split_springs(system)
     K0, f0 = _linear_parts(
@@ -408,8 +469,8 @@ def solve_reference(system, torque: float, law: ContactLaw, p: int = 0, k=None, 
     Bn, en = Bn[p], en[p]
     Bc, gc = system.contact_B[p], system.contact_gap[p]
     ngroups = int(system.contact_group.max()) + 1
-    k = np.full(ngroups, law.stiffness) if k is None else np.asarray(k)
-    kc = k[system.contact_group]
+    k = np.full(ngroups, law.stiffness) if k is None else np.asarray(k, dtype=float)
+    kc = k if k.size == gc.size != ngroups else k[system.contact_group]
     scale = np.max(np.abs(np.diag(K0)))
 
     def res(q):

@@ -181,7 +181,7 @@ def drive_from_case(case: Any, *, name: str | None = None) -> Drive:
         if law_name is not None:
             from gearte.models.rv_load_sharing import contact_law
 
-            law = contact_law(red, kind=law_name)
+            law = contact_law(red, law_name)
         cat = getattr(case.analyses, "catalogue", None)
         if cat is None:
             return RVDrive(red, name=label, law=law)

@@ -168,6 +168,14 @@ class ToothContactOptions(_Section):
         default="eq32",
         description="Initial clearance: eq 32 (paper, first order) or the exact envelope.",
     )
+    contact_law: Literal["line_contact", "hu2020"] = Field(
+        default="line_contact",
+        description="Pin contact law: textbook line contact (default) or Hu 2020 eq 38-39 as "
+        "printed (docs/contact-law.md).",
+    )
+    allowable_contact_pressure_MPa: float | None = Field(
+        default=None, gt=0, le=1e5, description="Warn when the Hertz pin pressure exceeds it."
+    )
 
 
 class CompensationOptions(_Section):
@@ -325,9 +333,11 @@ def _tooth_contact(st, case: Case) -> tuple[AnalysisResult, list[str]]:
         mu=o.poisson_ratio,
         F_start=o.start_force_N,
         clearance_model=o.clearance_model,
+        contact_law=o.contact_law,
     )
     tc = tooth_contact(st, T, mesh_angle=0.0, **kw)
     values = {
+        "contact_law": o.contact_law,
         "pins_in_mesh": int(tc.pins_in_mesh[0]),
         "max_contact_force [N]": float(tc.F_max[0]),
         "max_normal_deformation [mm]": float(tc.delta_max[0]),
@@ -340,6 +350,9 @@ def _tooth_contact(st, case: Case) -> tuple[AnalysisResult, list[str]]:
         "initial_clearance [mm]": tc.clearance[0],
         "normal_deformation [mm]": tc.approach[0],
         "contact_force [N]": tc.force[0],
+        "max_contact_pressure [MPa]": float(tc.max_contact_pressure[0]),
+        "contact_pressure [MPa]": tc.pressure[0],
+        "flank_curvature_radius [mm]": tc.curvature[0],
         "solver_residual_evaluations": int(tc.n_eval[0]),
     }
     warnings: list[str] = []
@@ -358,7 +371,15 @@ def _tooth_contact(st, case: Case) -> tuple[AnalysisResult, list[str]]:
                 "peak_pin_force [N]": float(sweep.max_pin_force.max()),
                 "pins_in_mesh_min": int(sweep.pins_in_mesh.min()),
                 "pins_in_mesh_max": int(sweep.pins_in_mesh.max()),
+                "max_contact_pressure_over_pitch [MPa]": sweep.max_contact_pressure,
             }
+        )
+        values["max_contact_pressure [MPa]"] = float(sweep.max_contact_pressure.max())
+    allowable = o.allowable_contact_pressure_MPa
+    if allowable is not None and values["max_contact_pressure [MPa]"] > allowable:
+        warnings.append(
+            f"tooth_contact: max_contact_pressure {values['max_contact_pressure [MPa]']:.0f} MPa "
+            f"exceeds analyses.tooth_contact.allowable_contact_pressure_MPa = {allowable:g} MPa"
         )
     if values["pins_in_mesh"] <= 2:
         warnings.append(

@@ -160,6 +160,13 @@ class ErrorSection(StrictModel):
 
 class ReducerSection(StrictModel):
     rated_torque_Nm: float = Field(gt=0, le=1e6)
+    contact_law: Literal["line_contact", "hu2020"] = Field(
+        default="line_contact",
+        description="pin-contact law (gearte.models.contact_law; docs/contact-law.md)",
+    )
+    allowable_contact_pressure_MPa: float | None = Field(
+        default=None, gt=0, le=1e5, description="warn when the Hertz pin pressure exceeds it"
+    )
     first_stage: FirstStageSection
     cranks: CranksSection
     discs: DiscsSection
@@ -304,6 +311,7 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         d.shift_modification_mm,
         d.youngs_modulus_MPa,
         d.poisson_ratio,
+        sec.contact_law,
     )
     p = sec.pins
 
@@ -355,6 +363,8 @@ def _load_sharing(red, red0, sec: LoadSharingSection) -> AnalysisResult:
     p_peak = np.unravel_index(np.argmax(ls.pin_force), ls.pin_force.shape)
     values = {
         "peak_pin_load [N]": ls.peak_pin_load,
+        "max_contact_pressure [MPa]": ls.max_contact_pressure,
+        "contact_law": ls.contact_law,
         "pairs_in_mesh_min": int(ls.pairs_in_mesh.min()),
         "pairs_in_mesh_max": int(ls.pairs_in_mesh.max()),
         "pairs_in_mesh_at_peak": int(ls.pairs_in_mesh[p_peak[0], p_peak[1]]),
@@ -370,7 +380,9 @@ def _load_sharing(red, red0, sec: LoadSharingSection) -> AnalysisResult:
     data = {"load": ls}
     notes = [
         "Pin loads from the quasi-static equilibrium of all parts (springs + unilateral pin "
-        "contacts with the Hu 2020 load-dependent stiffness), one output revolution.",
+        f"contacts with the '{ls.contact_law}' load-dependent stiffness), one output revolution; "
+        "max_contact_pressure: Hertz line-contact pressure of each pin with its own flank "
+        "curvature.",
     ]
     if has_errors and sec.compare_without_errors:
         ls0 = load_sharing(red0, T, th)
@@ -387,7 +399,15 @@ def _load_sharing(red, red0, sec: LoadSharingSection) -> AnalysisResult:
     st = cycloid_stage(red)
     share = (1.0 - 1.0 / red.ratio) * red.cycloid_teeth / red.pins.count / red.discs.count
     try:
-        tc = tooth_contact(st, T, disc_share=share, mesh_angle=np.linspace(0, 2 * np.pi / 40, 9))
+        tc = tooth_contact(
+            st,
+            T,
+            disc_share=share,
+            mesh_angle=np.linspace(0, 2 * np.pi / 40, 9),
+            E=red.discs.youngs_modulus,
+            mu=red.discs.poisson_ratio,
+            contact_law=ls.contact_law,
+        )
         values["peak_pin_load_cycloid_stage_analysis [N]"] = float(tc.force.max())
         notes.append(
             "peak_pin_load_cycloid_stage_analysis: one disc alone (centre fixed, rigid "
@@ -562,4 +582,12 @@ def run(case: Case, options=None) -> StudyResult:
     warnings = []
     if not out:
         warnings.append("no analyses requested: add [analyses.load_sharing] etc.")
+    allowable = case.reducer.allowable_contact_pressure_MPa
+    for r in out:
+        p = r.values.get("max_contact_pressure [MPa]")
+        if allowable is not None and p is not None and p > allowable:
+            warnings.append(
+                f"{r.name}: max_contact_pressure {p:.0f} MPa exceeds "
+                f"reducer.allowable_contact_pressure_MPa = {allowable:g} MPa"
+            )
     return StudyResult(case=case, analyses=out, warnings=warnings)

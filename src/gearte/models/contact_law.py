@@ -1,0 +1,490 @@
+"""Pin–disc contact laws: normal approach δ(F), its inverse, stiffness and Hertz pressure.
+
+The one place where gearte computes how far a pin and a cycloid flank approach under a force.
+Every user of a pin-contact law — the cycloid-stage tooth contact
+(:mod:`gearte.models.cycloid_contact`), the RV load-sharing solver
+(:mod:`gearte.solvers.rv_equilibrium`, through the coefficients returned here) and the Li 2023
+loaded contact (:mod:`gearte.models.cycloid_loaded_contact`) — calls this module. A law is chosen
+by name:
+
+``"line_contact"`` (default)
+    The textbook approach of two elastic cylinders in line contact (Johnson 1985, §5.6; the same
+    law as Li et al. 2023 eq 2)::
+
+        δ = (2 F (1 − ν²) / (π E b)) · (ln(4 |ρ| / a) + ln(4 r / a) − 1)
+        a = (4 F R* / (π b E*))^½,   1/R* = 1/r − 1/ρ,   1/E* = 2 (1 − ν²)/E
+
+    a the Hertz half-width of the contact strip, ρ the signed flank curvature radius
+    (ρ < 0 convex, ρ > 0 concave, as :func:`gearte.geometry.cycloid.curvature_radius`), r the
+    pin radius, b the face width; disc and pin of the same material.
+``"hu2020"``
+    Hu et al. 2020 eq 38–39 as printed, constant 4.99e-3 in the "half-width"::
+
+        δ = (2 F (1 − μ²) / (π E b)) · (2/3 + ln(16 r |ρ| / c²))
+        c = 4.99e-3 · (4 (1 − μ²) F |ρ| r / (E b (|ρ| + r)))^½
+
+    It is the shape of Roark's two-cylinder formula (c the full band width, constant 1.60) with
+    1.60 replaced by 4.99e-3 — a factor 320.6 in c, i.e. ln(320.6²) = 11.54 more in the bracket:
+    on the Hu 2020 stage the pin approach is 1.95× the textbook value. Kept because it is what
+    reproduces Hu 2020's Tables 4–5 and 7–8. See docs/contact-law.md.
+
+Both laws have the form ``δ(F) = F (a0 − a1 ln F)`` with ``a1 = 2 (1 − ν²)/(π E b)`` (F in N,
+δ in mm); :func:`log_law_coefficients` returns ``(a0, a1)`` so that solvers can evaluate any law
+without knowing which one it is.
+
+Units: mm, N, MPa.
+
+References
+----------
+Johnson K.L. (1985). Contact Mechanics. Cambridge University Press, §4.2 (eq 4.45) and §5.6.
+doi:10.1017/CBO9781139171731
+Young W.C., Budynas R.G. (2002). Roark's Formulas for Stress and Strain, 7th ed., Table 14.1
+case 2. McGraw-Hill. ISBN 0-07-072542-X
+Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+Li X., Huang J., Ding C., Guo R., Niu W. (2023). Machines 11(6), 626.
+doi:10.3390/machines11060626
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from gearte.errors import ConvergenceError, ParameterError
+
+__all__ = [
+    "LAWS",
+    "DEFAULT_LAW",
+    "HU2020_HALF_WIDTH_FACTOR",
+    "ROARK_BAND_WIDTH_FACTOR",
+    "check_law",
+    "contact_modulus",
+    "relative_radius",
+    "hertz_half_width",
+    "max_contact_pressure",
+    "log_law_coefficients",
+    "approach",
+    "force",
+    "force_from_coefficients",
+    "secant_stiffness",
+    "tangent_stiffness",
+]
+
+#: Names of the contact laws; the first is the default for user drives.
+LAWS = ("line_contact", "hu2020")
+DEFAULT_LAW = "line_contact"
+#: The constant of Hu 2020 eq 39 as printed.
+HU2020_HALF_WIDTH_FACTOR = 4.99e-3
+#: Roark's constant of the contact band width of two cylinders, b = 1.60 (p K_D C_E)^½
+#: (= 2 (2/π)^½ = 1.596, the full width 2a of Hertz's strip).
+ROARK_BAND_WIDTH_FACTOR = 1.60
+
+
+def check_law(law: str, field: str = "contact_law") -> str:
+    """Return ``law`` if it names a contact law; else a :class:`ParameterError` naming ``field``.
+
+    Parameters
+    ----------
+    law : str
+        ``"line_contact"`` or ``"hu2020"``.
+    field : str
+        Name of the input that carried the law (for the error message).
+
+    References
+    ----------
+    See the module docstring.
+    """
+    if not isinstance(law, str) or law not in LAWS:
+        raise ParameterError(field, law, f"must be one of {', '.join(repr(x) for x in LAWS)}")
+    return law
+
+
+def _check_material(E: float, nu: float, b: float) -> None:
+    for name, v in (("youngs_modulus", E), ("face_width", b)):
+        if not (math.isfinite(v) and v > 0.0):
+            raise ParameterError(name, v, "must be finite and > 0")
+    if not (math.isfinite(nu) and 0.0 <= nu < 0.5):
+        raise ParameterError("poisson_ratio", nu, "must be in [0, 0.5)")
+
+
+def contact_modulus(E: float, nu: float) -> float:
+    """Contact modulus E* = E / (2 (1 − ν²)) [MPa] of two bodies of the same material.
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus [MPa].
+    nu : float
+        Poisson's ratio [-].
+
+    References
+    ----------
+    Johnson (1985), eq 4.22 (1/E* = (1 − ν1²)/E1 + (1 − ν2²)/E2). doi:10.1017/CBO9781139171731
+    """
+    return E / (2.0 * (1.0 - nu * nu))
+
+
+def relative_radius(rho: ArrayLike, r: ArrayLike) -> np.ndarray:
+    """Relative radius of curvature R* of a pin on a flank [mm], 1/R* = 1/r − 1/ρ.
+
+    Parameters
+    ----------
+    rho : array_like
+        Signed curvature radius of the flank [mm]: < 0 convex, > 0 concave, ±inf flat.
+    r : array_like
+        Pin radius [mm].
+
+    Returns
+    -------
+    numpy.ndarray
+        R* [mm]; ``r |ρ| / (|ρ| + r)`` on a convex flank, ``r ρ / (ρ − r)`` on a concave one.
+
+    References
+    ----------
+    Johnson (1985), eq 4.45 context (R = R1 R2/(R1 + R2), concave radius negative).
+    doi:10.1017/CBO9781139171731
+    """
+    rho = np.asarray(rho, dtype=float)
+    with np.errstate(divide="ignore"):
+        curv = 1.0 / np.asarray(r, dtype=float) - np.where(np.isfinite(rho), 1.0 / rho, 0.0)
+    return 1.0 / curv
+
+
+def hertz_half_width(
+    F: ArrayLike, rho: ArrayLike, r: float, E: float, nu: float, b: float
+) -> np.ndarray:
+    """Hertz half-width a of the contact strip of a pin on a flank [mm].
+
+    ``a = (4 F R* / (π b E*))^½`` (Johnson 1985, eq 4.45 with P = F/b).
+
+    Parameters
+    ----------
+    F : array_like
+        Contact force [N] (≥ 0).
+    rho : array_like
+        Signed flank curvature radius [mm] (see :func:`relative_radius`).
+    r : float
+        Pin radius [mm].
+    E, nu : float
+        Young's modulus [MPa] and Poisson's ratio [-] of disc and pin.
+    b : float
+        Face width [mm].
+
+    References
+    ----------
+    Johnson (1985), eq 4.45. doi:10.1017/CBO9781139171731
+    """
+    _check_material(E, nu, b)
+    F = np.asarray(F, dtype=float)
+    rs = relative_radius(rho, r)
+    return np.sqrt(4.0 * F * rs / (math.pi * b * contact_modulus(E, nu)))
+
+
+def max_contact_pressure(
+    F: ArrayLike, rho: ArrayLike, r: float, E: float, nu: float, b: float
+) -> np.ndarray:
+    """Largest Hertz pressure p0 of a pin on a flank [MPa] (line contact).
+
+    ``p0 = 2 F / (π a b) = (F E* / (π b R*))^½`` (Johnson 1985, eq 4.45), with each pin's own
+    flank curvature ρ. It does not depend on the approach law (the pressure is Hertz's in both).
+
+    Parameters
+    ----------
+    F : array_like
+        Contact force [N] (0 gives 0).
+    rho : array_like
+        Signed flank curvature radius where the pin touches [mm].
+    r : float
+        Pin radius [mm].
+    E, nu : float
+        Young's modulus [MPa] and Poisson's ratio [-].
+    b : float
+        Face width [mm].
+
+    Returns
+    -------
+    numpy.ndarray
+        p0 [MPa].
+
+    Examples
+    --------
+    >>> round(float(max_contact_pressure(1810.0, -43.598, 2.978, 2.06e5, 0.3, 11.0)), 0)
+    1458.0
+
+    References
+    ----------
+    Johnson (1985), eq 4.45. doi:10.1017/CBO9781139171731
+    """
+    _check_material(E, nu, b)
+    f = np.maximum(np.asarray(F, dtype=float), 0.0)
+    rs = relative_radius(rho, r)
+    return np.sqrt(f * contact_modulus(E, nu) / (math.pi * b * rs))
+
+
+def log_law_coefficients(
+    law: str,
+    rho: ArrayLike,
+    r: float,
+    E: float,
+    nu: float,
+    b: float,
+    *,
+    rho_cap: float | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Coefficients (a0 [mm/N], a1 [mm/N]) of ``δ(F) = F (a0 − a1 ln F)`` for a named law.
+
+    Parameters
+    ----------
+    law : {"line_contact", "hu2020"}
+        The contact law (module docstring).
+    rho : array_like
+        Signed curvature radius of the flank where the pin touches [mm]. ``"hu2020"`` uses |ρ|
+        (as printed, convex–convex); ``"line_contact"`` uses the sign in R*.
+    r : float
+        Pin radius [mm] (the grinding pin radius r_rp + Δr_rp in gearte's stages).
+    E, nu : float
+        Young's modulus [MPa], Poisson's ratio [-] of disc and pin.
+    b : float
+        Face width [mm].
+    rho_cap : float, optional
+        Upper bound of |ρ| in the logarithm of ``"line_contact"`` [mm]. The flank curvature radius
+        passes through infinity at the profile's inflection; ln(4|ρ|/a) would then send the pin
+        stiffness to zero although the deforming body is finite. ``None``: no cap (|ρ| must be
+        finite).
+
+    Returns
+    -------
+    a0, a1 : numpy.ndarray
+        Broadcast to the shape of ``rho``; ``a1 = 2 (1 − ν²)/(π E b)`` for both laws.
+
+    Notes
+    -----
+    line contact: ln(4|ρ|/a) + ln(4r/a) = ln(16 |ρ| r) − ln q − ln F with a² = q F,
+    q = 4 R*/(π b E*), so a0 = a1 (ln(16 |ρ| r) − ln q − 1).
+    hu2020: δ = A F (2/3 + ln(B/F)), A = a1, B = 16 r |ρ| F / c², so a0 = a1 (2/3 + ln B).
+
+    References
+    ----------
+    Johnson (1985) §5.6; Hu et al. (2020) eq 38–39, doi:10.3390/app10020481.
+    """
+    check_law(law)
+    _check_material(E, nu, b)
+    if not (math.isfinite(r) and r > 0.0):
+        raise ParameterError("pin_radius", r, "must be finite and > 0")
+    rho = np.asarray(rho, dtype=float)
+    mu2 = 1.0 - nu * nu
+    a1 = 2.0 * mu2 / (math.pi * E * b)
+    rho_abs = np.abs(rho)
+    if law == "hu2020":
+        c2_per_F = HU2020_HALF_WIDTH_FACTOR**2 * 4.0 * mu2 * rho_abs * r / (E * b * (rho_abs + r))
+        a0 = a1 * (2.0 / 3.0 + np.log(16.0 * r * rho_abs / c2_per_F))
+    else:
+        if rho_cap is not None:
+            if not (math.isfinite(rho_cap) and rho_cap > 0.0):
+                raise ParameterError("rho_cap", rho_cap, "must be finite and > 0 [mm]")
+            rho_abs = np.minimum(rho_abs, rho_cap)
+        rs = relative_radius(rho, r)
+        q = 4.0 * rs / (math.pi * b * contact_modulus(E, nu))
+        a0 = a1 * (np.log(16.0 * rho_abs * r) - np.log(q) - 1.0)
+    return a0, np.broadcast_to(a1, np.shape(a0)).copy()
+
+
+def approach(
+    F: ArrayLike,
+    law: str,
+    rho: ArrayLike,
+    r: float,
+    E: float,
+    nu: float,
+    b: float,
+    *,
+    rho_cap: float | None = None,
+) -> np.ndarray:
+    """Normal approach δ [mm] of a pin and a flank under the contact force F [N].
+
+    Parameters
+    ----------
+    F : array_like
+        Contact force [N], > 0.
+    law, rho, r, E, nu, b, rho_cap
+        As in :func:`log_law_coefficients` ([-], [mm], [mm], [MPa], [-], [mm], [mm]).
+
+    Returns
+    -------
+    numpy.ndarray
+        δ(F) [mm].
+
+    Examples
+    --------
+    On the Hu 2020 Table 3 stage at φ0 (ρ = −43.598 mm, r = 2.978 mm, b = 11 mm, steel):
+
+    >>> kw = dict(rho=-43.598, r=2.978, E=2.06e5, nu=0.3, b=11.0)
+    >>> round(1e3 * float(approach(1810.0, "line_contact", **kw)), 2)
+    5.51
+    >>> round(1e3 * float(approach(1810.0, "hu2020", **kw)), 2)
+    10.98
+
+    References
+    ----------
+    Johnson (1985) §5.6, doi:10.1017/CBO9781139171731; Hu et al. (2020) eq 38–39,
+    doi:10.3390/app10020481.
+    """
+    F = np.asarray(F, dtype=float)
+    a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
+    return F * (a0 - a1 * np.log(F))
+
+
+def secant_stiffness(
+    F: ArrayLike,
+    law: str,
+    rho: ArrayLike,
+    r: float,
+    E: float,
+    nu: float,
+    b: float,
+    *,
+    rho_cap: float | None = None,
+) -> np.ndarray:
+    """Secant contact stiffness k = F / δ(F) [N/mm].
+
+    Parameters
+    ----------
+    F, law, rho, r, E, nu, b, rho_cap
+        As in :func:`approach`.
+
+    References
+    ----------
+    See :func:`approach`.
+    """
+    F = np.asarray(F, dtype=float)
+    a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
+    return 1.0 / (a0 - a1 * np.log(F))
+
+
+def tangent_stiffness(
+    F: ArrayLike,
+    law: str,
+    rho: ArrayLike,
+    r: float,
+    E: float,
+    nu: float,
+    b: float,
+    *,
+    rho_cap: float | None = None,
+) -> np.ndarray:
+    """Tangent contact stiffness k_t = dF/dδ = 1 / (a0 − a1 ln F − a1) [N/mm].
+
+    Parameters
+    ----------
+    F, law, rho, r, E, nu, b, rho_cap
+        As in :func:`approach`.
+
+    References
+    ----------
+    See :func:`approach`.
+    """
+    F = np.asarray(F, dtype=float)
+    a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
+    return 1.0 / (a0 - a1 * np.log(F) - a1)
+
+
+def force_from_coefficients(
+    delta: ArrayLike, a0: ArrayLike, a1: ArrayLike, *, rtol: float = 1e-12
+) -> np.ndarray:
+    """Inverse of ``δ = F (a0 − a1 ln F)``: the force F [N] for an approach δ [mm]; δ ≤ 0 → 0.
+
+    δ(F) increases up to F* = exp(a0/a1 − 1), where it reaches δ* = a1 F* (far beyond any
+    elastic load: the half-width is then comparable to the radii). Below δ* the inverse is found by
+    a safeguarded Newton iteration on u = ln F inside the bracket (ln δ − 60, ln F*); at or beyond
+    δ* the law has no inverse and ``inf`` is returned (callers report the load as out of range).
+
+    Parameters
+    ----------
+    delta : array_like
+        Approach [mm].
+    a0, a1 : array_like
+        Law coefficients from :func:`log_law_coefficients` [mm/N].
+    rtol : float
+        Relative tolerance on F [-].
+
+    Raises
+    ------
+    ConvergenceError
+        Newton did not converge in 100 iterations.
+
+    References
+    ----------
+    See :func:`approach`.
+    """
+    d = np.asarray(delta, dtype=float)
+    d, a0, a1 = np.broadcast_arrays(d, np.asarray(a0, dtype=float), np.asarray(a1, dtype=float))
+    out = np.zeros(d.shape)
+    pos = d > 0
+    if not np.any(pos):
+        return out
+    dd, b0, b1 = d[pos], a0[pos], a1[pos]
+    u_star = b0 / b1 - 1.0
+    beyond = dd >= b1 * np.exp(u_star)
+    res = np.full(dd.shape, np.inf)
+    ok = ~beyond
+    if np.any(ok):
+        dd, b0, b1, hi = dd[ok], b0[ok], b1[ok], u_star[ok]
+        lo = np.log(dd) - 60.0
+        # start from the fixed point of the slowly varying log, kept inside the bracket
+        u = np.clip(np.log(dd) - np.log(np.maximum(b0 - b1 * np.log(dd / b0), b1)), lo, hi)
+        r = np.zeros_like(u)
+        for _ in range(100):
+            f = np.exp(u)
+            r = f * (b0 - b1 * u) - dd
+            lo = np.where(r < 0.0, u, lo)
+            hi = np.where(r > 0.0, u, hi)
+            dr = f * (b0 - b1 * u - b1)
+            step = np.where(dr > 0.0, r / np.where(dr > 0.0, dr, 1.0), np.inf)
+            u_new = u - step
+            bad = ~((u_new > lo) & (u_new < hi))
+            u_new = np.where(bad, 0.5 * (lo + hi), u_new)
+            if np.all(np.abs(u_new - u) <= rtol):
+                u = u_new
+                break
+            u = u_new
+        else:
+            raise ConvergenceError(
+                f"contact_law.force: Newton did not converge in 100 iterations (max residual "
+                f"{np.max(np.abs(r)):.3g} mm, tolerance {rtol:g} relative)"
+            )
+        res[ok] = np.exp(u)
+    out[pos] = res
+    return out
+
+
+def force(
+    delta: ArrayLike,
+    law: str,
+    rho: ArrayLike,
+    r: float,
+    E: float,
+    nu: float,
+    b: float,
+    *,
+    rho_cap: float | None = None,
+    rtol: float = 1e-12,
+) -> np.ndarray:
+    """Contact force F [N] for a normal approach δ [mm] (inverse of :func:`approach`).
+
+    Parameters
+    ----------
+    delta : array_like
+        Approach [mm]; δ ≤ 0 gives F = 0 (no contact).
+    law, rho, r, E, nu, b, rho_cap
+        As in :func:`approach`.
+    rtol : float
+        Relative tolerance on F [-].
+
+    References
+    ----------
+    See :func:`approach`.
+    """
+    a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
+    return force_from_coefficients(delta, a0, a1, rtol=rtol)
