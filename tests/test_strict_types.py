@@ -104,3 +104,12 @@ def test_case_name_with_control_characters_is_refused():
     data["case"]["name"] = "a\x00b"
     field, _ = _one_error(data)
     assert field == "case.name"
+
+
+def test_true_is_not_a_sign():
+    """Found by the fuzzer (make fuzz, seed 13): ``angle_coeff = true`` passed as the sign 1,
+    since True == 1 satisfies ``Literal[-1, 1]`` even in strict mode."""
+    data = _bundled("wang2013_2kh_eq9")
+    data["errors"]["terms"][5]["angle_coeff"] = True
+    field, msg = _one_error(data)
+    assert field == "errors.terms.5.angle_coeff" and "boolean" in msg

@@ -11,9 +11,19 @@ import types
 import typing
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
 
-__all__ = ["StrictModel", "CaseMeta", "CaseBase"]
+__all__ = ["StrictModel", "CaseMeta", "CaseBase", "Sign"]
+
+
+def _not_bool(v: Any) -> Any:
+    if isinstance(v, bool):  # True == 1 would pass a Literal[-1, 1] even in strict mode
+        raise ValueError("must be the number -1 or 1, not a boolean")
+    return v
+
+
+#: A sign, -1 or 1 (a ``true`` is refused: it would equal 1).
+Sign = typing.Annotated[typing.Literal[-1, 1], BeforeValidator(_not_bool)]
 
 
 def _arrays_as_tuples(annotation: Any, value: Any) -> Any:

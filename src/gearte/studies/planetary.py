@@ -24,7 +24,7 @@ from pydantic import Field, field_validator, model_validator
 
 from gearte.errors import ParameterError
 from gearte.geometry.planetary import PlanetarySet
-from gearte.io.schema import CaseBase, StrictModel
+from gearte.io.schema import CaseBase, Sign, StrictModel
 from gearte.models.planetary_errors import (
     TermSet,
     coupled_te,
@@ -119,7 +119,7 @@ class TermRow(StrictModel):
     frequency: float | str = Field(description="multiple of the input speed, number or 'p/q'")
     phase_deg: float = Field(description="constant phase [deg]")
     angle: str | None = Field(default=None, description="key into errors.angles_deg")
-    angle_coeff: Literal[-1, 1] = 1
+    angle_coeff: Sign = 1
 
     @field_validator("frequency")
     @classmethod
@@ -157,7 +157,7 @@ class Errors(StrictModel):
     reference_angle: str | None = Field(
         default=None, description="source='terms': the angle that is the assembly datum"
     )
-    overall_sign: Literal[-1, 1] = Field(
+    overall_sign: Sign = Field(
         default=1, description="source='terms': sign in front of the sum (eq 9: -1)"
     )
 
