@@ -176,3 +176,61 @@ def test_li2023_k1_definition_is_a_named_option():
     assert CycloidStage(**kw, k1_definition="nominal").K1 == pytest.approx(0.60606, abs=5e-6)
     with pytest.raises(ParameterError, match="k1_definition"):
         CycloidStage(**kw, k1_definition="paper")
+
+
+def _case_dict(name):
+    import tomllib
+
+    from gearte.cases import case_path
+
+    with open(case_path(name), "rb") as fh:
+        return tomllib.load(fh)
+
+
+def test_cycloid_stage_echoes_law_and_warns_over_allowable_pressure():
+    from gearte import run_case
+
+    d = _case_dict("hu2020_rv80e_initial")
+    d["analyses"] = {"tooth_contact": {**d["analyses"]["tooth_contact"], "mesh_positions": 1}}
+    d["analyses"]["tooth_contact"]["allowable_contact_pressure_MPa"] = 1000.0
+    res = run_case(load_case(d))
+    tc = res["tooth_contact"]
+    assert tc["contact_law"] == "hu2020"
+    p = tc["max_contact_pressure [MPa]"]
+    assert p == pytest.approx(float(np.max(tc["contact_pressure [MPa]"])))
+    assert p > 1000.0
+    assert any("allowable_contact_pressure_MPa" in w for w in res.warnings)
+    d["analyses"]["tooth_contact"]["allowable_contact_pressure_MPa"] = 1.0e4
+    assert not any("allowable" in w for w in run_case(load_case(d)).warnings)
+
+
+def test_rv_reducer_echoes_law_and_pressure_and_warns_over_allowable():
+    from gearte import run_case
+
+    d = _case_dict("hu2020_rv80e_initial_reducer")
+    d["analyses"] = {"load_sharing": {"torque_Nm": 1141.0, "positions": 8}}
+    d["reducer"]["allowable_contact_pressure_MPa"] = 1500.0
+    res = run_case(load_case(d))
+    ls = res["load_sharing"]
+    assert ls["contact_law"] == "hu2020"
+    assert ls["max_contact_pressure [MPa]"] > 1500.0
+    assert any("allowable_contact_pressure_MPa" in w for w in res.warnings)
+    d["reducer"]["contact_law"] = "line_contact"
+    ls2 = run_case(load_case(d))["load_sharing"]
+    assert ls2["contact_law"] == "line_contact"
+    # the textbook law is about twice as stiff: fewer pins carry more load (docs/contact-law.md)
+    assert ls2["peak_pin_load [N]"] > 1.1 * ls["peak_pin_load [N]"]
+    assert ls2["pairs_in_mesh_max"] < ls["pairs_in_mesh_max"]
+
+
+def test_li2023_loaded_contact_pressure_uses_each_pins_curvature():
+    from gearte.models.cycloid_loaded_contact import LI2023_PAIR_MODIFIED, mesh_period_contact
+
+    mp = mesh_period_contact(LI2023_PAIR_MODIFIED, 225e3, 8)
+    c = mp.contact
+    rho = profile_curvature_radius(LI2023_PAIR_MODIFIED, c.phi)
+    st = LI2023_PAIR_MODIFIED.stage
+    ref = cl.max_contact_pressure(c.force, rho, st.r, E, NU, 12.0)
+    np.testing.assert_allclose(c.pressure, ref, rtol=1e-12)
+    assert mp.max_contact_pressure == pytest.approx(float(ref.max()))
+    assert LI2023_PAIR_MODIFIED.contact_law == "line_contact"

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -468,7 +469,9 @@ def envelope_gaps(
     px, py = theoretical_profile_xy(t0, z_p=zp, R=stage.r_p, a=stage.a)
     c, s = np.cos(-beta)[:, None], np.sin(-beta)[:, None]
     qx, qy = c * px - s * py, s * px + c * py
-    kw = dict(z_p=zp, r_p=stage.r_p, r_rp=stage.r_rp, a=stage.a, dr_rp=stage.dr_rp, dr_p=stage.dr_p)
+    kw: dict[str, Any] = dict(
+        z_p=zp, r_p=stage.r_p, r_rp=stage.r_rp, a=stage.a, dr_rp=stage.dr_rp, dr_p=stage.dr_p
+    )
     t = t0.copy()
     h = 1e-4
     for _ in range(newton_steps):

@@ -34,6 +34,7 @@ from gearte.models.contact_law import (
     check_law,
     force_from_coefficients,
     log_law_coefficients,
+    max_contact_pressure,
 )
 
 __all__ = [
@@ -294,6 +295,7 @@ class LoadedContact:
     pressure_angle : β = atan(F_r/F_t) [rad] (eq 7)
     mesh_stiffness : k_cr = F_cr / (r_c Δφ_c cos β) [N/mm] (eq 7, reading A)
     torsional_stiffness : T / Δφ_c [N·mm/rad]
+    pressure : Hertz pressure of each pin with its own flank curvature [MPa] (0 out of contact)
     """
 
     phi: np.ndarray
@@ -310,6 +312,7 @@ class LoadedContact:
     mesh_stiffness: np.ndarray
     torsional_stiffness: np.ndarray
     pins_in_contact: np.ndarray = field(default=None)  # type: ignore[arg-type]  # set in __post_init__
+    pressure: np.ndarray = field(default=None)  # type: ignore[arg-type]  # set by loaded_contact
 
 
 def solve_rotation(
@@ -479,6 +482,14 @@ def loaded_contact(
         mesh_stiffness=k_cr,
         torsional_stiffness=torque_Nmm / rot,
         pins_in_contact=np.sum(in_contact, axis=1),
+        pressure=max_contact_pressure(
+            force,
+            rho,
+            pair.stage.r,
+            pair.youngs_modulus_MPa,
+            pair.poisson_ratio,
+            pair.face_width_mm,
+        ),
     )
 
 
@@ -492,6 +503,11 @@ class MeshPeriodContact:
     pins_in_contact: np.ndarray
     max_force: np.ndarray  # [N]
     contact: LoadedContact
+
+    @property
+    def max_contact_pressure(self) -> float:
+        """Largest Hertz pin pressure over the mesh period [MPa]."""
+        return float(np.max(self.contact.pressure))
 
     @property
     def pressure_angle_mean(self) -> float:

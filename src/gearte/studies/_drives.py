@@ -17,6 +17,7 @@ from typing import Any, Literal
 from pydantic import ConfigDict, Field, PrivateAttr, ValidationInfo, model_validator
 
 from gearte.drives import Drive
+from gearte.errors import ParameterError
 from gearte.io.schema import StrictModel
 
 __all__ = ["DRIVE_CASE_KINDS", "DriveSpec", "drive_from_case"]
@@ -176,6 +177,13 @@ def drive_from_case(case: Any, *, name: str | None = None) -> Drive:
         from gearte.units import deg_to_rad
 
         red = build_reducer(case.reducer)
+        if getattr(red, "rated_torque", None) is None:
+            raise ParameterError(
+                "reducer.rated_torque_Nm",
+                None,
+                "an RV drive's lost motion and stiffness come from the catalogue virtual test, "
+                "which needs the rated torque",
+            )
         law_name = getattr(case.reducer, "contact_law", None)  # the case's pin-contact law
         law = None
         if law_name is not None:

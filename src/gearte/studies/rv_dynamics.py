@@ -308,6 +308,8 @@ def _contact(case: Case, model) -> AnalysisResult:
         "pins_in_contact_min": int(c.pins_in_contact.min()),
         "pins_in_contact_max": int(c.pins_in_contact.max()),
         "max_pin_force [N]": float(c.max_force.max()),
+        "max_contact_pressure [MPa]": c.max_contact_pressure,
+        "contact_law": pair.contact_law,
         "torque_per_disc [N·m]": t_disc,
         "mesh_position [deg]": np.degrees(c.mesh_position),
         "equivalent_pressure_angle [deg]": beta,
