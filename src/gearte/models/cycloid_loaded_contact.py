@@ -329,7 +329,8 @@ def solve_rotation(
     Pin i is compressed by ``δ_i = l_i Δφ − c_i`` (compatibility, Li 2023 eq 3 / Hu 2020 eq 37),
     carries ``F_i = F(δ_i)`` of the law ``δ = F (a0_i − a1_i ln F)`` with its own coefficients
     (its own flank curvature), and ``T = Σ F_i l_i`` (eq 4 / eq 42). T(Δφ) is increasing, so
-    Δφ is bracketed by doubling and found by bisection, vectorised over positions.
+    Δφ is bracketed by doubling and found by a safeguarded Newton iteration (dT/dΔφ = Σ k_t l²,
+    bisection when a step leaves the bracket), vectorised over positions.
 
     Parameters
     ----------
@@ -377,20 +378,29 @@ def solve_rotation(
         hi = np.where(short, hi * 2.0, hi)
     else:  # pragma: no cover - only for absurd loads
         raise ConvergenceError("solve_rotation: could not bracket the elastic rotation")
+    # safeguarded Newton on T(Δφ) inside the bracket (dT/dΔφ = Σ k_t,i l_i², k_t the tangent
+    # stiffness of each loaded pin); a step leaving the bracket is replaced by bisection
+    rot = 0.5 * (lo + hi)
     for it in range(200):  # noqa: B007 - reported on failure
-        mid = 0.5 * (lo + hi)
-        t_mid, _ = torque_at(mid)
+        t_mid, f = torque_at(rot)
         above = t_mid > torque_Nmm
-        hi = np.where(above, mid, hi)
-        lo = np.where(above, lo, mid)
-        if np.all(hi - lo <= rtol * hi):
+        hi = np.where(above, rot, hi)
+        lo = np.where(above, lo, rot)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            kt = np.where(f > 0.0, 1.0 / (a0 - a1 * np.log(np.where(f > 0.0, f, 1.0)) - a1), 0.0)
+        slope = np.sum(kt * arm * arm, axis=1)
+        step = np.where(slope > 0.0, (t_mid - torque_Nmm) / np.where(slope > 0.0, slope, 1.0), 0.0)
+        new = rot - step
+        new = np.where((slope > 0.0) & (new > lo) & (new < hi), new, 0.5 * (lo + hi))
+        done = np.abs(new - rot) <= rtol * np.abs(new)
+        rot = new
+        if np.all(done) or np.all(hi - lo <= rtol * hi):
             break
     else:  # pragma: no cover
         raise ConvergenceError(
-            f"solve_rotation: bisection stopped after {it + 1} iterations "
+            f"solve_rotation: Newton/bisection stopped after {it + 1} iterations "
             f"(bracket {np.max((hi - lo) / hi):.3g} relative, tolerance {rtol:g})"
         )
-    rot = 0.5 * (lo + hi)
     force = torque_at(rot)[1]
     if not np.all(np.isfinite(force)):
         raise ParameterError(
@@ -430,7 +440,7 @@ def loaded_contact(
     Compatibility (eq 3): pin i's angular backlash relative to the first pin to touch is
     φ_bl,i = Δ_i/l_i − min_j Δ_j/l_j; it is in contact when Δφ_c > φ_bl,i and then
     δ_i = (Δφ_c − φ_bl,i) l_i. Equilibrium (eq 4): T = Σ F_i l_i with F_i = k_n(F_i) δ_i
-    (eq 2 inverted per pin). T(Δφ_c) is increasing, so Δφ_c is found by bisection.
+    (eq 2 inverted per pin). T(Δφ_c) is increasing; Δφ_c is found by :func:`solve_rotation`.
 
     Equivalent quantities (eq 5–7): F_t = Σ F_i l_i / r_c, F_r = Σ F_i sqrt(1 − (l_i/r_c)²),
     F_cr = hypot(F_t, F_r), β = atan(F_r/F_t). The garbled eq 7 is read as
