@@ -11,6 +11,7 @@ Every ``import``/``from ... import`` of every module under ``src/gearte`` is rea
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -199,3 +200,39 @@ def test_checker_finds_a_planted_upward_import_and_cycle(tmp_path):
 @pytest.mark.parametrize("layer", [p for layer in LAYERS for p in layer])
 def test_layers_name_existing_modules(layer):
     assert layer in all_modules(), f"LAYERS names {layer}, which does not exist"
+
+
+# Hand-written angle/unit conversions that gearte.units provides (docs/architecture.md, "Units").
+CONVERSIONS = re.compile(
+    r"206264|3437\.7|648000|10800|180(\.0)?\s*/\s*np\.pi|np\.pi\s*/\s*180"
+    r"|np\.(degrees|radians|rad2deg|deg2rad)\("
+)
+# Modules being rewritten in parallel (issue 11 items 2-4) that still convert by hand; the list
+# only shrinks (test_unit_conversion_debt_only_shrinks).
+CONVERSION_PENDING = {
+    "gearte.studies.rv_dynamics",
+    "gearte.studies._rv_dynamics",  # its announced new name
+    "gearte.studies.rv_reducer",
+}
+
+
+def _hand_conversions() -> dict[str, list[str]]:
+    out: dict[str, list[str]] = {}
+    for module, path in all_modules().items():
+        if module == "gearte.units":
+            continue
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            code = line.split("#")[0]
+            if CONVERSIONS.search(code) and ">>>" not in code:
+                out.setdefault(module, []).append(f"{n}: {line.strip()}")
+    return out
+
+
+def test_unit_conversions_only_through_gearte_units():
+    found = {m: v for m, v in _hand_conversions().items() if m not in CONVERSION_PENDING}
+    assert not found, "\n".join(f"{m}:{line}" for m, lines in found.items() for line in lines)
+
+
+def test_unit_conversion_debt_only_shrinks():
+    clean = (CONVERSION_PENDING & set(all_modules())) - set(_hand_conversions())
+    assert not clean, f"remove from CONVERSION_PENDING (no hand conversion left): {clean}"

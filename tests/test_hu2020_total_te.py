@@ -21,7 +21,7 @@ from gearte.models.rv_catalogue import catalogue_values, torsion_test
 from gearte.models.rv_compensation import compensate
 from gearte.models.rv_load_sharing import output_positions, transmission_error
 from gearte.studies.rv_reducer import build_reducer
-from gearte.units import Nm_to_Nmm, arcmin_to_rad, rad_to_arcmin
+from gearte.units import Nm_to_Nmm, Nmm_per_rad_to_Nm_per_arcmin, arcmin_to_rad, rad_to_arcmin
 
 HU2020 = {"te_initial [arcmin]": 1.4559, "te_modified [arcmin]": 0.8538, "sim [%]": 41.35,
           "test [%]": 47.22, "pins_initial": 9, "pins_modified": 17}  # fmt: skip
@@ -64,6 +64,16 @@ def _reduction(a, b):
 
 
 def test_hu2020_modified_prototype_has_lower_total_te(te):
+    """Reduction of the mean loaded lag, initial → modified prototype, at T_c of the examples.
+
+    Paper: -41.35 % (Adams: flexible discs, everything else rigid), -47.22 % (test bench).
+    gearte, bearing-compliant reducer: 3.0886' → 2.4073', -22.06 % (documented deviation: the
+    bearings' compliance, common to both prototypes, dilutes the gain); supports and first stage
+    stiffened 1e4× (the paper's Adams setting): 0.8921' → 0.2077', -76.71 % (documented
+    deviation: gearte's rigid setting also stiffens the crank bearings the Adams model keeps
+    flexible through the discs). The paper's two numbers lie between gearte's two settings.
+    Tolerance 0.05 points: the 120-position load-sharing solution is converged far below that.
+    """
     rows = {}
     for tag, (ini, mod) in te.items():
         lag = [rad_to_arcmin(-t.total.mean()) for t in (ini, mod)]
@@ -81,6 +91,8 @@ def test_hu2020_modified_prototype_has_lower_total_te(te):
     # dilutes the gain) and the paper's own setting (only the cycloid contacts compliant)
     low = _reduction(*rows["real"][0])
     high = _reduction(*rows["rigid"][0])
+    assert low == pytest.approx(22.06, abs=0.05)
+    assert high == pytest.approx(76.71, abs=0.05)
     assert low < HU2020["sim [%]"] < high
     assert low < HU2020["test [%]"] < high
 
@@ -130,7 +142,9 @@ def test_hu2020_hysteresis_curve_monotonic_with_backlash_jump(prototypes):
     assert np.all(dang[seg != 0] * seg[seg != 0] >= -1e-12)
     cat = catalogue_values(red)
     assert rad_to_arcmin(cat.lost_motion) > rad_to_arcmin(cat.backlash) > 0.5
-    assert 100 < cat.torsional_rigidity / 1e3 / rad_to_arcmin(1.0) < 2000
+    # gearte's own catalogue value (the paper prints no rigidity); 0.1 % tolerance of the
+    # finite-difference slope between the rated-torque points
+    assert Nmm_per_rad_to_Nm_per_arcmin(cat.torsional_rigidity) == pytest.approx(423.24, rel=1e-3)
 
 
 def test_hu2020_compensation_lowers_lag_keeping_backlash(prototypes):

@@ -42,8 +42,11 @@ def mod():
 
 
 def test_li2023_fig9_unmodified_pressure_angle(unmod):
+    """Fig 9: mean equivalent pressure angle 31.9° (unmodified). gearte: 32.833°, documented
+    deviation +0.93° (docs/validation/li2023.md); tolerance 1e-3° (48 positions, converged
+    contact)."""
     beta = np.degrees(unmod.pressure_angle_mean)
-    assert 31.5 <= beta <= 33.5
+    assert beta == pytest.approx(32.833, abs=1e-3)
     # small ripple over the mesh period, as Fig 9 (31.5–32.1°)
     assert np.ptp(np.degrees(unmod.pressure_angle)) < 1.0
     # every pin of the loaded flank carries load without modification
@@ -51,8 +54,10 @@ def test_li2023_fig9_unmodified_pressure_angle(unmod):
 
 
 def test_li2023_fig9_stiffness_ratio(unmod, mod):
+    """Paper: k_cr 2.62e8 / 1.24e9 N/m = 0.211 (modified / unmodified). gearte: 0.2322,
+    documented deviation +10 %; tolerance 1e-4 (converged contact at 48 positions)."""
     ratio = mod.mesh_stiffness_mean / unmod.mesh_stiffness_mean
-    assert 0.15 <= ratio <= 0.35
+    assert ratio == pytest.approx(0.2322, abs=1e-4)
     # the modification concentrates load on a few pins near φ0 and lowers β
     assert mod.pins_in_contact.max() < 10
     assert np.degrees(mod.pressure_angle_mean) < 15.0

@@ -114,21 +114,31 @@ def test_resonance_warning_detects_near_mode(model):
 
 
 def test_li2023_fig11a_dte_without_errors(model, unmod):
-    """Paper: 0.78″ without errors; gearte must give the same order (0.1–2″) off resonance."""
-    for m in (model, unmod):
+    """Paper: 0.78″ without errors. gearte: 0.2240″ (modified profile, mean cycloid stiffness as
+    the paper's §4.1) and 0.2891″ (unmodified, Fourier stiffness), off resonance.
+
+    Documented deviation (-71 % / -63 %, docs/validation/li2023.md §2.5): the paper's DTE depends
+    on inputs it does not print (involute mesh stiffness, damping). Tolerance 1e-3 relative: the
+    fixed-step RK4 run is deterministic; the margin covers floating-point reassociation only.
+    """
+    for m, expected in ((model, 0.2240), (unmod, 0.2891)):
         assert not m.resonance_warnings(0.05)
         r = simulate_dte(m, 0.1, settle_s=0.06)
-        assert 0.1 <= r.peak_to_peak <= 2.0
+        assert r.peak_to_peak == pytest.approx(expected, rel=1e-3)
         _, _, peaks = dte_spectrum(r.t, r.dte, m.params.frequencies())
         assert peaks[0]["source"] in ("involute mesh", "cycloid mesh")
 
 
 def test_li2023_fig11b_dte_with_table3_errors(model):
-    """Table 3 errors, each on crank 1 / disc 1, one output revolution: paper 17.25″."""
+    """Table 3 errors, each on crank 1 / disc 1, one output revolution: paper 17.25″.
+
+    gearte: 13.12″, documented deviation -24 % (docs/validation/li2023.md; the placement of the
+    errors is not printed, §2.6). Tolerance as in the Fig 11a test.
+    """
     m = model.with_errors(RVErrors.table3(placement="first"))
     r = simulate_dte(m, 4.84, settle_s=0.1, record_dt=1e-3)
     print(f"DTE p2p with Table 3 errors ('first'): {r.peak_to_peak:.2f}″ (paper 17.25″)")
-    assert 5.0 <= r.peak_to_peak <= 50.0
+    assert r.peak_to_peak == pytest.approx(13.121, rel=1e-3)
     _, _, peaks = dte_spectrum(r.t, r.dte, m.params.frequencies())
     assert peaks[0]["source"] == "crank rotation"
 

@@ -36,7 +36,7 @@ def list_cases() -> dict[str, Path]:
 
 
 def case_path(name_or_path: str | os.PathLike[str]) -> Path:
-    """Resolve a case file path or a bundled case name to a path.
+    """Resolve ``name_or_path``, a case file path or a bundled case name, to a path.
 
     Raises
     ------

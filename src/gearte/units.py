@@ -30,6 +30,9 @@ __all__ = [
     "Nm_to_Nmm",
     "Nmm_to_Nm",
     "format_dms",
+    "rpm_to_rad_per_s",
+    "N_per_mm_to_N_per_m",
+    "Nmm_per_rad_to_Nm_per_arcmin",
     "KG_TO_T",
     "KGM2_TO_TMM2",
     "N_PER_M_TO_N_PER_MM",
@@ -66,57 +69,73 @@ def _divided(x: Any, factor: float) -> Any:
 
 
 def rad_to_arcmin(x: Quantity) -> Quantity:
-    """Angle [rad] → [arcmin]."""
+    """Angle ``x`` [rad] → [arcmin]."""
     return _scaled(x, ARCMIN_PER_RAD)
 
 
 def arcmin_to_rad(x: Quantity) -> Quantity:
-    """Angle [arcmin] → [rad]."""
+    """Angle ``x`` [arcmin] → [rad]."""
     return _divided(x, ARCMIN_PER_RAD)
 
 
 def rad_to_arcsec(x: Quantity) -> Quantity:
-    """Angle [rad] → [arcsec]."""
+    """Angle ``x`` [rad] → [arcsec]."""
     return _scaled(x, ARCSEC_PER_RAD)
 
 
 def arcsec_to_rad(x: Quantity) -> Quantity:
-    """Angle [arcsec] → [rad]."""
+    """Angle ``x`` [arcsec] → [rad]."""
     return _divided(x, ARCSEC_PER_RAD)
 
 
 def rad_to_deg(x: Quantity) -> Quantity:
-    """Angle [rad] → [deg]."""
+    """Angle ``x`` [rad] → [deg]."""
     return _scaled(x, DEG_PER_RAD)
 
 
 def deg_to_rad(x: Quantity) -> Quantity:
-    """Angle [deg] → [rad]."""
+    """Angle ``x`` [deg] → [rad]."""
     return _divided(x, DEG_PER_RAD)
 
 
 def um_to_mm(x: Quantity) -> Quantity:
-    """Length [µm] → [mm]."""
+    """Length ``x`` [µm] → [mm]."""
     return _scaled(x, 1e-3)
 
 
 def mm_to_um(x: Quantity) -> Quantity:
-    """Length [mm] → [µm]."""
+    """Length ``x`` [mm] → [µm]."""
     return _scaled(x, 1e3)
 
 
 def Nm_to_Nmm(x: Quantity) -> Quantity:  # noqa: N802 - unit names
-    """Torque [N·m] → [N·mm]."""
+    """Torque ``x`` [N·m] → [N·mm]."""
     return _scaled(x, 1e3)
 
 
 def Nmm_to_Nm(x: Quantity) -> Quantity:  # noqa: N802 - unit names
-    """Torque [N·mm] → [N·m]."""
+    """Torque ``x`` [N·mm] → [N·m]."""
     return _scaled(x, 1e-3)
 
 
+def rpm_to_rad_per_s(x: Quantity) -> Quantity:
+    """Speed ``x`` [rpm] → [rad/s]."""
+    return _scaled(x, 2.0 * np.pi / 60.0)
+
+
+def N_per_mm_to_N_per_m(x: Quantity) -> Quantity:  # noqa: N802 - unit names
+    """Stiffness ``x`` [N/mm] → [N/m]."""
+    return _scaled(x, 1e3)
+
+
+def Nmm_per_rad_to_Nm_per_arcmin(x: Quantity) -> Quantity:  # noqa: N802 - unit names
+    """Torsional stiffness ``x`` [N·mm/rad] → [N·m/arcmin] (catalogue torsional rigidity)."""
+    return _scaled(x, 1e-3 / ARCMIN_PER_RAD)
+
+
 def format_dms(angle_rad: float, *, arcsec_decimals: int = 0) -> str:
-    """Format an angle [rad] as the papers print it: ``9′59″`` (degrees shown only if ≥ 1°).
+    """Format an angle ``angle_rad`` [rad] as the papers print it: ``9′59″`` (degrees shown only
+    if ≥ 1°), seconds rounded to ``arcsec_decimals`` decimals [-].
 
     >>> format_dms(arcmin_to_rad(9 + 59 / 60))
     "9′59″"

@@ -56,6 +56,9 @@ def check_backend(
 ) -> dict[str, Any]:
     """Run the same seeded study sequentially and on ``scheduler``; compare the results.
 
+    ``samples`` draws in chunks of ``chunk_size`` from ``seed``; ``delay_s`` [s] of sleep per
+    chunk (to watch a cluster work); ``workers`` local threads.
+
     Returns
     -------
     dict

@@ -44,14 +44,23 @@ def base_diameter(d: ArrayLike, alpha: ArrayLike) -> np.ndarray | float:
 def centre_distance(z1: ArrayLike, z2: ArrayLike, module: ArrayLike) -> np.ndarray | float:
     """Nominal centre distance ``a = m (z₁ + z₂)/2`` [mm] of an external spur pair.
 
+    Teeth ``z1``, ``z2`` [-], ``module`` m [mm].
+
     >>> float(centre_distance(28, 110, 2.5))   # Jiang et al. (2024) Table 2: 172.5 mm
     172.5
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     return np.multiply(module, np.add(z1, z2)) / 2.0
 
 
 def gear_ratio(z_driving: ArrayLike, z_driven: ArrayLike) -> np.ndarray | float:
-    """Reduction ratio ``i = z_driven / z_driving`` (> 1 for a reduction).
+    """Reduction ratio ``i = z_driven / z_driving`` [-] (> 1 for a reduction).
+
+    ``z_driving``, ``z_driven``: teeth of the driving and the driven gear [-].
 
     >>> round(float(gear_ratio(28, 110)), 3)   # Table 2: 3.929
     3.929
@@ -62,7 +71,9 @@ def gear_ratio(z_driving: ArrayLike, z_driven: ArrayLike) -> np.ndarray | float:
 def bevel_pitch_cone_angles(
     z1: ArrayLike, z2: ArrayLike, shaft_angle: ArrayLike = np.pi / 2
 ) -> tuple[np.ndarray | float, np.ndarray | float]:
-    """Pitch-cone angles ``(δ₁, δ₂)`` [rad] of a bevel pair with shaft angle ``Σ`` [rad].
+    """Pitch-cone angles ``(δ₁, δ₂)`` [rad] of a bevel pair with ``shaft_angle`` Σ [rad].
+
+    Teeth ``z1``, ``z2`` [-].
 
     ``tan δ₁ = sin Σ / (z₂/z₁ + cos Σ)``, ``δ₂ = Σ − δ₁``. For ``z₁ = z₂`` and ``Σ = 90°``,
     ``δ₁ = δ₂ = 45°`` (the paper's pair).
@@ -77,14 +88,19 @@ def bevel_mean_diameter(
 ) -> np.ndarray | float:
     """Mean (mid-face) diameter ``d_m = d − b·sin δ`` [mm].
 
-    ``d`` outer pitch diameter [mm], ``b`` face width [mm], ``δ`` pitch-cone angle [rad].
+    ``d`` outer pitch diameter [mm], ``face_width`` b [mm], ``δ`` pitch-cone angle [rad].
     Jiang et al. (2024) Table 5: ``108.5 − 9·sin 45° = 102.1`` mm.
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     return np.subtract(d, np.multiply(face_width, np.sin(delta)))
 
 
 def bevel_cone_distance(d: ArrayLike, delta: ArrayLike) -> np.ndarray | float:
-    """Outer cone distance ``R = d / (2 sin δ)`` [mm]."""
+    """Outer cone distance ``R = d / (2 sin δ)`` [mm] (``d`` [mm], pitch-cone angle δ [rad])."""
     return np.divide(d, 2.0 * np.sin(delta))
 
 
@@ -93,10 +109,19 @@ def virtual_spur_diameter(d: ArrayLike, delta: ArrayLike) -> np.ndarray | float:
 
     The bevel pair is replaced by a cylindrical pair whose pitch circles are the developed back
     cones; Jiang et al. (2024) §3.1 (Fig. 5) compute the bevel backlash on that pair.
+    ``d`` pitch diameter [mm], δ pitch-cone angle [rad].
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     return np.divide(d, np.cos(delta))
 
 
 def virtual_spur_teeth(z: ArrayLike, delta: ArrayLike) -> np.ndarray | float:
-    """Virtual number of teeth ``z_v = z / cos δ`` of the back-cone equivalent spur gear."""
+    """Virtual number of teeth ``z_v = z / cos δ`` [-] of the back-cone equivalent spur gear.
+
+    ``z`` teeth [-], δ pitch-cone angle [rad].
+    """
     return np.divide(z, np.cos(delta))

@@ -57,6 +57,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gearte.errors import ParameterError
+from gearte.units import um_to_mm
 
 __all__ = [
     "FirstStage",
@@ -129,7 +130,7 @@ def iso6336_mesh_stiffness(face_width: float, c_gamma: float = 20.0) -> float:
     """
     if face_width <= 0:
         raise ParameterError("face_width", face_width, "must be > 0 mm")
-    return float(c_gamma * face_width * 1e3)
+    return float(c_gamma * face_width / um_to_mm(1.0))  # N/µm → N/mm
 
 
 @dataclass(frozen=True)

@@ -104,22 +104,46 @@ BEVEL_SOURCES: tuple[str, ...] = (
 # conversions (eq. 1)
 # ------------------------------------------------------------------------------------------------
 def normal_from_circumferential(jt: ArrayLike, alpha: ArrayLike) -> np.ndarray | float:
-    """Normal backlash ``jn = jt·cos α`` [mm] from circumferential ``jt`` [mm] (eq. 1)."""
+    """Normal backlash ``jn = jt·cos α`` [mm] from circumferential ``jt`` [mm] (eq. 1).
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
+    """
     return np.multiply(jt, np.cos(alpha))
 
 
 def circumferential_from_normal(jn: ArrayLike, alpha: ArrayLike) -> np.ndarray | float:
-    """Circumferential backlash ``jt = jn / cos α`` [mm] (eq. 1)."""
+    """Circumferential backlash ``jt = jn / cos α`` [mm] (eq. 1).
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
+    """
     return np.divide(jn, np.cos(alpha))
 
 
 def normal_from_radial(jr: ArrayLike, alpha: ArrayLike) -> np.ndarray | float:
-    """Normal backlash ``jn = 2·jr·sin α`` [mm] from radial ``jr`` [mm] (eq. 1)."""
+    """Normal backlash ``jn = 2·jr·sin α`` [mm] from radial ``jr`` [mm] (eq. 1).
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
+    """
     return np.multiply(2.0 * np.sin(alpha), jr)
 
 
 def radial_from_normal(jn: ArrayLike, alpha: ArrayLike) -> np.ndarray | float:
-    """Radial backlash ``jr = jn / (2 sin α)`` [mm] (eq. 1)."""
+    """Radial backlash ``jr = jn / (2 sin α)`` [mm] (eq. 1).
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
+    """
     return np.divide(jn, 2.0 * np.sin(alpha))
 
 
@@ -162,6 +186,11 @@ def spur_normal_backlash(
 
         jn = −(ΔEs1 + ΔEs2) cos α + 2Δfa sin α + 2(e1 sin φ1 + e2 sin φ2) sin α
              + Δb sin α + 2 S sin φb sin α
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     sa, ca = np.sin(alpha), np.cos(alpha)
     return (
@@ -212,6 +241,11 @@ def bevel_normal_backlash(
              + 2 sin α (e1 cos δ1 sin φ1 + e2 cos δ2 sin φ2)
              + 2 sin α (ΔP1 sin δ1 + ΔP2 sin δ2 + ΔP3 sin δ1 + ΔP4 sin δ2)
              + sin α (Δb1 cos δ1 + Δb2 cos δ2)
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     sa, ca = np.sin(alpha), np.cos(alpha)
     s1, s2, c1, c2 = np.sin(delta1), np.sin(delta2), np.cos(delta1), np.cos(delta2)
@@ -597,7 +631,11 @@ class BacklashSummary:
 def summarise_backlash(
     stack: LinearStack, *, confidence: float = 0.9973, min_limit: float = 0.0
 ) -> BacklashSummary:
-    """Mean, sd and the ``mean ∓ z·sd`` range at ``confidence`` (0.9973 ↔ the paper's 6σ)."""
+    """Mean, sd and the ``mean ∓ z·sd`` range [mm] of a backlash ``stack``.
+
+    ``confidence`` [-] sets z (0.9973 ↔ the paper's 6σ); ``min_limit`` [mm] the pair's minimum
+    limit normal backlash, compared with the range's lower end.
+    """
     z = z_for_confidence(confidence)
     m, s = stack.mean, stack.sd
     return BacklashSummary(m, s, m - z * s, m + z * s, confidence, min_limit)

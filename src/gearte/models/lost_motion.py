@@ -85,6 +85,11 @@ def return_error(jn: ArrayLike, d: ArrayLike, alpha: ArrayLike) -> np.ndarray | 
     >>> from gearte.units import rad_to_arcsec
     >>> round(float(rad_to_arcsec(return_error(0.054, 275.0, math.radians(20)))))
     86
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     d = np.asarray(d, dtype=float)
     if np.any(d <= 0):
@@ -103,14 +108,25 @@ def _check_ratios(ratios: Sequence[float], field: str = "ratios") -> np.ndarray:
 
 
 def stage_transfer_factors(ratios: Sequence[float]) -> np.ndarray:
-    """``1 / Πⱼ₍ⱼ>ₖ₎ iⱼ``: factor by which stage ``k``'s return error appears at the joint."""
+    """``1 / Πⱼ₍ⱼ>ₖ₎ iⱼ`` [-]: factor by which stage ``k``'s return error appears at the joint.
+
+    ``ratios``: reduction ratio of each stage [-], from the motor to the joint.
+    """
     r = _check_ratios(ratios)
     downstream = np.concatenate([np.cumprod(r[::-1])[::-1][1:], [1.0]])
     return 1.0 / downstream
 
 
 def motor_ratios(ratios: Sequence[float]) -> np.ndarray:
-    """``Πⱼ₍ⱼ≤ₖ₎ iⱼ``: motor angle per unit output angle of stage ``k`` (used in eq. 33)."""
+    """``Πⱼ₍ⱼ≤ₖ₎ iⱼ`` [-]: motor angle per unit output angle of stage ``k`` (used in eq. 33).
+
+    ``ratios``: reduction ratio of each stage [-], from the motor to the joint.
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
+    """
     return np.cumprod(_check_ratios(ratios))
 
 
@@ -122,11 +138,16 @@ def chain_lost_motion(stage_errors: ArrayLike, ratios: Sequence[float]) -> np.nd
     stage_errors : array_like, shape (..., n_stages)
         Return error of each stage at its own output [rad], stages from motor to joint.
     ratios : sequence of float
-        Reduction ratio of each stage (``> 0``).
+        Reduction ratio of each stage [-] (``> 0``).
 
     Returns
     -------
     ``Σₖ Δφₖ / Πⱼ₍ⱼ>ₖ₎ iⱼ`` [rad] — the worst case when the ``Δφₖ`` are maxima.
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     f = stage_transfer_factors(ratios)
     e = np.asarray(stage_errors, dtype=float)
@@ -136,7 +157,15 @@ def chain_lost_motion(stage_errors: ArrayLike, ratios: Sequence[float]) -> np.nd
 
 
 def end_effector_error(joint_error: ArrayLike, lever_length: ArrayLike) -> np.ndarray | float:
-    """End-effector displacement ``ΔZ = ΔφL·L`` [mm], eq. (31) (``ΔφL`` [rad], ``L`` [mm])."""
+    """End-effector displacement ``ΔZ = ΔφL·L`` [mm], eq. (31).
+
+    ``joint_error`` ΔφL [rad], ``lever_length`` L [mm].
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
+    """
     L = np.asarray(lever_length, dtype=float)
     if np.any(L <= 0):
         raise ParameterError("lever_length", lever_length, "must be > 0 mm")
@@ -148,8 +177,14 @@ def shim_backlash_reduction(
 ) -> np.ndarray | float:
     """Normal-backlash reduction [mm] of shims of ``thickness`` [mm] under both bevel gears.
 
-    ``shim_sensitivity`` defaults to ``2√2 sin α`` (two shims, 45° cones, eq. 32); pass
+    ``shim_sensitivity`` [-] (mm of backlash per mm of shim) defaults to ``2√2 sin α`` (two
+    shims, 45° cones, eq. 32), α the pressure angle [rad]; pass
     :meth:`gearte.models.backlash.BevelPair.shim_sensitivity` for other cone angles.
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     k = 2.0 * math.sqrt(2.0) * math.sin(alpha) if shim_sensitivity is None else shim_sensitivity
     return k * np.asarray(thickness, dtype=float)
@@ -174,7 +209,7 @@ def shim_thickness(
     alpha : float
         Pressure angle [rad].
     shim_sensitivity : float, optional
-        Backlash change per unit shim thickness (default ``2√2 sin α``).
+        Backlash change per unit shim thickness [-] (default ``2√2 sin α``).
     min_limit : float
         Minimum limit normal backlash of the pair [mm].
 
@@ -184,6 +219,11 @@ def shim_thickness(
 
     >>> round(shim_thickness(0.070, 0.024, math.radians(20)), 3)
     0.048
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     if not target_min < current_min:
         raise ParameterError(
@@ -210,7 +250,13 @@ def motor_compensation_angle(
 ) -> float:
     """Motor-angle offset [rad] applied when the load torque reverses, eq. (33).
 
-    ``Δφc = Σₖ cₖ (Πⱼ₍ⱼ≤ₖ₎ iⱼ) Δφₖ,m`` with ``cₖ = 1`` for the stages compensated.
+    ``Δφc = Σₖ cₖ (Πⱼ₍ⱼ≤ₖ₎ iⱼ) Δφₖ,m`` with ``cₖ = 1`` for the stages compensated:
+    ``mean_errors`` Δφₖ,m [rad] per stage, ``ratios`` iⱼ [-], ``compensate`` cₖ per stage.
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     m = motor_ratios(ratios)
     e = np.asarray(mean_errors, dtype=float)
@@ -223,7 +269,11 @@ def motor_compensation_angle(
 def compensation_residual(
     err_min: float | None, err_mean: float | None, err_max: float, compensated: bool
 ) -> float:
-    """Largest return error [rad] left at a stage's output after compensation by its mean."""
+    """Largest return error [rad] left at a stage's output after compensation by its mean.
+
+    ``err_min``, ``err_mean``, ``err_max``: the stage's return error [rad] (min and mean may be
+    None: unknown); ``compensated``: whether the stage is compensated.
+    """
     if not compensated:
         return float(err_max)
     if err_mean is None:
@@ -292,6 +342,11 @@ def analyse_chain(stages: Sequence[StageLostMotion], lever_length: float) -> Cha
         From the motor to the joint.
     lever_length : float
         Distance ``L`` from the joint axis to the end effector [mm].
+
+    References
+    ----------
+    Jiang J. et al. (2024) J. Zhejiang Univ. (Eng. Sci.) 58(8), 1533–1542.
+    doi:10.3785/j.issn.1008-973X.2024.08.001
     """
     if not stages:
         raise ParameterError("chain.stages", [], "a chain needs at least one stage")
@@ -345,7 +400,7 @@ class _Row:
 
 
 def compensation_table(result: ChainResult) -> dict:
-    """The motor-angle compensation as plain data (JSON-able dict).
+    """The motor-angle compensation of a chain ``result`` as plain data (JSON-able dict).
 
     ``rows``: one per stage with its ratio, motor ratio ``Πiⱼ``, mean return error [arcmin] and
     the motor offset it contributes [deg]; ``motor_compensation_angle_deg`` is their sum, to be
@@ -374,7 +429,7 @@ def compensation_table(result: ChainResult) -> dict:
 
 
 def compensation_table_csv(table: dict) -> str:
-    """CSV text of :func:`compensation_table` (one row per stage, a total line last)."""
+    """CSV text of a ``table`` from :func:`compensation_table` (one row per stage, a total last)."""
     buf = io.StringIO()
     rows = table["rows"]
     w = csv.DictWriter(buf, fieldnames=list(rows[0].keys()), lineterminator="\n")
@@ -386,7 +441,7 @@ def compensation_table_csv(table: dict) -> str:
 
 
 def compensation_table_json(table: dict) -> str:
-    """JSON text of :func:`compensation_table`."""
+    """JSON text of a ``table`` from :func:`compensation_table`."""
     return json.dumps(table, indent=2)
 
 

@@ -186,6 +186,11 @@ def derive_terms(pset: PlanetarySet, planet_model: str = "reference") -> TermSet
     the planet's relative frequency (11/24 instead of -(z_s/z_p)(w_s-w_c) = -7/24 of w_s), the
     sign of the planet's manufacturing term on the external line, and the sign of the ring's
     term; see ``docs/validation/wang2013.md``.
+
+    References
+    ----------
+    Wang C., Chen X., Li Y., Chen H. (2013). Trans. CSAM 44(8), 287-292.
+    doi:10.6041/j.issn.1000-1298.2013.08.049
     """
     if planet_model not in ("reference", "mean"):
         raise ParameterError("planet_model", planet_model, "must be 'reference' or 'mean'")
@@ -246,6 +251,11 @@ def terms_from_table(
         Output rotation per mm of summed mesh error [rad/mm] (eq. 9: ``1/(r_bs i_sc)``).
     reference_angle : str, optional
         The angle held at 0 as the assembly datum.
+
+    References
+    ----------
+    Wang C., Chen X., Li Y., Chen H. (2013). Trans. CSAM 44(8), 287-292.
+    doi:10.6041/j.issn.1000-1298.2013.08.049
     """
     terms = []
     for k, r in enumerate(rows):
@@ -269,7 +279,7 @@ def terms_from_table(
 
 
 def frequency_basis(terms: TermSet) -> tuple[Fraction, tuple[int, ...], np.ndarray]:
-    """Fundamental frequency and the harmonic number of every distinct non-zero |q|.
+    """Fundamental frequency and the harmonic number of every distinct non-zero |q| of ``terms``.
 
     Returns
     -------
@@ -350,6 +360,11 @@ def group_phasors(
     ``Im(-A e^{-i phi} e^{i |q| w t})`` for q < 0; Wang 2013 eqs 2-5 are the same sums written with
     arctan, which loses the quadrant (their footnote to eq 3 patches the case of a zero
     denominator only).
+
+    References
+    ----------
+    Wang C., Chen X., Li Y., Chen H. (2013). Trans. CSAM 44(8), 287-292.
+    doi:10.6041/j.issn.1000-1298.2013.08.049
     """
     arr = _term_arrays(terms)
     m = np.asarray(magnitudes, dtype=float)

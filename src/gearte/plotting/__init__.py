@@ -38,7 +38,8 @@ def for_analysis(name: str, figs: list[Figure]) -> list[Figure]:
 def new_figure(
     nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] = (7.0, 4.0), **subplot_kw: Any
 ) -> tuple[Any, Any]:
-    """A matplotlib Figure (Agg canvas, no pyplot) and its axes."""
+    """A matplotlib Figure (Agg canvas, no pyplot) and its axes: ``nrows`` × ``ncols`` subplots,
+    ``figsize`` [inch]; ``subplot_kw`` passed to ``Figure.subplots``."""
     from matplotlib.figure import Figure as MplFigure
 
     fig = MplFigure(figsize=figsize, layout="constrained")

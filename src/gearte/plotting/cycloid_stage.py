@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
+from gearte.units import Nmm_to_Nm, rad_to_deg
 
 __all__ = ["figures", "profile_figure", "contact_figures", "sensitivity_figure", "pareto_figure"]
 
@@ -21,7 +22,8 @@ def _exaggeration(max_dev_mm: float, tooth_height_mm: float) -> float:
 
 
 def profile_figure(stage: Any) -> Figure:
-    """Modified against unmodified profile over three teeth (polar, unwrapped), exaggerated."""
+    """Modified against unmodified profile of ``stage`` over three teeth (polar, unwrapped),
+    exaggerated."""
     phi = np.linspace(-3.0 * np.pi, 3.0 * np.pi, 4001)
 
     def polar(modified: bool, flank: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -34,7 +36,7 @@ def profile_figure(stage: Any) -> Figure:
     a1, r1 = polar(True, flank=2)
     dr = np.interp(a0, a1, r1) - r0
     k = _exaggeration(float(np.max(np.abs(dr))), stage.tip_radius - stage.root_radius)
-    deg = np.degrees(a0)
+    deg = rad_to_deg(a0)
     fig, ax = new_figure(figsize=(7.0, 4.0))
     ax.plot(deg, r0, color=PALETTE[7], lw=1.0, label="unmodified profile")
     ax.plot(
@@ -55,7 +57,8 @@ def profile_figure(stage: Any) -> Figure:
 
 
 def contact_figures(result: Any) -> list[Figure]:
-    """Clearance & deformation per pin (paper Fig 7/10), force per pin, sweep over a pitch."""
+    """Clearance & deformation per pin (paper Fig 7/10), force per pin, sweep over a pitch, from
+    the ``result`` of a cycloid_stage study."""
     tc = result["tooth_contact"]
     v = tc.values
     idx = np.asarray(v["pin_index"])
@@ -110,7 +113,7 @@ def contact_figures(result: Any) -> list[Figure]:
         Figure(
             "Contact force per pin",
             f"F_i = (δ_i − Δ_i)/δ_max · F_max (eq 41); torque on the disc "
-            f"{v['torque_on_disc [N·mm]'] / 1e3:.1f} N·m.",
+            f"{Nmm_to_Nm(v['torque_on_disc [N·mm]']):.1f} N·m.",
             fig,
         )
     )
@@ -139,7 +142,7 @@ def contact_figures(result: Any) -> list[Figure]:
 
 
 def sensitivity_figure(result: Any) -> Figure:
-    """Bar chart of the sensitivity indices (Table 2)."""
+    """Bar chart of the sensitivity indices (Table 2) of a cycloid_stage ``result``."""
     v = result["geometric_te"].values
     names = list(v["sensitivity_index"])
     vals = np.array([v["sensitivity_index"][k] for k in names])
@@ -160,7 +163,7 @@ def sensitivity_figure(result: Any) -> Figure:
 
 
 def pareto_figure(result: Any) -> Figure:
-    """Pareto of the factors' TE contributions (mean) and tolerance shares."""
+    """Pareto of the factors' TE contributions (mean) and tolerance shares of a ``result``."""
     v = result["geometric_te"].values
     contrib = v["contribution [arcmin]"]
     tol = v["tolerance_contribution [arcmin]"]

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.units import mm_to_um
 
 __all__ = [
     "figures",
@@ -32,7 +33,7 @@ def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:
     """Histogram of sampled normal backlash [µm] with the analytic normal density overlaid."""
     v = backlash.values
     mean, sd = v["backlash_mean [um]"], v["backlash_sd [um]"]
-    samples = np.asarray(mc.samples) * 1e3
+    samples = mm_to_um(np.asarray(mc.samples))
     fig, ax = new_figure()
     from gearte.plotting.display import STRIP_BELOW, distribution
 

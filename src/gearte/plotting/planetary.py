@@ -11,6 +11,7 @@ import numpy as np
 
 from gearte.labels import label
 from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.units import rad_to_arcsec
 
 _OPT = "optimal_assembly_te [arcsec]"
 
@@ -63,7 +64,7 @@ def te_period_figure(result: Any) -> Figure | None:
     te = a.data["te"]
     u = a.data["u"]
     per = float(1 / te.q0)  # input revolutions per common period
-    y = te.signal(u) * abs(te.scale) * 648000.0 / np.pi
+    y = rad_to_arcsec(te.signal(u) * abs(te.scale))
     fig, ax = new_figure()
     ax.plot(u / (2 * np.pi) * per, y, color=PALETTE[0], lw=1.2, label="Σ e(t) (coupled)")
     amp = a["coupled_te_amplitude [arcsec]"]
@@ -76,7 +77,7 @@ def te_period_figure(result: Any) -> Figure | None:
 
         d = result["assembly"].data
         opt = coupled_te(d["terms"], d["mags"], d["optimal"].angles)
-        yo = opt.signal(u) * abs(opt.scale) * 648000.0 / np.pi
+        yo = rad_to_arcsec(opt.signal(u) * abs(opt.scale))
         ax.plot(
             u / (2 * np.pi) * per,
             yo,

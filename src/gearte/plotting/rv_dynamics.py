@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
+from gearte.units import mm_to_um, rad_to_arcsec
 
 __all__ = ["figures"]
 
@@ -115,12 +116,12 @@ def _dte_figures(a) -> list[Figure]:
         ix, iy = names.index(f"{b}.x"), names.index(f"{b}.y")
         it, iw = names.index(f"{b}.theta"), names.index(f"{b}.omega")
         s = r.states
-        axes[0, c].plot(s[:, ix] * 1e3, s[:, iy] * 1e3, lw=0.5, color=PALETTE[0])
+        axes[0, c].plot(mm_to_um(s[:, ix]), mm_to_um(s[:, iy]), lw=0.5, color=PALETTE[0])
         axes[0, c].set_title(b, fontsize=9)
         axes[0, c].set_xlabel("x [µm]")
         axes[0, c].set_ylabel("y [µm]")
         th = s[:, it] - s[:, it].mean()
-        axes[1, c].plot(th * 206264.806, s[:, iw], lw=0.5, color=PALETTE[2])
+        axes[1, c].plot(rad_to_arcsec(th), s[:, iw], lw=0.5, color=PALETTE[2])
         axes[1, c].set_xlabel("θ − mean [arcsec]")
         axes[1, c].set_ylabel("dθ/dt [rad/s]")
     out.append(

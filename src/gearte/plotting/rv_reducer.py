@@ -6,7 +6,14 @@ from __future__ import annotations
 import numpy as np
 
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
-from gearte.units import format_quantity, rad_to_arcmin, rad_to_arcsec, rad_to_deg
+from gearte.units import (
+    Nm_to_Nmm,
+    Nmm_per_rad_to_Nm_per_arcmin,
+    format_quantity,
+    rad_to_arcmin,
+    rad_to_arcsec,
+    rad_to_deg,
+)
 
 __all__ = ["figures"]
 
@@ -92,7 +99,7 @@ def _hysteresis(cat, rated: float) -> Figure:
             ang[i100] + rad_to_arcmin((t - 100.0) / 100.0 * rated / k),
             color=PALETTE[1],
             lw=2,
-            label=f"rigidity {format_quantity(k / 1e3 / rad_to_arcmin(1.0), 'N*m/arcmin')}",
+            label=f"rigidity {format_quantity(Nmm_per_rad_to_Nm_per_arcmin(k), 'N*m/arcmin')}",
         )
     lost = format_quantity(rad_to_arcmin(cat.lost_motion), "arcmin")
     ax.axvspan(-3.0, 3.0, color=PALETTE[2], alpha=0.2, label=f"±3 %: lost motion {lost}")
@@ -142,7 +149,7 @@ def figures(result) -> list[Figure]:
         out += for_analysis("transmission_error", [_te(result["transmission_error"].data["te"])])
     if "catalogue" in result:
         cat = result["catalogue"].data["catalogue"]
-        rated = result["catalogue"]["rated_torque [N*m]"] * 1e3
+        rated = Nm_to_Nmm(result["catalogue"]["rated_torque [N*m]"])
         out += for_analysis("catalogue", [_hysteresis(cat, rated)])
     if "compensation" in result:
         comp = result["compensation"].data["compensation"]

@@ -35,7 +35,7 @@ def _num(v: Any) -> float:
 
 
 def varying_columns(result: Any) -> list[str]:
-    """Scalar results that are not the same at every point."""
+    """Scalar results of a sweep ``result`` that are not the same at every point."""
     out = []
     for col in result.columns:
         vals = result.column(col)

@@ -60,7 +60,8 @@ class AssemblyPlan:
 
 
 def relevant_angles(terms: TermSet, magnitudes: Mapping[str, float]) -> tuple[str, ...]:
-    """Free angles that act on at least one term of non-zero amplitude."""
+    """Free angles of ``terms`` that act on at least one term of non-zero amplitude, given the
+    ``magnitudes`` [mm] per magnitude key."""
     out = []
     for a in terms.free_angles:
         if any(
@@ -223,7 +224,7 @@ def optimal_assembly(
     seed : int
         Seed of the Sobol scrambling (the result is deterministic).
     extra_starts : list of mappings, optional
-        Further start points (e.g. the paper's rule) that are always polished.
+        Further start points, angle name → angle [rad] (e.g. the paper's rule), always polished.
 
     Returns
     -------

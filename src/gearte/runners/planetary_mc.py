@@ -64,7 +64,10 @@ class MCResult:
 
 
 def te_upper_bound(terms: TermSet, tolerances: np.ndarray) -> float:
-    """Σ|gain| × tolerance × |scale| [rad]: no sample of any scenario can exceed it."""
+    """Σ|gain| × tolerance × |scale| [rad]: no sample of any scenario can exceed it.
+
+    ``terms`` the term set, ``tolerances`` [mm] per magnitude key (``terms.magnitudes`` order).
+    """
     idx = [terms.magnitudes.index(t.magnitude) for t in terms.terms]
     return float(sum(abs(t.gain) * tolerances[i] for t, i in zip(terms.terms, idx, strict=True)))
 
@@ -90,8 +93,11 @@ def draw_chunk(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Magnitudes (n, n_mag) [mm] and angles (n, n_ang) [rad] of one chunk of a scenario.
 
-    ``fixed_angles``/``fixed_mask``: the assembly angles a strategy sets (relative to the
-    reference, which is itself held at 0 in the allocated/optimal scenarios).
+    ``terms`` the term set, ``tolerances`` [mm] per magnitude key (in ``terms.magnitudes``
+    order), ``rng`` the chunk's generator, ``n`` samples, ``rayleigh_sigma_fraction`` [-]
+    Rayleigh scale / tolerance. ``fixed_angles`` [rad] / ``fixed_mask`` [-] (bool): the
+    assembly angles a strategy sets (relative to the reference, which is itself held at 0 in the
+    allocated/optimal scenarios).
     """
     na = len(terms.angles)
     if scenario in ("random_assembly", "random_assembly_half_tolerance"):
@@ -154,9 +160,11 @@ def run_scenario(
     assembly_angles : mapping, optional
         Angles [rad] the strategy sets (allocated/optimal scenarios); others are drawn uniformly.
     rayleigh_sigma_fraction : float
-        Rayleigh scale / tolerance (0.5: the tolerance is 2 sigma) in (0, 10].
+        Rayleigh scale / tolerance [-] (0.5: the tolerance is 2 sigma) in (0, 10].
     bins : int
         Histogram bins on [0, :func:`te_upper_bound`].
+    workers, scheduler, progress
+        Where the chunks run (:func:`gearte.execution.map_chunks`) and whether to show progress.
     """
     if scenario not in SCENARIOS:
         raise ParameterError("scenario", scenario, f"must be one of {SCENARIOS}")

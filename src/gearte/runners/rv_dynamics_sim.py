@@ -84,7 +84,8 @@ class DTEResult:
 
 
 def default_step(model: RVDynamicModel, fraction: float = 0.85) -> float:
-    """RK4 step [s]: ``fraction`` of the stability limit at the stiffest mesh state."""
+    """RK4 step [s] for ``model``: ``fraction`` [-] of the stability limit at the stiffest mesh
+    state."""
     if not 0 < fraction <= 1:
         raise ParameterError("fraction", fraction, "must be in (0, 1]")
     return fraction * rk4_stability_limit(model.damped_eigenvalues(mesh="max"))
@@ -102,11 +103,29 @@ def simulate_dte(
     rtol: float = 1e-8,
     atol: float = 1e-12,
 ) -> DTEResult:
-    """Integrate from static equilibrium at t = 0 and return the DTE after ``settle_s``.
+    """Integrate ``model`` from static equilibrium at t = 0 and return the DTE after ``settle_s``.
 
     The DTE is θ_o − θ_s / i (absolute rotations, so the nominal motion cancels) in arcsec.
     Recorded states: x, y, θ and their rates of each body in ``record_bodies`` (trajectories and
     phase portraits, paper Fig 10).
+
+    Parameters
+    ----------
+    model : RVDynamicModel
+    duration_s : float
+        Span recorded after settling [s].
+    settle_s : float
+        Span discarded first [s] (transient from the static equilibrium).
+    method : str
+        ``"rk4"`` (fixed step), ``"dopri5"`` (adaptive) or ``"scipy"`` (solve_ivp, plain twin).
+    dt : float, optional
+        RK4 step [s]; default :func:`default_step`.
+    record_dt : float, optional
+        Recording interval [s] (rounded to a multiple of the RK4 step); None records nothing.
+    record_bodies : tuple of str
+        Bodies whose states are recorded.
+    rtol, atol : float
+        Tolerances [-] of the adaptive methods (relative; absolute in the states' units).
     """
     if not duration_s > 0:
         raise ParameterError("duration_s", duration_s, "must be > 0")
@@ -186,6 +205,9 @@ def dte_spectrum(
     t: np.ndarray, dte: np.ndarray, sources: dict[str, float], n_peaks: int = 8
 ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Amplitude spectrum [arcsec] of a uniformly sampled DTE and its labelled peaks.
+
+    ``t`` [s] sample times, ``dte`` [arcsec] the samples, ``sources`` name → frequency [Hz] for
+    the labels, ``n_peaks`` [-] peaks kept.
 
     Hann window, amplitude-corrected; peaks are the ``n_peaks`` largest local maxima above
     0.1 % of the largest, labelled by :func:`label_frequency` within 1.5 frequency bins (at

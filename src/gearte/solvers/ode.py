@@ -103,7 +103,8 @@ def _rk4_amp(z: np.ndarray) -> np.ndarray:
 
 
 def rk4_stability_limit(eigenvalues: np.ndarray) -> float:
-    """Largest step h [s] with |R(hλ)| ≤ 1 for every eigenvalue λ (classical RK4).
+    """Largest step h [s] with |R(hλ)| ≤ 1 for every eigenvalue λ [1/s] in ``eigenvalues``
+    (classical RK4).
 
     R(z) = 1 + z + z²/2 + z³/6 + z⁴/24. For each λ the first crossing of |R| = 1 along the ray
     h λ is bracketed on a fine grid and refined by bisection; purely imaginary λ (|R| > 1 for
@@ -438,7 +439,12 @@ def integrate(
         Time [s] after t_span[0] before the output is summarised and recorded.
     record_dt : float, optional
         Recording interval [s] (a multiple of dt for RK4); ``None`` records nothing.
-    record_states : indices of state components recorded beside the output.
+    record_states : sequence of int, optional
+        Indices of state components recorded beside the output.
+    max_records : int
+        Most recorded rows allowed (memory bound; a longer record is an error).
+    max_steps : int
+        Most DOPRI5 steps before giving up (stiff or diverging system).
     args : tuple, optional
         Replaces ``system.args`` (e.g. another error realisation) without recompiling.
 

@@ -121,7 +121,7 @@ def sincos(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def grid_points(harmonics: Sequence[int] | np.ndarray) -> int:
-    """Nodes of the dense stage: 8 per period of the highest harmonic (>= 16), so that
+    """Nodes of the dense stage: 8 per period of the highest of ``harmonics`` (>= 16), so that
     ``n_max h = pi/4`` bounds the rotation angles of the refinement."""
     return max(16, 8 * int(max(harmonics)) if len(harmonics) else 16)
 
@@ -381,8 +381,10 @@ def exact_extremes_numpy(
     points: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Plain-numpy twin of :func:`exact_extremes`: grid of ``points`` (default 8 n_max) nodes,
-    Newton from *every* discrete local extremum (no pruning), vectorised; used to test the
-    compiled kernel and, with a fine grid, as the reference of the benchmark."""
+    Newton from *every* discrete local extremum (no pruning, ``iterations`` steps), vectorised;
+    used to test the compiled kernel and, with a fine grid, as the reference of the benchmark.
+    ``c`` constant part [mm], ``Z`` phasors per harmonic [mm], ``harmonics`` n_g [-] as for
+    :func:`exact_extremes`."""
     nh = np.asarray(harmonics, dtype=np.int64)
     c = np.atleast_1d(np.asarray(c, dtype=float))
     Z = np.atleast_2d(np.asarray(Z, dtype=complex))
@@ -423,7 +425,8 @@ def grid_extremes_numpy(
     c: np.ndarray, Z: np.ndarray, harmonics: Sequence[int], points: int = 2048
 ) -> tuple[np.ndarray, np.ndarray]:
     """Fixed-grid max/min over one period from the phasors (``points`` nodes, no refinement,
-    one matrix product) [mm]: the *optimised* grid of ``benchmarks/bench_planetary_mc.py``."""
+    one matrix product) [mm]: the *optimised* grid of ``benchmarks/bench_planetary_mc.py``.
+    ``c`` constant part [mm], ``Z`` phasors per harmonic [mm], ``harmonics`` n_g [-]."""
     nh = np.asarray(harmonics, dtype=np.int64)
     c = np.atleast_1d(np.asarray(c, dtype=float))
     Z = np.atleast_2d(np.asarray(Z, dtype=complex))

@@ -704,9 +704,9 @@ def run(case: Case, options) -> StudyResult:
             "stage_at_joint_max_after_shim [arcmin]": chain_values(res_shim),
         }
         if sh.verified_backlash_min_um is not None:
-            vals["verified_backlash_after_shim_min [um]"] = used[0] * 1e3
-            vals["verified_backlash_after_shim_mean [um]"] = used[1] * 1e3
-            vals["verified_backlash_after_shim_max [um]"] = used[2] * 1e3
+            vals["verified_backlash_after_shim_min [um]"] = mm_to_um(used[0])
+            vals["verified_backlash_after_shim_mean [um]"] = mm_to_um(used[1])
+            vals["verified_backlash_after_shim_max [um]"] = mm_to_um(used[2])
         analyses.append(
             AnalysisResult(
                 name="shim",

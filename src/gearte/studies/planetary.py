@@ -392,7 +392,9 @@ def run(case: Case, options) -> StudyResult:
                 "terms": rows,
                 "speeds [x input]": speeds,
                 "ratio": pset.ratio,
-                "output_scale [arcsec/um]": _arcsec(terms.scale * 1e-3),
+                "output_scale [arcsec/um]": _arcsec(
+                    terms.scale * um_to_mm(1.0)
+                ),  # [rad/mm]·[mm/µm]
                 "common_period [input rev]": str(1 / q0),
                 "harmonics": list(harm),
             },

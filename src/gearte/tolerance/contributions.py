@@ -48,7 +48,8 @@ def variance_shares(stack: LinearStack) -> dict[str, float]:
 def group_shares(
     shares: Mapping[str, float], stack: LinearStack | FunctionStack
 ) -> dict[str, float]:
-    """Sum shares of contributors sharing a ``group`` (ungrouped keep their own name)."""
+    """Sum ``shares`` [-] (contributor name → share) of the contributors of ``stack`` sharing a
+    ``group`` (ungrouped keep their own name)."""
     out: dict[str, float] = {}
     for c in stack.contributors:
         key = c.group or c.name
@@ -153,7 +154,8 @@ def sobol_indices(
 
 
 def pareto(shares: Mapping[str, float]) -> list[tuple[str, float, float]]:
-    """``(name, share, cumulative share)`` sorted by decreasing share."""
+    """``(name, share, cumulative share)`` of ``shares`` (name → share [-]), sorted by
+    decreasing share."""
     items = sorted(shares.items(), key=lambda kv: kv[1], reverse=True)
     out = []
     cum = 0.0

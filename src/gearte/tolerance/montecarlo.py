@@ -153,6 +153,8 @@ def _linear_stack_samples(rng, n, codes, params, sens, const, pool):  # pragma: 
 def linear_stack_reference(stack: LinearStack, rng: np.random.Generator, n: int) -> np.ndarray:
     """Plain per-sample Python loop: the basic reference of the compiled kernel.
 
+    ``n`` samples [the stack's unit] of ``stack`` drawn from ``rng``.
+
     Makes the same Generator calls in the same order as the kernel (contributor by contributor
     within a sample), so its samples are identical to the kernel's for the same Generator state.
     """
@@ -167,7 +169,8 @@ def linear_stack_reference(stack: LinearStack, rng: np.random.Generator, n: int)
 
 
 def kernel_samples(stack: LinearStack, rng: np.random.Generator, n: int) -> np.ndarray:
-    """Samples of a linear stack drawn by the compiled kernel (for tests and plots)."""
+    """``n`` samples [the stack's unit] of a linear ``stack`` drawn by the compiled kernel from
+    ``rng`` (for tests and plots)."""
     arrays = stack.kernel_arrays()
     if arrays is None:
         raise ParameterError("stack", stack.name, "has contributors the kernel cannot draw")
@@ -220,7 +223,12 @@ def reduce_samples(
     usl: float,
     keep: int,
 ) -> ChunkStats:
-    """Plain-numpy twin of the kernel's reduction (same formulas, same bin edges)."""
+    """Plain-numpy twin of the kernel's reduction (same formulas, same bin edges).
+
+    ``y`` samples [the quantity's unit]; ``shift`` [same unit] subtracted before the moments;
+    histogram over [``lo``, ``hi``] [same unit] in ``nbins`` bins; ``lsl``/``usl`` spec limits
+    [same unit] for the out-of-spec count; ``keep`` samples kept.
+    """
     y = np.asarray(y, dtype=float)
     d = y - shift
     b = np.floor((y - lo) * (nbins / (hi - lo)))
@@ -242,7 +250,10 @@ def reduce_samples(
 def process_capability(
     mean: float, sd: float, lower: float | None, upper: float | None
 ) -> tuple[float | None, float | None]:
-    """``(Cp, Cpk)`` against spec limits; Cp needs both limits, Cpk at least one.
+    """``(Cp, Cpk)`` [-] against spec limits; Cp needs both limits, Cpk at least one.
+
+    ``mean`` μ, ``sd`` σ, ``lower`` LSL and ``upper`` USL (None: no limit), all in the unit of
+    the quantity [same unit].
 
     ``Cp = (USL − LSL)/(6σ)``, ``Cpk = min(USL − μ, μ − LSL)/(3σ)``.
     """
@@ -408,9 +419,9 @@ def monte_carlo(
         Samples per chunk (fixes the random streams; memory per worker ~ ``8·chunk_size`` bytes
         on the numpy path, constant on the kernel path).
     lower_spec, upper_spec : float, optional
-        Specification limits for the out-of-spec fractions and Cp/Cpk.
+        Specification limits [the stack's unit] for the out-of-spec fractions and Cp/Cpk.
     percentiles : sequence of float
-        Percent levels to report.
+        Percent levels to report [%].
     keep : int
         Number of leading samples kept for plots.
     nbins : int

@@ -30,7 +30,7 @@ __all__ = [
 
 
 def z_for_confidence(confidence: float) -> float:
-    """Two-sided normal quantile: ``z`` with ``P(|Z| ≤ z) = confidence`` (0.9973 → 3.0)."""
+    """Two-sided normal quantile: ``z`` [-] with ``P(|Z| ≤ z) = confidence`` [-] (0.9973 → 3.0)."""
     from scipy.stats import norm
 
     if not 0.0 < confidence < 1.0:

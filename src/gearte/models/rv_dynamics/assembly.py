@@ -41,6 +41,7 @@ from gearte.units import (
     N_PER_M_TO_N_PER_MM,
     NM_PER_RAD_TO_NMM_PER_RAD,
     Nm_to_Nmm,
+    deg_to_rad,
 )
 
 __all__ = ["RVDynamicModel"]
@@ -86,10 +87,10 @@ class RVDynamicModel:
         )
         self.beta_cr = self.contact.pressure_angle_mean
         if p.cycloid_pressure_angle_deg is not None:
-            self.beta_cr = float(np.deg2rad(p.cycloid_pressure_angle_deg))
+            self.beta_cr = float(deg_to_rad(p.cycloid_pressure_angle_deg))
         sr = float(np.sum(self.contact.contact.radial_force_signed))
         self.sgn_radial = 1.0 if sr >= 0 else -1.0
-        alpha = np.deg2rad(p.pressure_angle_deg)
+        alpha = deg_to_rad(p.pressure_angle_deg)
         self.contact_ratio = involute_contact_ratio(p.sun_teeth, p.planet_teeth, p.module_mm, alpha)
         k1 = p.involute_single_pair_stiffness_N_per_m * N_PER_M_TO_N_PER_MM
         self.involute_fourier = rectangular_mesh_stiffness_fourier(
@@ -133,7 +134,7 @@ class RVDynamicModel:
             "w_o": p.output_speed,
             "ratio": p.ratio,
             "crank_rate": 1.0 - p.pair.pin_count,
-            "phi_h0": np.deg2rad(p.crank_phase_deg),
+            "phi_h0": deg_to_rad(p.crank_phase_deg),
             "a_h": p.centre_distance_mm,
             "ecc": p.pair.eccentricity_mm,
             "r_bs": self.r_bs,
@@ -212,7 +213,7 @@ class RVDynamicModel:
         w_o = p.output_speed
         th_o = w_o * t
         th_s = p.ratio * th_o
-        th_h = np.deg2rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
+        th_h = deg_to_rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
         a_h = p.centre_distance_mm
         ecc = p.pair.eccentricity_mm
         out = []
@@ -402,7 +403,7 @@ class RVDynamicModel:
         f[-1] = -Nm_to_Nmm(p.output_torque_Nm)
         w_o = p.output_speed
         th_o = w_o * t
-        th_h = np.deg2rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
+        th_h = deg_to_rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
         for i in range(m):
             psi = th_o + 2 * np.pi * i / m
             c = p.centre_distance_mm * np.array([np.cos(psi), np.sin(psi)]) * w_o**2

@@ -26,7 +26,14 @@ __all__ = [
 
 
 def involute_contact_ratio(z1: int, z2: int, module_mm: float, alpha_rad: float) -> float:
-    """Transverse contact ratio ε_α of a standard external spur pair (addendum = m) [-]."""
+    """Transverse contact ratio ε_α [-] of a standard external spur pair (addendum = m).
+
+    Teeth ``z1``, ``z2`` [-], module ``module_mm`` [mm], pressure angle ``alpha_rad`` [rad].
+
+    References
+    ----------
+    ISO 21771:2007, Gears — Cylindrical involute gears and gear pairs — Concepts and geometry.
+    """
     r1, r2 = module_mm * z1 / 2, module_mm * z2 / 2
     rb1, rb2 = r1 * np.cos(alpha_rad), r2 * np.cos(alpha_rad)
     ra1, ra2 = r1 + module_mm, r2 + module_mm
@@ -41,7 +48,14 @@ def rectangular_mesh_stiffness_fourier(
     """Fourier series (eq 11) of the rectangular-wave involute mesh stiffness.
 
     Two pairs in mesh (2 k_1) over the fraction ε_α − 1 of a mesh period, one pair (k_1) over the
-    rest: mean k_1 ε_α. Returns (mean, a_l, b_l) in the units of ``single_pair_stiffness``.
+    rest: mean k_1 ε_α. ``single_pair_stiffness`` k_1 [N/mm], ``contact_ratio`` ε_α [-] in (1, 2),
+    ``n_harmonics`` kept [-], ``n_samples`` [-] points of the wave over one period. Returns
+    (mean, a_l, b_l) in the units of ``single_pair_stiffness``.
+
+    References
+    ----------
+    Li X., Huang J., Ding C., Guo R., Niu W. (2023). Machines 11(6), 626.
+    doi:10.3390/machines11060626
     """
     if not 1.0 < contact_ratio < 2.0:
         raise ParameterError("contact_ratio", contact_ratio, "must be in (1, 2)")
@@ -74,6 +88,11 @@ def cycloid_mesh_stiffness_fourier(
     Returns
     -------
     (mean [N/mm], a_l [N/mm], b_l [N/mm])
+
+    References
+    ----------
+    Li X., Huang J., Ding C., Guo R., Niu W. (2023). Machines 11(6), 626.
+    doi:10.3390/machines11060626
     """
     k_mean, a, b = fourier_fit(mesh_stiffness, n_harmonics)
     if mean_only:

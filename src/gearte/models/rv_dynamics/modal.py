@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gearte.units import deg_to_rad
+
 if TYPE_CHECKING:  # the model calls these functions; typing only
     from gearte.models.rv_dynamics.assembly import RVDynamicModel
 
@@ -43,7 +45,7 @@ class ModalResult:
 def modal_analysis(
     model: RVDynamicModel, t: float = 0.0, *, input_shaft: bool = True, mesh: str = "mean"
 ) -> ModalResult:
-    """Undamped natural frequencies [Hz] and mode shapes of ``model`` at time t [s].
+    """Undamped natural frequencies [Hz] and mode shapes of ``model`` at time ``t`` [s].
 
     ``mesh`` selects the mesh stiffnesses ("mean", "time" or "max", see
     :meth:`RVDynamicModel.elements`); ``input_shaft=False`` removes the input torsional spring
@@ -58,15 +60,16 @@ def modal_analysis(
 
 
 def rigid_mode(model: RVDynamicModel, t: float = 0.0) -> np.ndarray:
-    """Analytic rigid-body vector for θ_o = 1 [rad]: θ_s = i, θ_p = θ_H = 1 − z_p, θ_c = 1.
+    """Analytic rigid-body vector of ``model`` for θ_o = 1 [rad]: θ_s = i, θ_p = θ_H = 1 − z_p,
+    θ_c = 1.
 
-    Translations [mm/rad] of the carried bodies at time t [s] follow from their rotation.
+    Translations [mm/rad] of the carried bodies at time ``t`` [s] follow from their rotation.
     """
     p = model.params
     m, n = p.crank_count, p.disc_count
     q = np.zeros(model.n_dof)
     th_o = p.output_speed * t
-    th_h = np.deg2rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
+    th_h = deg_to_rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
     rate = 1.0 - p.pair.pin_count
     q[2] = p.ratio
     for i in range(m):
@@ -85,14 +88,19 @@ def rigid_mode(model: RVDynamicModel, t: float = 0.0) -> np.ndarray:
 
 
 def stiffness_proportional_damping(model: RVDynamicModel) -> float:
-    """β_R = 2ζ/ω_1 [s], ω_1 the lowest elastic mode (with the input shaft), ζ the damping ratio."""
+    """β_R = 2ζ/ω_1 [s] of ``model``: ω_1 its lowest elastic mode (with the input shaft), ζ its
+    damping ratio."""
     f = modal_analysis(model).frequencies
     w1 = 2 * np.pi * f[f > 0][0]
     return 2.0 * model.params.damping_ratio / w1
 
 
 def damped_eigenvalues(model: RVDynamicModel, t: float = 0.0, *, mesh: str = "max") -> np.ndarray:
-    """Eigenvalues [1/s] of the first-order state matrix at time t [s] (stability limit)."""
+    """Eigenvalues [1/s] of the first-order state matrix of ``model`` at time ``t`` [s].
+
+    ``mesh`` as in :func:`modal_analysis` ("max": the stiffest state, for the RK4 stability
+    limit).
+    """
     K = model.stiffness_matrix(t, mesh=mesh)
     minv = 1.0 / model.mass
     nd = model.n_dof
@@ -106,9 +114,10 @@ def damped_eigenvalues(model: RVDynamicModel, t: float = 0.0, *, mesh: str = "ma
 def resonance_warnings(
     model: RVDynamicModel, margin: float = 0.1, harmonics: tuple[int, ...] = (1,)
 ) -> list[str]:
-    """Warnings when a mesh frequency [Hz] × ``harmonics`` lies within ±margin of a mode.
+    """Warnings when a mesh frequency [Hz] of ``model`` × ``harmonics`` lies within ±margin of a
+    natural frequency.
 
-    ``margin`` is the relative band (0.1 = ±10 %).
+    ``margin`` [-] is the relative band (0.1 = ±10 %).
     """
     freqs = modal_analysis(model).frequencies
     freqs = freqs[freqs > 0]

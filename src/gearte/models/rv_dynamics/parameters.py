@@ -23,7 +23,7 @@ import numpy as np
 from gearte.errors import ParameterError
 from gearte.models.cycloid_loaded_contact import CycloidPinPair
 from gearte.models.rv_dynamics.mesh_stiffness import involute_contact_ratio
-from gearte.units import N_PER_M_TO_N_PER_MM
+from gearte.units import N_PER_M_TO_N_PER_MM, deg_to_rad, rad_to_deg, rpm_to_rad_per_s
 
 __all__ = [
     "RVDynamicsParameters",
@@ -137,7 +137,7 @@ class RVDynamicsParameters:
     @property
     def output_speed(self) -> float:
         """ω_o, nominal output speed [rad/s]."""
-        return self.input_speed_rpm * 2.0 * np.pi / 60.0 / self.ratio
+        return rpm_to_rad_per_s(self.input_speed_rpm) / self.ratio
 
     @property
     def centre_distance_mm(self) -> float:
@@ -238,7 +238,7 @@ class RVErrors:
         """
         if placement not in ("first", "all"):
             raise ParameterError("placement", placement, "must be 'first' or 'all'")
-        d = np.deg2rad
+        d = deg_to_rad
         m, n = crank_count, disc_count
         mask_m = np.zeros(m)
         mask_mn = np.zeros((m, n))
@@ -318,7 +318,7 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
         sun_teeth=fs.sun_teeth,
         planet_teeth=fs.planet_teeth,
         module_mm=fs.module,
-        pressure_angle_deg=float(np.degrees(fs.pressure_angle)),
+        pressure_angle_deg=rad_to_deg(float(fs.pressure_angle)),
         crank_count=cr.count,
         disc_count=di.count,
         pair=pair,

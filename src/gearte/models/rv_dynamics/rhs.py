@@ -103,7 +103,8 @@ def _fourier2(mean, coef, c1, s1):
 
 @njit(cache=True, nogil=True)
 def rv_rhs(t, y, args, dydt, work):
-    """dy/dt of the lumped RV model (compiled; plain twin: ``RVDynamicModel.rhs_numpy``).
+    """dy/dt of the lumped RV model at time ``t`` [s], written into ``dydt`` (compiled; plain twin:
+    ``RVDynamicModel.rhs_numpy``).
 
     y = [q (6M+3N+6), q̇]; q per body (x [mm], y [mm], θ [rad]) in the order sun, planets 1..M,
     cranks 1..M, discs 1..N, output. ``args`` = (pf, inv_mass, fsp, fcr, err_g, err_m, err_mn,
@@ -338,7 +339,8 @@ def rv_rhs(t, y, args, dydt, work):
 
 @njit(cache=True, nogil=True)
 def rv_dte(t, y, args):
-    """Dynamic transmission error θ_o − θ_s / i [rad] of state y."""
+    """Dynamic transmission error θ_o − θ_s / i [rad] of state ``y`` at time ``t`` [s]; ``args``
+    as for :func:`rv_rhs`."""
     pf = args[0]
     nd = 3 * (2 * int(pf[30]) + int(pf[31]) + 2)
     return y[nd - 1] - y[2] / pf[1]
