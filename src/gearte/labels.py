@@ -80,8 +80,8 @@ def label(name: str) -> str:
 
 
 def label_with_unit(name: str) -> str:
-    """:func:`label` followed by the unit in brackets: ``"Peak pin load [N]"``, ``"Output TE
-    [arcsec]"``, ``"Backlash [µm]"``."""
+    """:func:`label` of ``name`` (a result name) followed by the unit in brackets:
+    ``"Peak pin load [N]"``, ``"Output TE [arcsec]"``, ``"Backlash [µm]"``."""
     _, unit = split_unit(str(name))
     text = label(name)
     return f"{text} [{unit_text(unit)}]" if unit else text

@@ -198,7 +198,7 @@ def split_unit(name: str) -> tuple[str, str]:
 
 
 def format_number(x: object, digits: int = 4) -> str:
-    """A number for people: ``digits`` significant digits, no exponent between 1e-3 and 1e6,
+    """The number ``x`` for people: ``digits`` significant digits, no exponent between 1e-3 and 1e6,
     integers as integers, booleans as yes/no; NaN, infinities and ``None`` as an em dash."""
     if x is None:
         return "—"
@@ -228,8 +228,9 @@ def format_number(x: object, digits: int = 4) -> str:
 
 
 def format_quantity(x: object, unit: str = "", digits: int = 4) -> str:
-    """A value with its unit for people: ``(1.0339, "arcmin")`` → ``1.034′``, ``(1904.6, "N")``
-    → ``1905 N``, ``(17.19, "um")`` → ``17.19 µm``, NaN → ``—`` (no unit)."""
+    """The value ``x`` with its ``unit`` for people (``digits`` significant digits):
+    ``(1.0339, "arcmin")`` → ``1.034′``, ``(1904.6, "N")`` → ``1905 N``, ``(17.19, "um")`` →
+    ``17.19 µm``, NaN → ``—`` (no unit)."""
     text = format_number(x, digits)
     if not unit or text == "—":
         return text

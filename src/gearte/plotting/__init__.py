@@ -29,7 +29,8 @@ class Figure:
 
 
 def for_analysis(name: str, figs: list[Figure]) -> list[Figure]:
-    """Mark figures as illustrating the analysis ``name`` (the report shows them beside it)."""
+    """Mark the figures ``figs`` as illustrating the analysis ``name`` (the report shows them
+    beside it)."""
     for f in figs:
         f.analysis = name
     return figs

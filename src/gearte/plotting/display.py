@@ -26,9 +26,10 @@ STRIP_BELOW = 30
 
 
 def decimate(x: np.ndarray, y: np.ndarray, max_points: int = MAX_POINTS) -> np.ndarray:
-    """Indices of the points of ``(x, y)`` to draw: all of them if there are at most
-    ``max_points``; else the first, the last, and in each of ``max_points // 4`` buckets of
-    consecutive points the ones with the smallest and largest ``x`` and ``y`` (in order).
+    """Indices of the points of ``x`` [any unit], ``y`` [any unit] to draw (``max_points``
+    [-]): all of them if there are at most ``max_points``; else the first, the last, and in
+    each of ``max_points // 4`` buckets of consecutive points the ones with the smallest and
+    largest ``x`` and ``y`` (in order).
 
     Works for signals (``x`` increasing: the min/max envelope of ``y`` is kept exactly) and for
     curves such as trajectories and phase portraits (their extent in both directions is kept).
@@ -142,7 +143,8 @@ def _legends_outside(fig: Any) -> None:
 
 
 def polish(fig: Any) -> Any:
-    """Decimate long lines, put legends outside the data and integer ticks on integer data."""
+    """Decimate long lines of ``fig`` (a matplotlib figure), put legends outside the data and
+    integer ticks on integer data."""
     _decimate_lines(fig)
     _integer_ticks(fig)
     _legends_outside(fig)
@@ -151,7 +153,8 @@ def polish(fig: Any) -> Any:
 
 def distribution(ax: Any, samples: Any, *, color: str, label: str = "", density: bool = False,
                  bins: int | None = None) -> str:  # fmt: skip
-    """Samples on ``ax`` along x: a histogram, or a strip plot below :data:`STRIP_BELOW` samples.
+    """Samples on ``ax`` along x: a histogram, or a strip plot below :data:`STRIP_BELOW` samples,
+    in ``color``, named ``label``; ``density`` and ``bins`` as in ``Axes.hist``.
 
     Returns ``"histogram"`` or ``"strip"`` (the y label to use differs)."""
     s = np.asarray(samples, dtype=float)

@@ -66,7 +66,7 @@ def render_figures(
     available, forked copies of this process render shares of the figures in parallel and send
     the PNGs back (the figures are not pickled: a fork inherits them). ``timings`` (if given)
     receives ``"figures"`` (building the matplotlib figures) and ``"render"`` (drawing them to
-    PNG), in seconds.
+    PNG), in seconds [s].
     """
     from gearte.plotting import figures_for
 

@@ -226,8 +226,8 @@ def _change_text(stem: str, unit: str, before: float, after: float) -> str:
 
 
 def tradeoff_warnings(result: Any, *, threshold: float = 0.01) -> list[str]:
-    """Warnings for recommendations that worsen another reported quantity by more than
-    ``threshold`` (relative; any change of a count)."""
+    """Warnings for the analyses of ``result`` whose recommendations worsen another reported
+    quantity by more than ``threshold`` [-] (relative; any change of a count)."""
     out = []
     for a in result.analyses:
         pairs = _pairs(a.values)

@@ -123,7 +123,7 @@ def _is_scalar(v: Any) -> bool:
 
 
 def is_series(v: Any) -> bool:
-    """A list/array of numbers (``None``/NaN allowed), any shape."""
+    """Whether ``v`` is a list/array of numbers (``None``/NaN allowed), any shape."""
     if isinstance(v, np.ndarray):
         return v.dtype.kind in "biuf" or (
             v.dtype == object and all(x is None or _is_number(x) for x in v.ravel())
@@ -156,7 +156,7 @@ def _as_float(v: Any) -> np.ndarray:
 
 
 def summarise_series(v: Any) -> dict[str, Any]:
-    """Count, NaN count, min, mean, max of a numeric series, skipping NaN/None."""
+    """Count, NaN count, min, mean, max of the numeric series ``v``, skipping NaN/None."""
     shape = np.shape(np.asarray(v, dtype=object))
     x = _as_float(v)
     ok = x[np.isfinite(x)]
@@ -317,12 +317,14 @@ def analysis_tables(analysis: Any) -> list[Table]:
 
 
 def item_label(key: str) -> str:
-    """An item of a mapping (a factor, a stage) for people: identifiers get :func:`label`."""
+    """``key``, an item of a mapping (a factor, a stage), for people: identifiers get
+    :func:`label`."""
     return label(key) if "_" in key and " " not in key else key
 
 
 def relative_change(before: float, after: float) -> str:
-    """The relative change for people: `` (+17 %)``; `` (×3110)`` over 1000 %; ``""`` from 0."""
+    """The relative change from ``before`` [any unit] to ``after`` [same unit] for people:
+    `` (+17 %)``; `` (×3110)`` over 1000 %; ``""`` from 0."""
     if not before:
         return ""
     r = 100 * (after - before) / abs(before)
