@@ -207,4 +207,6 @@ def figures(result: Any) -> list[Figure]:
         out += for_analysis("geometric_te", [sensitivity_figure(result), pareto_figure(result)])
     if "tooth_contact" in result:
         out += for_analysis("tooth_contact", contact_figures(result))
-    return out
+    from gearte.plotting.yield_figures import yield_figures
+
+    return out + yield_figures(result)

@@ -128,6 +128,8 @@ def mc_histograms_figure(result: Any) -> Figure | None:
 
 def figures(result: Any) -> list[Figure]:
     """All figures of a ``planetary`` result."""
+    from gearte.plotting.yield_figures import yield_figures
+
     out = [phasor_figure(result), te_period_figure(result), mc_histograms_figure(result)]
     names = [
         "coupled_te",
@@ -137,4 +139,4 @@ def figures(result: Any) -> list[Figure]:
     for f, name in zip(out, names, strict=True):
         if f is not None:
             f.analysis = name
-    return [f for f in out if f is not None]
+    return [f for f in out if f is not None] + yield_figures(result)

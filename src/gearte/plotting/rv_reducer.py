@@ -154,4 +154,7 @@ def figures(result) -> list[Figure]:
     if "compensation" in result:
         comp = result["compensation"].data["compensation"]
         out += for_analysis("compensation", [_compensation(comp)])
+    from gearte.plotting.yield_figures import yield_figures
+
+    out += yield_figures(result)
     return out

@@ -26,6 +26,7 @@ from pydantic import ConfigDict, Field, model_validator
 from gearte.errors import ParameterError
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.results import AnalysisResult, StudyResult
+from gearte.studies._yield import YieldSection
 
 KIND = "cycloid_stage"
 REFERENCES = ["hu2020"]
@@ -205,6 +206,9 @@ class Analyses(_Section):
     geometric_te: GeometricTEOptions | None = None
     tooth_contact: ToothContactOptions | None = None
     compensation: CompensationOptions | None = None
+    yield_: YieldSection | None = Field(
+        default=None, alias="yield", description="production yield (gearte.studies._yield)"
+    )
 
 
 class Case(CaseBase):
@@ -492,4 +496,39 @@ def run(case: Case, options) -> StudyResult:
         warnings += w
     if case.analyses.compensation is not None:
         analyses.append(_compensation(st, case))
+    if case.analyses.yield_ is not None:
+        analyses.append(_yield(st, case, options))
     return StudyResult(case=case, analyses=analyses, warnings=warnings)
+
+
+def _yield(st, case: Case, options) -> AnalysisResult:
+    """``[analyses.yield]``: the nine component errors [µm] drawn from their laws → the
+    distribution of the geometric TE (not only eq 17's RSS band) and its yield."""
+    from gearte.models.cycloid_te import ERROR_FACTORS
+    from gearte.runners.yield_models import CycloidGeometricTE
+    from gearte.studies._yield import ToleranceEntry, yield_analysis
+
+    means = {k: getattr(case.errors, k).mean_um for k in ERROR_FACTORS}
+    # the [errors] bands (mean ± T/2) as normal laws with σ = T/6, unless the section says else
+    bands = {
+        k: ToleranceEntry(tolerance_um=0.5 * getattr(case.errors, k).tolerance_um)
+        for k in ERROR_FACTORS
+        if getattr(case.errors, k).tolerance_um > 0
+    }
+
+    def worst_case(errors):
+        d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
+        d["errors"] = {k: {"mean_um": float(errors.get(k, means[k]))} for k in ERROR_FACTORS}
+        d["analyses"] = {"geometric_te": {}}
+        return d
+
+    return yield_analysis(
+        case.analyses.yield_,  # type: ignore[arg-type]
+        CycloidGeometricTE(st, means),
+        {k: "um" for k in ERROR_FACTORS},
+        means,
+        options=options,
+        worst_case=worst_case,
+        references=["hu2020"],
+        defaults=bands,
+    )

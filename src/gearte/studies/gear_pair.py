@@ -84,9 +84,34 @@ class SpurGearSpec(_ThicknessLimits):
     """One spur gear: teeth, tooth-thickness deviations, radial composite tolerance."""
 
     teeth: int = Field(ge=5, le=10_000, description="Number of teeth z.")
-    radial_composite_tol_um: float = Field(
-        gt=0, le=10_000, description="Radial composite tolerance F''i [µm]; Rayleigh σx = F''i/6."
+    radial_composite_tol_um: float | None = Field(
+        default=None,
+        gt=0,
+        le=10_000,
+        description="Radial composite tolerance F''i [µm]; Rayleigh σx = F''i/6. Or give grade.",
     )
+    grade: int | None = Field(
+        default=None,
+        ge=4,
+        le=11,
+        description="Accuracy grade instead of radial_composite_tol_um: F''i from ISO 1328-2 "
+        "(1997 formulas) at the pair's module and d = m·z (gearte.tolerance.iso1328).",
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> SpurGearSpec:
+        if (self.radial_composite_tol_um is None) == (self.grade is None):
+            raise ValueError("give exactly one of radial_composite_tol_um and grade")
+        return self
+
+    def radial_composite_um(self, module_mm: float) -> float:
+        """F''i [µm]: as given, or from the grade (ISO 1328-2:1997, rounded)."""
+        if self.radial_composite_tol_um is not None:
+            return float(self.radial_composite_tol_um)
+        from gearte.tolerance.iso1328 import radial_composite_tolerances
+
+        assert self.grade is not None  # one of the two is given (validated)
+        return radial_composite_tolerances(self.grade, module_mm, module_mm * self.teeth).F_i2
 
 
 class _Clearance(StrictModel):
@@ -241,13 +266,19 @@ class SpurPairSpec(_Clearance, _Distributions):
     driving: SpurGearSpec
     driven: SpurGearSpec
 
+    @model_validator(mode="after")
+    def _grades_in_range(self) -> SpurPairSpec:
+        for g in (self.driving, self.driven):
+            g.radial_composite_um(self.module_mm)  # ParameterError naming the field if outside
+        return self
+
     def build(self) -> SpurPair:
         def gear(g: SpurGearSpec) -> SpurGear:
             return SpurGear(
                 g.teeth,
                 float(um_to_mm(g.thickness_upper_um)),
                 float(um_to_mm(g.thickness_lower_um)),
-                float(um_to_mm(g.radial_composite_tol_um)),
+                float(um_to_mm(g.radial_composite_um(self.module_mm))),
             )
 
         return SpurPair(

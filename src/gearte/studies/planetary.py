@@ -33,6 +33,7 @@ from gearte.models.planetary_errors import (
     terms_from_table,
 )
 from gearte.results import AnalysisResult, StudyResult
+from gearte.studies._yield import YieldSection
 from gearte.units import deg_to_rad, mm_to_um, rad_to_arcsec, rad_to_deg, um_to_mm
 
 KIND = "planetary"
@@ -213,6 +214,9 @@ class Analyses(StrictModel):
     coupled_te: CoupledTEOptions | None = Field(default_factory=CoupledTEOptions)
     assembly: AssemblyOptions | None = Field(default_factory=AssemblyOptions)
     monte_carlo: MonteCarloOptions | None = None
+    yield_: YieldSection | None = Field(
+        default=None, alias="yield", description="production yield (gearte.studies._yield)"
+    )
 
 
 class Case(CaseBase):
@@ -509,6 +513,9 @@ def run(case: Case, options) -> StudyResult:
             )
         )
 
+    if case.analyses.yield_ is not None:
+        analyses.append(_yield(case, terms, mags, angs, options))
+
     # ---- Monte-Carlo
     mc = case.analyses.monte_carlo
     if mc is not None:
@@ -562,3 +569,43 @@ def run(case: Case, options) -> StudyResult:
                 )
             )
     return StudyResult(case=case, analyses=analyses, warnings=warnings)
+
+
+def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> AnalysisResult:
+    """``[analyses.yield]``: magnitudes [µm] and directions [deg] as tolerances (e.g. Wang's
+    random assembly: each direction ``uniform``, ``nominal_deg = 180``, ``tolerance_deg =
+    180``) → yield of the coupled TE."""
+    from gearte.runners.yield_models import PlanetaryCoupledTE
+    from gearte.studies._yield import yield_analysis
+
+    mag_um = {k: float(mm_to_um(v)) for k, v in mags.items()}
+    ang_deg = {k: float(rad_to_deg(v)) for k, v in angs.items()}
+    units = {k: "um" for k in terms.magnitudes} | {k: "deg" for k in terms.angles}
+    nominal = {
+        **{k: mag_um.get(k, 0.0) for k in terms.magnitudes},
+        **{k: ang_deg.get(k, 0.0) for k in terms.angles},
+    }
+
+    def worst_case(errors):
+        d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
+        d.pop("name", None)
+        d["errors"]["magnitudes_um"] = {
+            **d["errors"]["magnitudes_um"],
+            **{k: errors[k] for k in terms.magnitudes if k in errors},
+        }
+        d["errors"]["angles_deg"] = {
+            **d["errors"].get("angles_deg", {}),
+            **{k: errors[k] for k in terms.angles if k in errors},
+        }
+        d["analyses"] = {"coupled_te": {"assembly": "given"}}
+        return d
+
+    return yield_analysis(
+        case.analyses.yield_,  # type: ignore[arg-type]
+        PlanetaryCoupledTE(terms, mag_um, ang_deg),
+        units,
+        nominal,
+        options=options,
+        worst_case=worst_case,
+        references=["wang2013"],
+    )

@@ -44,12 +44,14 @@ from gearte.geometry.rv import (
 )
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.results import AnalysisResult, StudyResult
+from gearte.studies._yield import YieldSection
 from gearte.units import (
     Nm_to_Nmm,
     arcmin_to_rad,
     deg_to_rad,
     rad_to_arcmin,
     rad_to_arcsec,
+    rad_to_deg,
     um_to_mm,
 )
 
@@ -262,11 +264,25 @@ class CompensationSection(StrictModel):
     bounds_um: Bounds
 
 
+class RVYieldSection(YieldSection):
+    """``[analyses.yield]`` of an RV reducer (gearte.studies._yield): tolerance keys are the
+    error families ``planet_base_circle``, ``disc_crank_bore``, ``cam``, ``carrier_crank_bore``
+    (magnitude [µm], ``kind = "rayleigh"``, ``phase = true`` for a uniform direction),
+    ``pins.radius_errors``, ``pins.radial_position_errors``, ``pins.tangential_position_errors``
+    [µm], or one instance (``cam.c1.d2``, ``pins.radius_errors.p7``)."""
+
+    positions: int = Field(default=36, ge=2, le=3600, description="TE output positions")
+    te_torque_Nm: float | None = Field(
+        default=None, gt=0, le=1e6, description="torque of the loaded TE; default rated"
+    )
+
+
 class Analyses(StrictModel):
     load_sharing: LoadSharingSection | None = None
     transmission_error: TESection | None = None
     catalogue: CatalogueSection | None = None
     compensation: CompensationSection | None = None
+    yield_: RVYieldSection | None = Field(default=None, alias="yield")
 
 
 class Case(CaseBase):
@@ -579,6 +595,8 @@ def run(case: Case, options=None) -> StudyResult:
         out.append(_catalogue(red, a.catalogue))
     if a.compensation is not None:
         out.append(_compensation(red, a.compensation))
+    if a.yield_ is not None:
+        out.append(_yield(case, red0 if red0 is not None else red, a.yield_, options))
     warnings = []
     if not out:
         warnings.append("no analyses requested: add [analyses.load_sharing] etc.")
@@ -591,3 +609,70 @@ def run(case: Case, options=None) -> StudyResult:
                 f"reducer.allowable_contact_pressure_MPa = {allowable:g} MPa"
             )
     return StudyResult(case=case, analyses=out, warnings=warnings)
+
+
+def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
+    """``[analyses.yield]``: each sample one assembled reducer (errors drawn from the
+    tolerances; errors without a tolerance keep the case's values) → catalogue test, angular TE
+    over one output revolution, peak pin load; yield against ``[analyses.yield.spec]``."""
+    from gearte.runners.yield_models import RV_PIN_FAMILIES, RVReducerYield, rv_error_keys
+    from gearte.studies._yield import yield_analysis
+
+    model = RVReducerYield(
+        build_reducer(case.reducer),
+        positions=sec.positions,
+        te_torque=None if sec.te_torque_Nm is None else float(Nm_to_Nmm(sec.te_torque_Nm)),
+    )
+    families = rv_error_keys(red)
+    units = {k: "um" for k in families} | {k: "um" for v in families.values() for k in v}
+
+    def worst_case(errors):
+        d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
+        entries = {(e["part"], e["crank"], e.get("disc")): e for e in d["reducer"]["errors"]}
+        for part in ("planet_base_circle", "disc_crank_bore", "cam", "carrier_crank_bore"):
+            for key in families[part]:
+                if key not in errors:
+                    continue
+                idx = key.split(".")[1:]
+                crank = int(idx[0][1:])
+                disc = int(idx[1][1:]) if len(idx) > 1 else None
+                entry = {"part": part, "crank": crank, "value_um": float(errors[key])}
+                if disc is not None:
+                    entry["disc"] = disc
+                phase = float(errors.get(f"{key}_phase_rad", 0.0))
+                entry["angle_deg"] = float(np.mod(rad_to_deg(phase) + 180.0, 360.0) - 180.0)
+                entries[(part, crank, disc)] = entry
+        d["reducer"]["errors"] = list(entries.values())
+        pins = d["reducer"]["pins"]
+        for f in RV_PIN_FAMILIES:
+            keys = families[f"pins.{f}"]
+            if any(k in errors for k in keys):
+                old = pins.get(f"{f}_um") or [0.0] * len(keys)
+                pins[f"{f}_um"] = [float(errors.get(k, old[i])) for i, k in enumerate(keys)]
+        te_torque = sec.te_torque_Nm or case.reducer.rated_torque_Nm
+        d["analyses"] = {
+            "catalogue": {"lost_motion_fraction": 0.03},
+            "transmission_error": {"torque_Nm": te_torque, "positions": max(8, sec.positions)},
+        }
+        return d
+
+    def grade_um(key: str, grade: int) -> float | None:
+        """planet_base_circle: eccentricity tolerance F_rT/2 of the planet (ISO 1328-1:2013)."""
+        from gearte.tolerance.iso1328 import runout_tolerance
+
+        fs = case.reducer.first_stage
+        if key.split(".")[0] != "planet_base_circle":
+            return None
+        return 0.5 * runout_tolerance(grade, fs.module_mm, fs.module_mm * fs.planet_teeth)
+
+    return yield_analysis(
+        sec,
+        model,
+        units,
+        {},
+        options=options,
+        worst_case=worst_case,
+        references=["han2023", "hu2020"],
+        families=families,
+        grade_um=grade_um,
+    )

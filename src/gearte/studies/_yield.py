@@ -1,0 +1,467 @@
+"""``[analyses.yield]``: the production-yield analysis any study kind can offer.
+
+A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) adds
+``yield: YieldSection | None`` to its analyses and calls :func:`yield_analysis`. The section::
+
+    [analyses.yield]
+    samples = 20_000            # assembled drives drawn
+    seed = 14
+    confidence = 0.95           # of the yield's interval
+    ci_method = "wilson"        # or "clopper-pearson"
+    sobol_samples = 2_000       # 0: no Sobol indices
+    bootstrap = 100
+    keep_worst = 3              # worst samples written as case files
+
+    [analyses.yield.tolerances.<error key>]   # keys: the drive's error keys
+    kind = "normal"     # normal | truncated_normal | uniform | rayleigh | empirical | constant
+    tolerance_um = 8.0          # or tolerance_deg for an angle key, or grade = N for a gear's
+                                # eccentricity (ISO 1328-1:2013: tolerance = F_rT/2)
+    nominal_um = 0.0            # default: the case's value of that error
+    sigmas = 3.0                # optional: σ = tolerance / sigmas
+    phase = false               # rayleigh: also a uniform direction
+    values_um = [...]           # empirical: measured deviations
+
+    [[analyses.yield.groups]]   # correlated errors (one batch)
+    name = "pins"; keys = ["pin_radius_error", "pin_circle_radius_error"]; rho = 0.8
+
+    [analyses.yield.spec."geometric_te [arcmin]"]
+    upper = 1.0                 # and/or lower
+
+    [analyses.yield.allocation]           # optional: cheapest tolerances for a target yield
+    target_yield = 0.99
+    costs.<error key> = {a = 1.0, b = 8.0, k = 1.0}
+
+Result (analysis ``yield``): ``yield``, ``yield_ci_low``, ``yield_ci_high``, ``cpk``,
+per-quantity statistics, ``sobol_first`` / ``sobol_total`` per tolerance (with CIs) beside
+``linear_share``, the worst samples (their drawn errors), and ``allocation``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any, Literal
+
+from pydantic import Field, model_validator
+
+from gearte.io.schema import StrictModel
+from gearte.results import AnalysisResult
+
+__all__ = ["YieldSection", "ToleranceEntry", "yield_analysis", "to_toml"]
+
+
+class ToleranceEntry(StrictModel):
+    """One error's tolerance; lengths in µm, angles in deg (as the error key's unit)."""
+
+    kind: Literal["normal", "truncated_normal", "uniform", "rayleigh", "empirical", "constant"] = (
+        "normal"
+    )
+    tolerance_um: float | None = Field(default=None, ge=0, le=100_000)
+    tolerance_deg: float | None = Field(default=None, ge=0, le=360)
+    grade: int | None = Field(
+        default=None,
+        ge=1,
+        le=11,
+        description="ISO 1328-1:2013 class instead of tolerance_um, where the error is a gear's "
+        "eccentricity: tolerance = F_rT / 2",
+    )
+    nominal_um: float | None = Field(default=None, ge=-100_000, le=100_000)
+    nominal_deg: float | None = Field(default=None, ge=-360, le=360)
+    sigmas: float | None = Field(default=None, gt=0, le=100)
+    phase: bool = False
+    values_um: list[float] | None = Field(default=None, min_length=2, max_length=1_000_000)
+
+    @model_validator(mode="after")
+    def _one_unit(self) -> ToleranceEntry:
+        given = [self.tolerance_um, self.tolerance_deg, self.grade]
+        if sum(v is not None for v in given) != 1:
+            raise ValueError("give exactly one of tolerance_um, tolerance_deg and grade")
+        if self.phase and self.kind != "rayleigh":
+            raise ValueError("phase = true goes with kind = 'rayleigh' only")
+        if self.kind == "empirical" and self.values_um is None:
+            raise ValueError("kind = 'empirical' needs values_um (>= 2 measurements)")
+        return self
+
+    @property
+    def unit(self) -> str:
+        return "deg" if self.tolerance_deg is not None else "um"
+
+
+class GroupEntry(StrictModel):
+    """Correlated errors (one grinding batch, one fixture)."""
+
+    name: str = Field(min_length=1, max_length=100)
+    keys: list[str] = Field(min_length=1, max_length=1000, description="keys or families")
+    rho: float = Field(ge=0, le=1, description="correlation of the members' standard normals")
+
+
+class SpecEntry(StrictModel):
+    """``lower <= quantity <= upper``."""
+
+    lower: float | None = None
+    upper: float | None = None
+
+    @model_validator(mode="after")
+    def _limits(self) -> SpecEntry:
+        if self.lower is None and self.upper is None:
+            raise ValueError("give lower, upper or both")
+        if self.lower is not None and self.upper is not None and self.upper < self.lower:
+            raise ValueError(f"inverted limits: upper {self.upper} < lower {self.lower}")
+        return self
+
+
+class CostEntry(StrictModel):
+    """``cost = a + b / t^k`` (t in the error's unit) or a table of widths and prices."""
+
+    a: float = Field(default=0.0, ge=0, le=1e12)
+    b: float | None = Field(default=None, ge=0, le=1e12)
+    k: float = Field(default=1.0, ge=0, le=10)
+    widths: list[float] | None = Field(default=None, min_length=2, max_length=100)
+    prices: list[float] | None = Field(default=None, min_length=2, max_length=100)
+
+    @model_validator(mode="after")
+    def _one_form(self) -> CostEntry:
+        table = self.widths is not None or self.prices is not None
+        if table == (self.b is not None):
+            raise ValueError("give either b (cost model a + b/t^k) or widths and prices")
+        if table and (
+            self.widths is None or self.prices is None or len(self.widths) != len(self.prices)
+        ):
+            raise ValueError("widths and prices must have the same length")
+        return self
+
+
+class AllocationEntry(StrictModel):
+    target_yield: float = Field(gt=0, lt=1)
+    costs: dict[str, CostEntry] = Field(min_length=1)
+    samples: int | None = Field(default=None, ge=100, le=10**8)
+
+
+class YieldSection(StrictModel):
+    """``[analyses.yield]`` (module docstring)."""
+
+    samples: int = Field(default=20_000, ge=1, le=10**9)
+    seed: int = Field(default=0, ge=0)
+    chunk_size: int = Field(default=2_000, ge=1, le=10**7)
+    confidence: float = Field(default=0.95, gt=0.5, lt=1)
+    ci_method: Literal["wilson", "clopper-pearson"] = "wilson"
+    sobol_samples: int = Field(default=0, ge=0, le=10**7)
+    bootstrap: int = Field(default=100, ge=0, le=10_000)
+    keep_worst: int = Field(default=3, ge=0, le=100)
+    tolerances: dict[str, ToleranceEntry] = Field(default_factory=dict)
+    groups: list[GroupEntry] = Field(default_factory=list)
+    spec: dict[str, SpecEntry] = Field(default_factory=dict)
+    allocation: AllocationEntry | None = None
+
+
+def _tolerances(
+    section: YieldSection,
+    units: Mapping[str, str],
+    nominal: Mapping[str, float],
+    defaults: Mapping[str, ToleranceEntry],
+    families: Mapping[str, list[str]],
+    grade_um: Callable[[str, int], float | None] | None = None,
+):
+    from gearte.errors import ParameterError
+    from gearte.tolerance.yield_mc import CorrelatedGroup, Tolerance, ToleranceSet
+
+    given = {**defaults, **section.tolerances}
+    # a family's tolerance stands for each of its instances (an instance may be given itself)
+    expanded: dict[str, tuple[ToleranceEntry, str | None]] = {}
+    for key, t in given.items():
+        if key in families:
+            for inst in families[key]:
+                if inst not in given:
+                    expanded[inst] = (t, key)
+        else:
+            expanded[key] = (t, None)
+    tols = []
+    for key, (t, fam) in expanded.items():
+        ukey = fam or key
+        if ukey not in units:
+            raise ParameterError(
+                f"analyses.yield.tolerances.{ukey}",
+                ukey,
+                f"is not an error key or family; known: {sorted(units)}",
+            )
+        if t.unit != units[ukey]:
+            raise ParameterError(
+                f"analyses.yield.tolerances.{ukey}",
+                t.unit,
+                f"this error is in {units[ukey]}: give tolerance_{units[ukey]}",
+            )
+        tol = t.tolerance_um if t.unit == "um" else t.tolerance_deg
+        if t.grade is not None:
+            tol = None if grade_um is None else grade_um(ukey, t.grade)
+            if tol is None:
+                raise ParameterError(
+                    f"analyses.yield.tolerances.{ukey}.grade",
+                    t.grade,
+                    "this error is not a gear's eccentricity: give tolerance_um",
+                )
+        nom = t.nominal_um if t.unit == "um" else t.nominal_deg
+        tols.append(
+            Tolerance(
+                key,
+                t.kind,
+                float(tol),  # type: ignore[arg-type]
+                nominal=float(nominal.get(key, 0.0) if nom is None else nom),
+                sigmas=t.sigmas,
+                phase=t.phase,
+                values=None if t.values_um is None else tuple(t.values_um),
+                family=fam,
+            )
+        )
+    groups = tuple(CorrelatedGroup(g.name, tuple(g.keys), g.rho) for g in section.groups)
+    return ToleranceSet(tuple(tols), groups)
+
+
+def to_toml(data: Mapping[str, Any], _prefix: str = "") -> str:
+    """A minimal TOML writer for case dictionaries (tables, scalars, lists of scalars or of
+    tables).
+
+    Parameters
+    ----------
+    data : mapping
+        The case dictionary.
+    _prefix : str
+        Dotted name of the enclosing table (recursion).
+    """
+
+    def scalar(v: Any) -> str:
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, int):
+            return str(v)
+        if isinstance(v, float):
+            return repr(v) if math.isfinite(v) else "nan"
+        if isinstance(v, str):
+            return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+        if isinstance(v, list | tuple):
+            return "[" + ", ".join(scalar(x) for x in v) + "]"
+        if isinstance(v, Mapping):
+            return "{" + ", ".join(f"{_key(k)} = {scalar(x)}" for k, x in v.items()) + "}"
+        raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+    def _key(k: str) -> str:
+        return k if k.replace("_", "").replace("-", "").isalnum() else scalar(str(k))
+
+    lines: list[str] = []
+    tables: list[tuple[str, Mapping[str, Any]]] = []
+    arrays: list[tuple[str, list[Mapping[str, Any]]]] = []
+    for k, v in data.items():
+        if v is None:
+            continue
+        name = f"{_prefix}.{_key(k)}" if _prefix else _key(k)
+        if isinstance(v, Mapping):
+            tables.append((name, v))
+        elif isinstance(v, list) and v and all(isinstance(x, Mapping) for x in v):
+            arrays.append((name, v))
+        else:
+            lines.append(f"{_key(k)} = {scalar(v)}")
+    out = "\n".join(lines) + ("\n" if lines else "")
+    for name, v in tables:
+        body = to_toml(v, name)
+        out += f"\n[{name}]\n{body}"
+    for name, items in arrays:
+        for item in items:
+            out += f"\n[[{name}]]\n" + to_toml(item, name)
+    return out
+
+
+def yield_analysis(
+    section: YieldSection,
+    model: Callable,
+    units: Mapping[str, str],
+    nominal: Mapping[str, float],
+    *,
+    options: Any = None,
+    worst_case: Callable[[Mapping[str, float]], dict] | None = None,
+    references: list[str] | None = None,
+    defaults: Mapping[str, ToleranceEntry] | None = None,
+    families: Mapping[str, list[str]] | None = None,
+    grade_um: Callable[[str, int], float | None] | None = None,
+) -> AnalysisResult:
+    """Run the yield analysis of a drive.
+
+    Parameters
+    ----------
+    section : YieldSection
+    model : callable
+        The drive's yield model (errors in the keys' units → quantities).
+    units : mapping
+        Error key → ``"um"`` or ``"deg"`` (the keys a tolerance may name).
+    nominal : mapping
+        Error key → the case's value [unit of the key] (the nominal of a tolerance that gives
+        none).
+    options : RunOptions, optional
+        ``seed``/``samples`` override the section's; workers, scheduler, progress.
+    worst_case : callable, optional
+        Drawn errors [units of the keys] → a case dictionary that reproduces that drive alone.
+    references : list of str, optional
+        Reference keys of the analysis.
+    defaults : mapping, optional
+        Tolerances the drive's own description implies (e.g. a cycloid stage's error bands);
+        the section's entries replace them key by key.
+    families : mapping, optional
+        Family key → its instance keys (e.g. ``cam`` → ``cam.c1.d1`` …): a tolerance on a
+        family applies to each instance, drawn independently (a correlated group may name it).
+    grade_um : callable, optional
+        ``(key, grade) -> tolerance [µm]`` for errors that are a gear's eccentricity (``None``
+        for the others): how ``grade = N`` reads for this drive.
+    """
+    from gearte.errors import ParameterError
+    from gearte.tolerance.allocation import CostModel, PriceTable, allocate
+    from gearte.tolerance.yield_contributions import (
+        linear_prediction,
+        pareto_rows,
+        sobol_tolerances,
+    )
+    from gearte.tolerance.yield_mc import SpecLimit, run_yield
+
+    seed = section.seed if getattr(options, "seed", None) is None else int(options.seed)
+    n = section.samples if getattr(options, "samples", None) is None else int(options.samples)
+    defaults = dict(defaults or {})
+    ts = _tolerances(section, units, nominal, defaults, dict(families or {}), grade_um)
+    spec = [SpecLimit(q, s.lower, s.upper) for q, s in section.spec.items()]
+    progress = getattr(options, "progress", False)
+    res = run_yield(
+        model,
+        ts,
+        spec,
+        n,
+        seed=seed,
+        chunk_size=section.chunk_size,
+        confidence=section.confidence,
+        ci_method=section.ci_method,
+        keep_worst=section.keep_worst,
+        options=options,
+        progress=progress,
+    )
+    quantities = {
+        q: {
+            "mean": st.stats.mean,
+            "sd": st.stats.sd,
+            "min": st.stats.min,
+            "max": st.stats.max,
+            "cpk": st.cpk,
+            "fail_fraction": st.fail_fraction,
+        }
+        for q, st in res.quantities.items()
+    }
+    values: dict[str, Any] = {
+        "yield": res.yield_,
+        "yield_ci_low": res.ci[0],
+        "yield_ci_high": res.ci[1],
+        "cpk": res.cpk,
+        "samples": res.n,
+        "seed": seed,
+        "spec": {s.quantity: {"lower": s.lower, "upper": s.upper} for s in spec},
+        "quantities": quantities,
+        "tolerances": {
+            t.family_name: {"kind": t.kind, "tolerance": t.tolerance, "nominal": t.nominal}
+            for t in ts.tolerances
+        },
+    }
+    notes = [
+        f"{res.n} assembled drives drawn (seed {seed}, chunks of {section.chunk_size}); yield = "
+        f"share meeting every spec limit, {section.confidence:.0%} {section.ci_method} interval.",
+        "Tolerance meaning: normal ±t with σ = t/3 unless sigmas is given; rayleigh: 99.73 % of "
+        "magnitudes ≤ t; uniform on ±t around the nominal.",
+    ]
+    data: dict[str, Any] = {"yield": res}
+    files: dict[str, str] = {}
+    sobol_q = spec[0].quantity if spec else next(iter(res.quantities), None)
+    if section.sobol_samples and sobol_q is not None and ts.tolerances:
+        sob = sobol_tolerances(
+            model,
+            ts,
+            [sobol_q],
+            section.sobol_samples,
+            seed=seed + 1,
+            bootstrap=section.bootstrap,
+            options=options,
+            progress=progress,
+        )[sobol_q]
+        lin = linear_prediction(model, ts, [sobol_q])[sobol_q]
+        values.update(
+            {
+                "sobol_quantity": sobol_q,
+                "sobol_first": sob.first,
+                "sobol_total": sob.total,
+                "sobol_first_ci": {k: list(v) for k, v in sob.first_ci.items()},
+                "sobol_total_ci": {k: list(v) for k, v in sob.total_ci.items()},
+                "linear_share": lin.share,
+                "linear_sd": lin.sd,
+                "monte_carlo_sd": res.quantities[sobol_q].stats.sd,
+            }
+        )
+        data["pareto"] = pareto_rows(sob, lin)
+        notes.append(
+            "Sobol indices (Saltelli 2010 first order, Jansen total) with percentile-bootstrap "
+            "intervals, beside the linear (sensitivity × σ) share; where they differ the "
+            "physics is non-linear."
+        )
+    worst = []
+    for i, w in enumerate(res.worst):
+        worst.append(
+            {
+                "sample": w["sample"],
+                "margin": w["margin"],
+                "errors": w["errors"],
+                "values": w["values"],
+            }
+        )
+        if worst_case is not None:
+            case = worst_case(w["errors"])
+            header = (
+                f"# worst sample {i + 1}: sample {w['sample']} of seed {seed} "
+                f"(chunk size {section.chunk_size}); run it with `gearte run` on its own.\n"
+            )
+            files[f"worst_sample_{i + 1}.toml"] = header + to_toml(case)
+    values["worst_samples"] = worst
+    if section.allocation is not None:
+        costs: dict[str, CostModel | PriceTable] = {}
+        for key, c in section.allocation.costs.items():
+            if key not in ts.families:
+                raise ParameterError(
+                    f"analyses.yield.allocation.costs.{key}", key, "has no tolerance to allocate"
+                )
+            if c.b is not None:
+                costs[key] = CostModel(c.a, c.b, c.k)
+            else:
+                costs[key] = PriceTable(tuple(c.widths or ()), tuple(c.prices or ()))
+        al = allocate(
+            model,
+            ts,
+            spec,
+            costs,
+            section.allocation.target_yield,
+            n=section.allocation.samples or n,
+            seed=seed + 2,
+            chunk_size=section.chunk_size,
+            options=options,
+        )
+        values["allocation"] = {
+            "target_yield": al.target,
+            "tolerances": al.widths,
+            "cost": al.cost,
+            "cost_by_tolerance": al.cost_by_tolerance,
+            "search_yield": al.search_yield,
+            "verified_yield": al.verified.yield_,
+            "verified_yield_ci_low": al.verified.ci[0],
+            "verified_yield_ci_high": al.verified.ci[1],
+            "verified_seed": al.verified.seed,
+            "meets_target": al.meets_target,
+            "locally_optimal": al.locally_optimal,
+            "yield_if_loosened_one_step": al.loosening_yields,
+        }
+    return AnalysisResult(
+        name="yield",
+        title="Production yield: tolerance Monte-Carlo through the physics",
+        values=values,
+        references=references or [],
+        notes=notes,
+        data=data,
+        files=files,
+    )

@@ -1,0 +1,116 @@
+"""The RV reducer through the yield engine: each sample one assembled reducer."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import gearte
+from gearte.geometry.rv import ManufacturingErrors
+from gearte.models.rv_catalogue import catalogue_values
+from gearte.runners.yield_models import RVReducerYield, rv_error_keys
+from gearte.studies.rv_reducer import build_reducer
+from gearte.tolerance.yield_mc import SpecLimit, Tolerance, ToleranceSet, run_yield
+from gearte.units import rad_to_arcmin
+
+
+@pytest.fixture(scope="module")
+def rv():
+    red = build_reducer(gearte.load_case("han2023_rv110e").reducer)
+    return red, RVReducerYield(red, positions=36)
+
+
+def test_rv_zero_tolerances_give_the_deterministic_catalogue_values_exactly(rv):
+    red, model = rv
+    keys = rv_error_keys(red)
+    ts = ToleranceSet(
+        tuple(Tolerance(k, "rayleigh", 0.0, phase=True, family="cam") for k in keys["cam"])
+        + tuple(
+            Tolerance(k, "normal", 0.0, family="pins.radius_errors")
+            for k in keys["pins.radius_errors"]
+        )
+    )
+    r = run_yield(model, ts, [SpecLimit("lost_motion [arcmin]", upper=1.0)], 2, seed=0)
+    # a drawn error replaces the measured one: the deterministic reducer has zero cam errors
+    e = red.errors
+    red0 = red.with_errors(
+        ManufacturingErrors(e.planet, e.disc_bore, np.zeros_like(e.cam), e.carrier_bore)
+    )
+    red0 = red0.replace(pins=replace(red0.pins, radius_errors=np.zeros(red0.pins.count)))
+    cv = catalogue_values(red0)
+    st = r.quantities["lost_motion [arcmin]"].stats
+    assert st.min == st.max == pytest.approx(float(rad_to_arcmin(cv.lost_motion)), rel=1e-12)
+
+
+def test_rv_drawn_errors_change_the_reducer_as_keyed(rv):
+    red, model = rv
+    e = {"cam.c1.d2": 10.0, "cam.c1.d2_phase_rad": np.pi / 2, "pins.radius_errors.p3": -2.0}
+    r = model.reducer_for(e)
+    np.testing.assert_allclose(r.errors.cam[0, 1], [0.0, 0.01], atol=1e-15)
+    assert r.pins.radius_errors[2] == pytest.approx(-0.002)
+    # errors not drawn keep the reducer's measured values
+    np.testing.assert_array_equal(r.errors.planet, red.errors.planet)
+
+
+@pytest.mark.slow
+def test_rv_samples_give_every_catalogue_quantity(rv):
+    red, model = rv
+    keys = rv_error_keys(red)
+    ts = ToleranceSet(
+        tuple(Tolerance(k, "rayleigh", 5.0, phase=True, family="cam") for k in keys["cam"])
+    )
+    r = run_yield(model, ts, [SpecLimit("angular_te [arcmin]", upper=1.0)], 4, seed=3, chunk_size=2)
+    names = {
+        "lost_motion [arcmin]",
+        "torsional_rigidity [Nm/arcmin]",
+        "backlash [arcmin]",
+        "hysteresis_loss [arcmin]",
+        "angular_te [arcmin]",
+        "loaded_te [arcmin]",
+        "peak_pin_load [N]",
+        "max_contact_pressure [MPa]",
+    }
+    assert names <= set(r.quantities)
+    assert r.quantities["angular_te [arcmin]"].stats.sd > 0
+
+
+def test_rv_reducer_case_yield_analysis_and_runnable_worst_case(tmp_path):
+    """han2023_rv110e_yield with 4 samples and no Sobol: the result names issue 14 requires,
+    and the worst reducer written as a case file gives the same lost motion when run alone."""
+    import json
+    import tomllib
+
+    from gearte.cases import case_path
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies import RunOptions
+
+    data = tomllib.loads(case_path("han2023_rv110e_yield").read_text())
+    data["analyses"]["yield"].update(samples=4, chunk_size=2, sobol_samples=0, keep_worst=1)
+    res = gearte.run_case(load_case_dict(data, name="rv_yield"), RunOptions(progress=False))
+    gearte.write_outputs(res, tmp_path / "out")
+    v = json.loads((tmp_path / "out" / "results.json").read_text())["analyses"]["yield"]["values"]
+    for k in ("yield", "yield_ci_low", "yield_ci_high", "cpk"):
+        assert k in v
+    worst = v["worst_samples"][0]
+    alone = gearte.run_case(gearte.load_case(tmp_path / "out" / "worst_sample_1.toml"))
+    lm = alone["catalogue"]["lost_motion [arcmin]"]
+    assert lm == pytest.approx(worst["values"]["lost_motion [arcmin]"], rel=1e-6)
+
+
+def test_rv_planet_eccentricity_tolerance_from_its_iso1328_grade(tmp_path):
+    """grade = 6 on planet_base_circle: planet m 1.5, z 40 → d 60 mm; F_pT = (0.12 + 0.55·√60 +
+    1.05 + 12)·√2 = 24.65 µm, F_rT = 0.9·F_pT = 22.19 → 22 µm; eccentricity tolerance F_rT/2 =
+    11 µm (by hand from ISO 1328-1:2013 eq. 6 and the rounding rule)."""
+    import tomllib
+
+    from gearte.cases import case_path
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies import RunOptions
+
+    data = tomllib.loads(case_path("han2023_rv110e_yield").read_text())
+    data["analyses"]["yield"].update(samples=2, chunk_size=2, sobol_samples=0, keep_worst=0)
+    data["analyses"]["yield"]["spec"] = {}
+    res = gearte.run_case(load_case_dict(data, name="rv_grade"), RunOptions(progress=False))
+    assert res["yield"]["tolerances"]["planet_base_circle"]["tolerance"] == 11.0
