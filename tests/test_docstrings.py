@@ -192,6 +192,31 @@ PENDING = frozenset(
         "gearte.models.cycloid_te.geometric_te",
         "gearte.models.cycloid_te.sensitivity_indices",
         "gearte.models.cycloid_te.te_gradients",
+        "gearte.io.bench.read_hysteresis",  # issue 17, docs pending
+        "gearte.io.bench.read_te_folder",  # issue 17, docs pending
+        "gearte.io.bench.write_hysteresis",  # issue 17, docs pending
+        "gearte.io.bench.write_te_trace",  # issue 17, docs pending
+        "gearte.models.bench_reduced.hysteresis_angle",  # issue 17, docs pending
+        "gearte.models.bench_reduced.hysteresis_jacobian",  # issue 17, docs pending
+        "gearte.models.bench_reduced.parameter_names",  # issue 17, docs pending
+        "gearte.models.bench_reduced.te_basis",  # issue 17, docs pending
+        "gearte.models.bench_reduced.te_coefficients",  # issue 17, docs pending
+        "gearte.models.bench_reduced.te_trace",  # issue 17, docs pending
+        "gearte.models.catalogue.backlash_at_zero",  # issue 17, docs pending
+        "gearte.models.catalogue.branch_directions",  # issue 17, docs pending
+        "gearte.models.catalogue.forward_backward_difference",  # issue 17, docs pending
+        "gearte.models.catalogue.hysteresis_loss",  # issue 17, docs pending
+        "gearte.models.catalogue.hysteresis_values",  # issue 17, docs pending
+        "gearte.models.catalogue.lost_motion",  # issue 17, docs pending
+        "gearte.models.catalogue.split_branches",  # issue 17, docs pending
+        "gearte.models.catalogue.torsional_rigidity",  # issue 17, docs pending
+        "gearte.models.orders.label_frequency",  # issue 17, docs pending
+        "gearte.models.rv_catalogue.virtual_loop",  # issue 17, docs pending
+        "gearte.plotting.rv_bench.figures",  # issue 17, docs pending
+        "gearte.runners.bench_calibration.calibrate",  # issue 17, docs pending
+        "gearte.runners.bench_calibration.reduced_constants",  # issue 17, docs pending
+        "gearte.runners.bench_calibration.synthetic_bench",  # issue 17, docs pending
+        "gearte.runners.bench_diagnosis.diagnose",  # issue 17, docs pending
         "gearte.models.rv_catalogue.backlash",
         "gearte.models.rv_catalogue.catalogue_values",
         "gearte.models.rv_catalogue.torque_path",
@@ -218,7 +243,6 @@ PENDING = frozenset(
         "gearte.results.to_jsonable",
         "gearte.runners.rv_dynamics_sim.draw_errors",
         "gearte.runners.rv_dynamics_sim.dte_batch",
-        "gearte.runners.rv_dynamics_sim.label_frequency",
         "gearte.solvers.contact.solve_load_sharing_plain",
         "gearte.solvers.ode.integrate",
         "gearte.solvers.rv_equilibrium.solve_positions",

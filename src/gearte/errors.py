@@ -15,6 +15,7 @@ __all__ = [
     "ConvergenceError",
     "DivergenceError",
     "SchedulerError",
+    "BenchFileError",
     "OutputError",
     "Interrupted",
 ]
@@ -94,6 +95,29 @@ class OutputError(GearteError):
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (type(self), (self.path, self.reason))
+
+
+class BenchFileError(GearteError, ValueError):
+    """A bench measurement file (CSV) is malformed.
+
+    The message names the file, the line (1-based, as an editor shows it) and the column (its
+    header name and 1-based number) where the problem was found, and the reason.
+    """
+
+    def __init__(self, file: str, line: int | None, column: str | None, reason: str) -> None:
+        self.file = file
+        self.line = line
+        self.column = column
+        self.reason = reason
+        where = file
+        if line is not None:
+            where += f", line {line}"
+        if column is not None:
+            where += f", column {column}"
+        super().__init__(f"{where}: {reason}")
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.file, self.line, self.column, self.reason))
 
 
 class Interrupted(KeyboardInterrupt):

@@ -15,6 +15,9 @@ swept ``0 → +T_r → 0 → −T_r → 0``, the output torsion angle is recorde
 * **Angular transmission error**: peak-to-peak of the output angle error over one output
   revolution (unloaded: the geometric TE; loaded: the total TE).
 
+The definitions themselves live once in :mod:`gearte.models.catalogue` and are shared with
+measured bench curves (:mod:`gearte.io.bench`); this module only produces the virtual curve.
+
 The quasi-static model has no friction, so the loading and unloading branches coincide except
 inside the backlash: the midpoints equal the curve, and the hysteresis loss equals the backlash.
 These are stated limitations, not fitted quantities.
@@ -29,6 +32,7 @@ from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer
+from gearte.models.catalogue import ZERO_TORQUE_FRACTION, hysteresis_values
 from gearte.models.rv_load_sharing import PinContactLaw, assemble, contact_law, solver_law
 from gearte.solvers.rv_equilibrium import ContactLaw, solve_positions
 
@@ -39,6 +43,7 @@ __all__ = [
     "backlash",
     "CatalogueValues",
     "catalogue_values",
+    "virtual_loop",
 ]
 
 
@@ -137,13 +142,51 @@ def backlash(
 
 @dataclass(frozen=True)
 class CatalogueValues:
-    """Catalogue quantities [N·mm/rad, rad] and the curve they were read from."""
+    """Catalogue quantities [N·mm/rad, rad] and the curves they were read from.
+
+    ``loop`` is the virtual hysteresis loop the quantities are read from by the shared
+    definitions of :mod:`gearte.models.catalogue` (exactly as from a measured curve); ``curve``
+    is the dense sweep for plots.
+    """
 
     torsional_rigidity: float
     lost_motion: float
     backlash: float
     hysteresis_loss: float
     curve: TorsionTest
+    loop: TorsionTest | None = None
+    loop_direction: np.ndarray | None = None
+
+
+def virtual_loop(
+    reducer: RVReducer,
+    *,
+    theta: float = 0.0,
+    lost_motion_fraction: float = 0.03,
+    law: PinContactLaw | ContactLaw | None = None,
+) -> tuple[TorsionTest, np.ndarray]:
+    """The virtual hysteresis loop sampled at the torques the catalogue definitions read.
+
+    Descending branch ``+T_r → −T_r`` then ascending ``−T_r → +T_r`` through
+    ``±{1, 0.5, f, ε}·T_r`` and zero (where the output stays on the side it comes from), each
+    branch followed with warm starts; returns the loop and its branch marks (+1 rising torque).
+    """
+    law = contact_law(reducer) if law is None else law
+    tr = reducer.rated_torque
+    levels = np.array([1.0, 0.5, lost_motion_fraction, ZERO_TORQUE_FRACTION])
+    unload_pos = _follow(reducer, theta, levels * tr, law)
+    unload_neg = _follow(reducer, theta, -levels * tr, law)
+    load_pos = _follow(reducer, theta, levels[::-1] * tr, law)
+    load_neg = _follow(reducer, theta, -levels[::-1] * tr, law)
+    t_desc = np.concatenate([levels, [0.0], -levels[::-1]]) * tr
+    a_desc = np.concatenate([unload_pos, unload_pos[-1:], load_neg])
+    t_asc = -t_desc
+    a_asc = np.concatenate([unload_neg, unload_neg[-1:], load_pos])
+    loop = TorsionTest(
+        torque=np.concatenate([t_desc, t_asc]), angle=np.concatenate([a_desc, a_asc])
+    )
+    direction = np.concatenate([-np.ones(t_desc.size, np.int64), np.ones(t_asc.size, np.int64)])
+    return loop, direction
 
 
 def catalogue_values(
@@ -157,8 +200,9 @@ def catalogue_values(
 ) -> CatalogueValues:
     """Torsional rigidity, lost motion, backlash and hysteresis loss from a virtual test.
 
-    Each quantity is read at its exact torque: the branches ``0 → ±T_r`` are followed with
-    warm starts through ``±1e-4, ±lost_motion_fraction, ±0.5, ±1`` × rated torque.
+    The virtual loop (:func:`virtual_loop`) is read by the shared catalogue definitions
+    (:func:`gearte.models.catalogue.hysteresis_values`), the same functions that read a
+    measured bench curve.
     """
     if not 0 < lost_motion_fraction < 0.5:
         raise ParameterError("lost_motion_fraction", lost_motion_fraction, "must be in (0, 0.5)")
@@ -166,22 +210,22 @@ def catalogue_values(
     curve = torsion_test(
         reducer, turning_points, theta=theta, steps_per_segment=steps_per_segment, law=law
     )
-    levels = np.array([1e-4, lost_motion_fraction, 0.5, 1.0])
-    tr = reducer.rated_torque
-    pos = _follow(reducer, theta, levels * tr, law)
-    neg = _follow(reducer, theta, -levels * tr, law)
-    k_pos = 0.5 * tr / (pos[3] - pos[2])
-    k_neg = 0.5 * tr / (neg[2] - neg[3])
-    rigidity = 0.5 * (k_pos + k_neg)
-    lost_motion = pos[1] - neg[1]
-    backlash = pos[0] - neg[0]
-    # hysteresis loss: zero-torque width after unloading from ±T_r (same as backlash here)
-    back_pos = _follow(reducer, theta, np.array([1.0, 0.5, 1e-4]) * tr, law)[-1]
-    back_neg = _follow(reducer, theta, -np.array([1.0, 0.5, 1e-4]) * tr, law)[-1]
+    loop, direction = virtual_loop(
+        reducer, theta=theta, lost_motion_fraction=lost_motion_fraction, law=law
+    )
+    hv = hysteresis_values(
+        loop.torque,
+        loop.angle,
+        reducer.rated_torque,
+        direction=direction,
+        lost_motion_fraction=lost_motion_fraction,
+    )
     return CatalogueValues(
-        torsional_rigidity=float(rigidity),
-        lost_motion=float(lost_motion),
-        backlash=float(backlash),
-        hysteresis_loss=float(back_pos - back_neg),
+        torsional_rigidity=hv.torsional_rigidity,
+        lost_motion=hv.lost_motion,
+        backlash=hv.backlash,
+        hysteresis_loss=hv.hysteresis_loss,
         curve=curve,
+        loop=loop,
+        loop_direction=direction,
     )

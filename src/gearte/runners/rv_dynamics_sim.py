@@ -13,6 +13,7 @@ from functools import partial
 import numpy as np
 
 from gearte.errors import ParameterError
+from gearte.models.orders import label_frequency
 from gearte.models.rv_dynamics import (
     RHS_SOURCE_KEY,
     RHS_WORK_SIZE,
@@ -170,35 +171,6 @@ def simulate_dte(
         solver=res,
         dt=float(dt) if dt is not None else float("nan"),
     )
-
-
-def label_frequency(f: float, sources: dict[str, float], tol: float) -> str:
-    """Physical source of a spectral line at f [Hz]: a harmonic of a source or a mesh sideband.
-
-    Tries h × source first (h = 1..8 for meshes, whose rectangular stiffness wave is rich in
-    harmonics, 1..4 for rotations), then mesh ± k × rotation sidebands (k = 1..3); returns
-    ``"unidentified"`` when nothing lies within ``tol`` [Hz].
-    """
-    best, err = "unidentified", tol
-    for name, fs in sources.items():
-        for h in range(1, 9 if "mesh" in name else 5):
-            d = abs(f - h * fs)
-            if d <= err:
-                best, err = (name if h == 1 else f"{h}× {name}"), d
-    if best != "unidentified":
-        return best
-    meshes = {k: v for k, v in sources.items() if "mesh" in k}
-    rots = {k: v for k, v in sources.items() if "rotation" in k}
-    for mn, fm in meshes.items():
-        for h in (1, 2):
-            for rn, fr in rots.items():
-                for k in (1, 2, 3):
-                    for sgn in (+1, -1):
-                        d = abs(f - (h * fm + sgn * k * fr))
-                        if d <= err:
-                            sb = f"{'' if h == 1 else f'{h}× '}{mn} {'+' if sgn > 0 else '−'} "
-                            best, err = sb + f"{'' if k == 1 else f'{k}× '}{rn} (sideband)", d
-    return best
 
 
 def dte_spectrum(

@@ -1,0 +1,212 @@
+"""Reduced RV model of one serial's bench data: hysteresis curve and angular TE per direction.
+
+Fast enough to be fitted by least squares to thousands of bench samples in a fraction of a
+second, and derived from the whole-reducer model (:mod:`gearte.models.rv_load_sharing` through
+:mod:`gearte.models.rv_catalogue`) by three constants: the nominal torsional rigidity ``K_nom``
+and the backlash per unit radial clearance of the cam (crank–disc) and carrier crank bearings,
+``g_cam``, ``g_car`` — see :func:`gearte.runners.bench_calibration.reduced_constants`.
+
+Hysteresis (input locked, output torque ``T`` [N·mm], branch ``s = +1`` for rising torque,
+``−1`` for falling)::
+
+    θ(T, s) = θ0 + F(T − s T_fr) + C_rig T
+    F(u)    = (β/2) tanh(u / T_β) + (T_r / (f K_nom)) c_p sgn(u) |u/T_r|^p
+    β       = g_cam c_cam + g_car c_car,    c_p = 0.5 / (1 − 0.5^p),   p = 0.9
+
+* ``F`` is the frictionless reducer: free play ``β`` taken up over a transition torque ``T_β``,
+  then a stiffening elastic law (Palmgren line contact ``δ ∝ Q^0.9``); ``c_p`` makes the
+  catalogue rigidity ``(T_r/2)/(θ(T_r) − θ(T_r/2))`` of the elastic part exactly ``f K_nom``, so
+  ``f`` is a contact-stiffness factor on the whole model's rigidity.
+* Friction is a torque ``T_fr`` opposing the motion inside the reducer (Coulomb), so the loop
+  width is the play plus the elastic twist of ``2 T_fr``.
+* ``C_rig`` [rad/(N·mm)] is the compliance of the rig (shafts, couplings, encoder mount) between
+  the torque sensor and the output encoder; it carries the measured torque, not the friction.
+
+Angular TE of direction ``d`` (+1 forward, −1 backward) at output position ``φ`` [rad]::
+
+    TE_d(φ) = o + d (β + w)/2 + Σ_j [a_j cos(n_j φ) + b_j sin(n_j φ)] + a_e cos φ + b_e sin φ
+
+with the error families ``j`` at their characteristic orders ``n_j``
+(:func:`gearte.models.orders.rv_characteristic_orders`): the geometric errors of a part repeat
+with that part's rotation; ``(a_e, b_e)`` is the output encoder's eccentricity (rig) and ``w`` the
+running wind-up (elastic twist under the running friction torque) so that the forward–backward
+difference is ``β + w``.
+
+This is a reduced model: it keeps what a bench can see of the whole model (play, stiffness,
+friction, the orders of the error families) and none of the load sharing; its limitations are
+stated in docs/bench.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = [
+    "STIFFNESS_EXPONENT",
+    "ReducedRV",
+    "HYSTERESIS_PARAMETERS",
+    "hysteresis_angle",
+    "te_trace",
+    "te_basis",
+    "hysteresis_jacobian",
+    "te_orders",
+    "te_coefficients",
+    "parameter_names",
+]
+
+STIFFNESS_EXPONENT = 0.9
+"""``p`` of the elastic law (Palmgren line contact, δ ∝ Q^0.9)."""
+
+HYSTERESIS_PARAMETERS = (
+    "cam_bearing_clearance",  # [mm]
+    "carrier_bearing_clearance",  # [mm]
+    "play_transition_torque",  # T_β [N·mm]
+    "contact_stiffness_factor",  # f [-]
+    "rig_compliance",  # C_rig [rad/(N·mm)]
+    "friction_torque",  # T_fr [N·mm]
+    "angle_offset",  # θ0 [rad]
+)
+TE_COMMON = ("te_offset", "running_windup")  # o [rad], w [rad]
+
+
+@dataclass(frozen=True)
+class ReducedRV:
+    """Constants of the reduced model of one reducer type.
+
+    Attributes
+    ----------
+    rated_torque : float
+        ``T_r`` [N·mm].
+    nominal_rigidity : float
+        ``K_nom`` [N·mm/rad], the whole model's catalogue rigidity.
+    backlash_per_clearance : (float, float)
+        ``(g_cam, g_car)`` [rad/mm].
+    families : dict
+        Error family name → order (integer harmonic of the output revolution).
+    """
+
+    rated_torque: float
+    nominal_rigidity: float
+    backlash_per_clearance: tuple[float, float]
+    families: dict[str, int] = field(default_factory=dict)
+
+    def family_parameters(self) -> tuple[str, ...]:
+        names: list[str] = []
+        for fam in (*self.families, "encoder eccentricity"):
+            key = fam.replace(" ", "_")
+            names += [f"{key}_cos", f"{key}_sin"]
+        return tuple(names)
+
+
+def parameter_names(model: ReducedRV) -> tuple[str, ...]:
+    """All parameter names: hysteresis, TE common, then (cos, sin) per family and the encoder."""
+    return (*HYSTERESIS_PARAMETERS, *TE_COMMON, *model.family_parameters())
+
+
+def _play(p: dict, model: ReducedRV) -> float:
+    g_cam, g_car = model.backlash_per_clearance
+    return g_cam * p["cam_bearing_clearance"] + g_car * p["carrier_bearing_clearance"]
+
+
+def hysteresis_angle(
+    model: ReducedRV, params: dict, torque: ArrayLike, direction: ArrayLike
+) -> np.ndarray:
+    """Output torsion angle [rad] at the measured torques [N·mm] and branches (±1)."""
+    t = np.asarray(torque, dtype=float)
+    s = np.asarray(direction, dtype=float)
+    tr = model.rated_torque
+    u = t - s * params["friction_torque"]
+    p = STIFFNESS_EXPONENT
+    cp = 0.5 / (1.0 - 0.5**p)
+    x = u / tr
+    elastic = tr * cp / (params["contact_stiffness_factor"] * model.nominal_rigidity)
+    elastic = elastic * np.sign(x) * np.abs(x) ** p
+    play = 0.5 * _play(params, model) * np.tanh(u / params["play_transition_torque"])
+    return params["angle_offset"] + play + elastic + params["rig_compliance"] * t
+
+
+def hysteresis_jacobian(
+    model: ReducedRV, params: dict, torque: ArrayLike, direction: ArrayLike
+) -> dict[str, np.ndarray]:
+    """Partial derivatives of :func:`hysteresis_angle` with respect to each of
+    :data:`HYSTERESIS_PARAMETERS` [rad per parameter unit], analytic.
+
+    At exactly ``u = T − s T_fr = 0`` the elastic law's slope ``|u|^(p−1)`` is infinite; it is
+    evaluated at ``|u/T_r| = 1e-12`` there.
+    """
+    t = np.asarray(torque, dtype=float)
+    s = np.asarray(direction, dtype=float)
+    tr = model.rated_torque
+    g_cam, g_car = model.backlash_per_clearance
+    tb = params["play_transition_torque"]
+    f = params["contact_stiffness_factor"]
+    u = t - s * params["friction_torque"]
+    x = u / tr
+    p = STIFFNESS_EXPONENT
+    cp = 0.5 / (1.0 - 0.5**p)
+    e = tr * cp / (f * model.nominal_rigidity)
+    ax = np.maximum(np.abs(x), 1e-12)
+    th = np.tanh(u / tb)
+    sech2 = 1.0 - th**2
+    beta = _play(params, model)
+    d_du = 0.5 * beta * sech2 / tb + e * p * ax ** (p - 1.0) / tr
+    return {
+        "cam_bearing_clearance": 0.5 * g_cam * th,
+        "carrier_bearing_clearance": 0.5 * g_car * th,
+        "play_transition_torque": -0.5 * beta * sech2 * u / tb**2,
+        "contact_stiffness_factor": -(e / f) * np.sign(x) * np.abs(x) ** p,
+        "rig_compliance": t.copy(),
+        "friction_torque": -s * d_du,
+        "angle_offset": np.ones_like(t),
+    }
+
+
+def te_orders(model: ReducedRV) -> list[int]:
+    """The distinct orders of the TE model (the families' and the encoder's order 1)."""
+    out: list[int] = []
+    for n in (*model.families.values(), 1):
+        if int(n) not in out:
+            out.append(int(n))
+    return out
+
+
+def te_basis(model: ReducedRV, position: ArrayLike) -> np.ndarray:
+    """``(K, 1 + 2 U)`` columns ``1, cos(n φ), sin(n φ)`` for the ``U`` distinct orders of
+    :func:`te_orders` (families sharing an order share its columns)."""
+    phi = np.asarray(position, dtype=float)
+    cols = [np.ones_like(phi)]
+    for n in te_orders(model):
+        cols += [np.cos(n * phi), np.sin(n * phi)]
+    return np.column_stack(cols)
+
+
+def te_coefficients(model: ReducedRV, params: dict, direction: int) -> np.ndarray:
+    """Coefficients of :func:`te_basis` [rad]: the offset of the direction, then per order the
+    sums of the cos and sin amplitudes of the families at that order."""
+    orders = te_orders(model)
+    c = np.zeros(1 + 2 * len(orders))
+    c[0] = params["te_offset"] + 0.5 * direction * (_play(params, model) + params["running_windup"])
+    for fam, n in (*model.families.items(), ("encoder eccentricity", 1)):
+        key = fam.replace(" ", "_")
+        k = 1 + 2 * orders.index(int(n))
+        c[k] += params[f"{key}_cos"]
+        c[k + 1] += params[f"{key}_sin"]
+    return c
+
+
+def te_trace(
+    model: ReducedRV,
+    params: dict,
+    position: ArrayLike,
+    direction: int,
+    basis: np.ndarray | None = None,
+) -> np.ndarray:
+    """Angular TE [rad] of one direction (+1 forward, −1 backward) at output positions [rad].
+
+    ``basis`` may hold :func:`te_basis` of the positions, computed once for repeated calls.
+    """
+    b = te_basis(model, position) if basis is None else basis
+    return b @ te_coefficients(model, params, direction)

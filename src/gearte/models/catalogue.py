@@ -1,0 +1,283 @@
+"""One definition per catalogue quantity of a precision reducer, for measured and virtual curves.
+
+The same functions read a hysteresis curve or a TE trace whether it comes from a test bench
+(:mod:`gearte.io.bench`) or from gearte's own virtual test (:mod:`gearte.models.rv_catalogue`),
+so a measured serial and a simulated one are compared by identical arithmetic.
+
+Hysteresis curve (input locked, output torque ``T`` swept ``0 → +T_r → −T_r → +T_r``, output
+torsion angle ``θ``), after the manufacturers' catalogues (Nabtesco RV "rigidity and lost
+motion"; the same definitions are in GB/T 35089):
+
+* the curve is split into its **ascending** branch (torque rising) and **descending** branch
+  (torque falling) — :func:`split_branches`; each is a function ``θ(T)`` read by linear
+  interpolation between samples;
+* the **mid-curve** ``θ_mid(T) = (θ_asc(T) + θ_desc(T)) / 2``;
+* **torsional rigidity** ``b/a``: ``(T_r/2)/(θ_mid(T_r) − θ_mid(T_r/2))`` and the same for
+  ``−T_r``, averaged [N·mm/rad];
+* **lost motion** ``θ_mid(+f T_r) − θ_mid(−f T_r)``, ``f = 0.03`` (configurable, e.g. 0.05) [rad];
+* **backlash at zero torque**: the hysteresis loss less the friction width ``w_f`` (the loop
+  width at ``±T_r/2``, where only friction separates the branches): the free play [rad];
+* **hysteresis loss** ``θ_desc(0) − θ_asc(0)``: the width of the loop at zero torque after
+  unloading from ``±T_r`` (free play plus friction) [rad].
+
+Angular TE trace (output angle minus input angle / ratio, one output revolution per direction):
+
+* **peak-to-peak per direction** ``max TE − min TE`` [rad];
+* **forward–backward difference** ``TE_fwd(φ) − TE_bwd(φ)`` along the revolution, both traces
+  interpolated linearly and periodically onto the forward positions [rad]; its mean is the lost
+  motion under running conditions.
+
+References
+----------
+Nabtesco Corporation, *Precision Reduction Gear RV* catalogue, "Rigidity (torsional rigidity,
+lost motion) and hysteresis". GB/T 35089-2018, *Precision gear reducers for robots*.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from gearte.errors import ParameterError
+
+__all__ = [
+    "ZERO_TORQUE_FRACTION",
+    "Branches",
+    "branch_directions",
+    "split_branches",
+    "torsional_rigidity",
+    "lost_motion",
+    "backlash_at_zero",
+    "hysteresis_loss",
+    "HysteresisValues",
+    "hysteresis_values",
+    "te_peak_to_peak",
+    "forward_backward_difference",
+]
+
+ZERO_TORQUE_FRACTION = 1e-4
+"""``ε``: a virtual test samples ``±ε T_r`` on either side of zero torque."""
+
+
+@dataclass(frozen=True)
+class Branches:
+    """Ascending and descending branches, each sorted by torque [N·mm] with angles [rad]."""
+
+    asc_torque: np.ndarray
+    asc_angle: np.ndarray
+    desc_torque: np.ndarray
+    desc_angle: np.ndarray
+
+    def ascending(self, torque: ArrayLike) -> np.ndarray:
+        """``θ_asc(T)`` [rad] by linear interpolation."""
+        return np.interp(np.asarray(torque, dtype=float), self.asc_torque, self.asc_angle)
+
+    def descending(self, torque: ArrayLike) -> np.ndarray:
+        """``θ_desc(T)`` [rad] by linear interpolation."""
+        return np.interp(np.asarray(torque, dtype=float), self.desc_torque, self.desc_angle)
+
+    def mid(self, torque: ArrayLike) -> np.ndarray:
+        """Mid-curve ``(θ_asc + θ_desc)/2`` [rad]."""
+        return 0.5 * (self.ascending(torque) + self.descending(torque))
+
+
+def branch_directions(torque: ArrayLike, threshold: float = 0.02) -> np.ndarray:
+    """Infer the branch of each sample of a torque sweep: +1 torque rising, −1 falling.
+
+    A turning point is declared when the torque retreats from its running extreme by more than
+    ``threshold`` × the sweep's range (so noise on the torque reading does not split a branch);
+    samples up to the extreme belong to the branch that reached it.
+    """
+    t = np.asarray(torque, dtype=float)
+    n = t.size
+    out = np.empty(n, dtype=np.int64)
+    thr = threshold * float(np.ptp(t)) if n else 0.0
+    direction = 0
+    start = 0
+    ext_i = 0
+    for k in range(1, n):
+        if direction == 0:
+            if abs(t[k] - t[0]) > thr:
+                direction = 1 if t[k] > t[0] else -1
+                ext_i = k
+            continue
+        if (t[k] - t[ext_i]) * direction > 0:
+            ext_i = k
+        elif (t[ext_i] - t[k]) * direction > thr:
+            out[start : ext_i + 1] = direction
+            start = ext_i + 1
+            direction = -direction
+            ext_i = k
+    out[start:] = direction if direction != 0 else 1
+    return out
+
+
+def _runs(direction: np.ndarray) -> list[tuple[int, int, int]]:
+    edges = np.nonzero(np.diff(direction))[0] + 1
+    bounds = np.concatenate([[0], edges, [direction.size]])
+    return [
+        (int(a), int(b), int(direction[a])) for a, b in zip(bounds[:-1], bounds[1:], strict=True)
+    ]
+
+
+def split_branches(
+    torque: ArrayLike,
+    angle: ArrayLike,
+    rated_torque: float,
+    direction: ArrayLike | None = None,
+    *,
+    reach: float = 0.98,
+) -> Branches:
+    """Split a hysteresis sweep into its ascending and descending branches.
+
+    Parameters
+    ----------
+    torque : (K,) [N·mm], in recording order
+    angle : (K,) output torsion angle [rad]
+    rated_torque : float
+        ``T_r`` [N·mm].
+    direction : (K,) ints, optional
+        +1 rising / −1 falling torque per sample (a marked branch); inferred by
+        :func:`branch_directions` when omitted.
+    reach : float
+        Each branch must span ``[−reach T_r, +reach T_r]``.
+
+    Returns
+    -------
+    Branches
+        For each direction the *last* contiguous run of samples that spans ``±reach T_r``
+        (the virgin loading ``0 → +T_r`` of a standard sweep is thereby skipped), sorted by torque
+        (stable, so a repeated torque keeps its recording order).
+
+    Raises
+    ------
+    ParameterError
+        If no run of a direction spans ``±reach T_r``.
+    """
+    t = np.asarray(torque, dtype=float)
+    a = np.asarray(angle, dtype=float)
+    if t.shape != a.shape or t.ndim != 1:
+        raise ParameterError("angle", a.shape, f"must have the shape of torque {t.shape}")
+    if not np.isfinite(rated_torque) or rated_torque <= 0:
+        raise ParameterError("rated_torque", rated_torque, "must be > 0 [N·mm]")
+    d = branch_directions(t) if direction is None else np.asarray(direction)
+    lo, hi = -reach * rated_torque, reach * rated_torque
+    chosen: dict[int, tuple[int, int]] = {}
+    for s, e, sgn in _runs(d):
+        seg = t[s:e]
+        if seg.size >= 2 and seg.min() <= lo and seg.max() >= hi:
+            chosen[sgn] = (s, e)
+    for sgn, name in ((1, "ascending"), (-1, "descending")):
+        if sgn not in chosen:
+            raise ParameterError(
+                "hysteresis",
+                f"torque range [{t.min():.6g}, {t.max():.6g}] N·mm",
+                f"no {name} branch spans ±{reach:g} × rated torque {rated_torque:.6g} N·mm "
+                "(sweep -T_r → +T_r and back, or lower the rated torque)",
+            )
+    out = []
+    for sgn in (1, -1):
+        s, e = chosen[sgn]
+        seg_t, seg_a = t[s:e], a[s:e]
+        if sgn < 0:  # keep the recording order among equal torques after sorting
+            seg_t, seg_a = seg_t[::-1], seg_a[::-1]
+        order = np.argsort(seg_t, kind="stable")
+        out += [seg_t[order], seg_a[order]]
+    return Branches(*out)
+
+
+def torsional_rigidity(branches: Branches, rated_torque: float) -> float:
+    """Torsional rigidity b/a [N·mm/rad]: ``(T_r/2)/(θ_mid(T_r) − θ_mid(T_r/2))``, both signs
+    averaged.
+
+    A measured sweep whose peak torque falls short of ``T_r`` (within the ``reach`` that
+    :func:`split_branches` accepts) is read at its own peak ``T_hi``:
+    ``(T_hi − T_r/2)/(θ_mid(T_hi) − θ_mid(T_r/2))`` — nothing is extrapolated.
+    """
+    tr = rated_torque
+    hi = min(tr, branches.asc_torque[-1], branches.desc_torque[-1])
+    lo = max(-tr, branches.asc_torque[0], branches.desc_torque[0])
+    th = branches.mid(np.array([lo, -0.5 * tr, 0.5 * tr, hi]))
+    k_pos = (hi - 0.5 * tr) / (th[3] - th[2])
+    k_neg = (-0.5 * tr - lo) / (th[1] - th[0])
+    return float(0.5 * (k_pos + k_neg))
+
+
+def lost_motion(branches: Branches, rated_torque: float, fraction: float = 0.03) -> float:
+    """Lost motion ``θ_mid(+f T_r) − θ_mid(−f T_r)`` [rad], ``f`` = ``fraction`` (0.03 or 0.05)."""
+    if not 0 < fraction < 0.5:
+        raise ParameterError("lost_motion_fraction", fraction, "must be in (0, 0.5)")
+    th = branches.mid(np.array([-fraction, fraction]) * rated_torque)
+    return float(th[1] - th[0])
+
+
+def backlash_at_zero(branches: Branches, rated_torque: float) -> float:
+    """Backlash at zero torque [rad]: the hysteresis loss less the friction width.
+
+    ``(θ_desc(0) − θ_asc(0)) − w_f`` with the friction width ``w_f`` the mean loop width at
+    ``±T_r/2``, where the reducer is closed and only friction separates the branches. The free
+    play without friction; equal to the hysteresis loss for a frictionless (virtual) curve.
+    """
+    half = np.array([-0.5, 0.5]) * rated_torque
+    w_f = float(np.mean(branches.descending(half) - branches.ascending(half)))
+    return hysteresis_loss(branches) - w_f
+
+
+def hysteresis_loss(branches: Branches) -> float:
+    """Hysteresis loss ``θ_desc(0) − θ_asc(0)`` [rad]: loop width at zero torque."""
+    return float(branches.descending(0.0) - branches.ascending(0.0))
+
+
+@dataclass(frozen=True)
+class HysteresisValues:
+    """Catalogue quantities of one hysteresis curve [N·mm/rad, rad]."""
+
+    torsional_rigidity: float
+    lost_motion: float
+    backlash: float
+    hysteresis_loss: float
+    lost_motion_fraction: float
+
+
+def hysteresis_values(
+    torque: ArrayLike,
+    angle: ArrayLike,
+    rated_torque: float,
+    *,
+    direction: ArrayLike | None = None,
+    lost_motion_fraction: float = 0.03,
+) -> HysteresisValues:
+    """All hysteresis catalogue quantities of a sweep (see the module docstring)."""
+    br = split_branches(torque, angle, rated_torque, direction)
+    return HysteresisValues(
+        torsional_rigidity=torsional_rigidity(br, rated_torque),
+        lost_motion=lost_motion(br, rated_torque, lost_motion_fraction),
+        backlash=backlash_at_zero(br, rated_torque),
+        hysteresis_loss=hysteresis_loss(br),
+        lost_motion_fraction=lost_motion_fraction,
+    )
+
+
+def te_peak_to_peak(te: ArrayLike) -> float:
+    """Peak-to-peak of a TE trace [same unit as ``te``]."""
+    v = np.asarray(te, dtype=float)
+    return float(v.max() - v.min())
+
+
+def forward_backward_difference(
+    forward_position: ArrayLike,
+    forward_te: ArrayLike,
+    backward_position: ArrayLike,
+    backward_te: ArrayLike,
+) -> np.ndarray:
+    """``TE_fwd(φ) − TE_bwd(φ)`` [rad] at the forward positions ``φ`` [rad].
+
+    The backward trace is interpolated linearly and periodically (period 2π) onto the forward
+    positions; either trace may run in either sense.
+    """
+    bp = np.asarray(backward_position, dtype=float)
+    bt = np.asarray(backward_te, dtype=float)
+    back = np.interp(np.asarray(forward_position, dtype=float), bp, bt, period=2 * np.pi)
+    return np.asarray(forward_te, dtype=float) - back

@@ -1,0 +1,542 @@
+"""Calibration of one serial's reduced model to its bench data, and synthetic benches.
+
+Composes the reduced model (:mod:`gearte.models.bench_reduced`) with a bounded least-squares
+solver (``scipy.optimize.least_squares``, trust-region reflective). Reports the fit, the
+residuals, confidence intervals from the Jacobian, the correlations, and which parameters the
+data cannot identify (rank and condition of the Jacobian, huge intervals, parameters at a bound).
+:func:`synthetic_bench` generates bench data from known parameters (noise, encoder quantisation,
+rig compliance) for tests, the benchmark and the bundled example.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from gearte.errors import ParameterError
+from gearte.models.bench_data import HysteresisCurve, TETrace
+from gearte.models.bench_reduced import (
+    HYSTERESIS_PARAMETERS,
+    TE_COMMON,
+    ReducedRV,
+    hysteresis_angle,
+    hysteresis_jacobian,
+    parameter_names,
+    te_basis,
+    te_coefficients,
+    te_orders,
+    te_trace,
+)
+from gearte.models.catalogue import branch_directions, hysteresis_values
+from gearte.units import arcsec_to_rad
+
+__all__ = [
+    "ParameterSpec",
+    "parameter_specs",
+    "CalibrationResult",
+    "calibrate",
+    "synthetic_bench",
+    "reduced_constants",
+    "Z95",
+]
+
+Z95 = 1.959963984540054
+"""Two-sided 95 % normal quantile: confidence interval = ± Z95 × standard error."""
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """Unit label (for reports), scale, bounds of one parameter (gearte units)."""
+
+    unit: str
+    scale: float
+    lower: float
+    upper: float
+
+
+def parameter_specs(model: ReducedRV) -> dict[str, ParameterSpec]:
+    """Scales and bounds of every parameter of the reduced model."""
+    tr, k = model.rated_torque, model.nominal_rigidity
+    specs = {
+        "cam_bearing_clearance": ParameterSpec("mm", 0.005, 0.0, 0.2),
+        "carrier_bearing_clearance": ParameterSpec("mm", 0.005, 0.0, 0.2),
+        "play_transition_torque": ParameterSpec("N·mm", 0.01 * tr, 1e-5 * tr, 0.2 * tr),
+        "contact_stiffness_factor": ParameterSpec("-", 1.0, 0.05, 20.0),
+        "rig_compliance": ParameterSpec("rad/(N·mm)", 0.1 / k, 0.0, 20.0 / k),
+        "friction_torque": ParameterSpec("N·mm", 0.01 * tr, 0.0, 0.3 * tr),
+        "angle_offset": ParameterSpec("rad", 1e-4, -0.05, 0.05),
+        "te_offset": ParameterSpec("rad", 1e-5, -0.05, 0.05),
+        "running_windup": ParameterSpec("rad", 1e-5, -0.01, 0.01),
+    }
+    for name in model.family_parameters():
+        specs[name] = ParameterSpec("rad", 1e-5, -0.005, 0.005)
+    return specs
+
+
+@dataclass
+class CalibrationResult:
+    """Outcome of :func:`calibrate` (all values in gearte units, see :func:`parameter_specs`).
+
+    Attributes
+    ----------
+    params : dict
+        Every parameter of the model: fitted ones at their estimate, the others as fixed.
+    fitted : tuple of str
+    std, ci : dict
+        Standard error and 95 % half-width of each fitted parameter (``inf`` where the data
+        cannot identify it).
+    correlation : ndarray
+        Correlation matrix of the fitted parameters (order of ``fitted``).
+    flags : dict
+        Fitted parameter → why it is not identified (absent: identified).
+    groups : list of tuple
+        Parameters the data cannot tell apart (each group spans a null direction of J).
+    rank, condition : int, float
+        Rank and condition number of the column-normalised Jacobian.
+    residual_rms : dict
+        RMS residual [rad] of the hysteresis and the TE data; ``residuals`` holds them.
+    """
+
+    model: ReducedRV
+    params: dict
+    fitted: tuple[str, ...]
+    std: dict
+    ci: dict
+    correlation: np.ndarray
+    covariance: np.ndarray
+    flags: dict
+    groups: list
+    rank: int
+    condition: float
+    residual_rms: dict
+    residuals: dict = field(repr=False, default_factory=dict)
+    cost: float = 0.0
+    success: bool = True
+    message: str = ""
+
+    def identified(self) -> list[str]:
+        return [n for n in self.fitted if n not in self.flags]
+
+
+@dataclass(frozen=True)
+class _TERow:
+    """One direction of one trace, compressed exactly for least squares on the linear TE model.
+
+    With ``A`` the basis at the samples and ``ĉ`` the least-squares coefficients,
+    ``‖A c − y‖² = rss0 + ‖R (c − ĉ)‖²`` (``R`` the Cholesky factor of ``AᵀA``), so the fit
+    sees ``1 + 2U`` rows instead of thousands of samples and loses nothing.
+    """
+
+    direction: int
+    c_hat: np.ndarray
+    r: np.ndarray
+    rss0: float
+    samples: int
+
+
+def _te_rows(model, traces: list[TETrace]) -> list[_TERow]:
+    rows = []
+    for tr in traces:
+        for d, (pos, te) in tr.directions().items():
+            a = te_basis(model, pos)
+            ata = a.T @ a  # normal equations: the basis is well conditioned over a revolution
+            try:
+                r = np.linalg.cholesky(ata).T
+                c_hat = np.linalg.solve(ata, a.T @ te)
+            except np.linalg.LinAlgError:
+                raise ParameterError(
+                    "te",
+                    tr.source,
+                    "too few samples to resolve the orders of the TE model "
+                    f"(highest order {max(te_orders(model))} needs > {2 * max(te_orders(model))} "
+                    "samples per revolution)",
+                ) from None
+            rss0 = float(np.sum((a @ c_hat - te) ** 2))
+            rows.append(_TERow(1 if d == "forward" else -1, c_hat, r, rss0, te.size))
+    return rows
+
+
+def _initial(model, hyst, direction, te_rows, fixed):
+    """Starting point: catalogue values of the curve; TE coefficients by linear least squares."""
+    p = dict.fromkeys(parameter_names(model), 0.0)
+    tr = model.rated_torque
+    g = sum(model.backlash_per_clearance)
+    if hyst is not None:
+        hv = hysteresis_values(hyst.torque, hyst.angle, tr, direction=direction)
+        beta = max(hv.backlash, 1e-7)
+        p["cam_bearing_clearance"] = p["carrier_bearing_clearance"] = beta / (2 * g)
+        k_meas = hv.torsional_rigidity
+        p["rig_compliance"] = 0.05 / k_meas
+        p["contact_stiffness_factor"] = float(
+            np.clip(1.0 / ((1.0 / k_meas - p["rig_compliance"]) * model.nominal_rigidity),
+                    0.1, 10.0)
+        )  # fmt: skip
+        width = max(hv.hysteresis_loss - hv.backlash, 0.0)
+        p["friction_torque"] = max(0.5 * width * k_meas, 1e-4 * tr)
+        p["play_transition_torque"] = 0.01 * tr
+        p["angle_offset"] = float(
+            np.median(hyst.angle[np.abs(hyst.torque) < 0.05 * tr])
+            if np.any(np.abs(hyst.torque) < 0.05 * tr)
+            else 0.0
+        )
+    else:
+        p["contact_stiffness_factor"] = 1.0
+        p["play_transition_torque"] = 0.01 * tr
+    if te_rows:
+        orders = te_orders(model)
+        fwd = [r.c_hat for r in te_rows if r.direction > 0]
+        bwd = [r.c_hat for r in te_rows if r.direction < 0]
+        mean = np.mean([r.c_hat for r in te_rows], axis=0)
+        p["te_offset"] = float(mean[0])
+        if fwd and bwd:
+            p["running_windup"] = float(np.mean(fwd, 0)[0] - np.mean(bwd, 0)[0]) - (
+                hysteresis_play(model, p)
+            )
+        taken: set = set()
+        for fam, n in model.families.items():  # an order's amplitude goes to its first family
+            if n in taken:
+                continue
+            taken.add(n)
+            k = 1 + 2 * orders.index(int(n))
+            key = fam.replace(" ", "_")
+            p[f"{key}_cos"], p[f"{key}_sin"] = float(mean[k]), float(mean[k + 1])
+    p.update(fixed)
+    return p
+
+
+def hysteresis_play(model: ReducedRV, p: dict) -> float:
+    g_cam, g_car = model.backlash_per_clearance
+    return g_cam * p["cam_bearing_clearance"] + g_car * p["carrier_bearing_clearance"]
+
+
+def calibrate(
+    model: ReducedRV,
+    hysteresis: HysteresisCurve | None,
+    traces: list[TETrace],
+    *,
+    fit: list[str] | tuple[str, ...] | None = None,
+    fixed: dict | None = None,
+    max_relative_ci: float = 0.25,
+    torque_noise: float = 0.0,
+) -> CalibrationResult:
+    """Fit the chosen parameters of the reduced model to one serial's hysteresis and TE data.
+
+    Parameters
+    ----------
+    model : ReducedRV
+    hysteresis : HysteresisCurve or None
+    traces : list of TETrace
+        One or more TE traces of the serial (their torque/speed are not modelled: use the
+        traces of one operating point).
+    fit : names, optional
+        Parameters to fit (default: all whose data are given); the others are held at ``fixed``
+        or at their starting value.
+    fixed : dict, optional
+        Values [gearte units] of parameters held fixed (e.g. ``{"rig_compliance": 1e-10}`` from
+        a calibration shaft, ``{"encoder_eccentricity_cos": 0, ...}`` from a reversal test).
+    torque_noise : float
+        Standard deviation of the torque reading as a fraction of ``T_r`` (the sensor's
+        specification); near zero torque, where the curve is steep, it dominates the angle
+        error and the hysteresis residuals are weighted by the effective variance.
+    max_relative_ci : float
+        A parameter whose 95 % half-width exceeds this fraction of its bound range is flagged.
+
+    Returns
+    -------
+    CalibrationResult
+
+    Notes
+    -----
+    Residuals are weighted by each block's noise (hysteresis angle, TE), estimated from a first
+    fit; the covariance is ``s² (JᵀJ)⁺`` at the weighted solution with ``s²`` the reduced
+    chi-square, so the interval of any identified parameter is valid whatever the null space.
+    """
+    from scipy.optimize import least_squares
+
+    fixed = dict(fixed or {})
+    names = parameter_names(model)
+    specs = parameter_specs(model)
+    unknown = [n for n in (*(fit or ()), *fixed) if n not in names]
+    if unknown:
+        raise ParameterError("calibration.fit", unknown, f"unknown parameter(s); known: {names}")
+    te_rows = _te_rows(model, traces)
+    if hysteresis is None and not te_rows:
+        raise ParameterError("calibration", None, "needs a hysteresis curve or a TE trace")
+    direction: Any = None
+    if hysteresis is not None:
+        direction = (
+            hysteresis.branch
+            if hysteresis.branch is not None
+            else branch_directions(hysteresis.torque)
+        )
+    available = []
+    if hysteresis is not None:
+        available += list(HYSTERESIS_PARAMETERS)
+    if te_rows:
+        available += [*TE_COMMON, *model.family_parameters()]
+        for c in ("cam_bearing_clearance", "carrier_bearing_clearance"):
+            if c not in available:
+                available.append(c)
+    fit = tuple(n for n in (fit or available) if n not in fixed)
+    if not fit:
+        raise ParameterError("calibration.fit", [], "nothing to fit")
+    p0 = _initial(model, hysteresis, direction, te_rows, fixed)
+    scale = np.array([specs[n].scale for n in fit])
+    lo = np.array([specs[n].lower for n in fit]) / scale
+    hi = np.array([specs[n].upper for n in fit]) / scale
+    x0 = np.clip(np.array([p0[n] for n in fit]) / scale, lo, hi)
+    x0 = np.clip(x0, lo + 1e-6 * (hi - lo), hi - 1e-6 * (hi - lo))
+
+    def unpack(x):
+        p = dict(p0)
+        p.update(zip(fit, x * scale, strict=True))
+        return p
+
+    def te_map(direction):
+        base = unpack(np.zeros(len(fit)))
+        c0 = te_coefficients(model, base, direction)
+        cx = np.empty((c0.size, len(fit)))
+        for j in range(len(fit)):
+            e = np.zeros(len(fit))
+            e[j] = 1.0
+            cx[:, j] = te_coefficients(model, unpack(e), direction) - c0
+        return c0, cx
+
+    te_maps = [te_map(r.direction) for r in te_rows]
+
+    def blocks(x):
+        p = unpack(x)
+        out = {}
+        if hysteresis is not None:
+            out["hysteresis"] = hysteresis_angle(model, p, hysteresis.torque, direction) - (
+                hysteresis.angle
+            )
+        if te_rows:  # the TE coefficients are linear in the parameters: c = c0 + C x
+            out["te"] = np.concatenate([r.r @ (c0 + cx @ x - r.c_hat) for r, (c0, cx) in
+                                        zip(te_rows, te_maps, strict=True)])  # fmt: skip
+        return out
+
+    weights = dict.fromkeys(("hysteresis", "te"), 1.0 / arcsec_to_rad(1.0))
+
+    def fun(x):
+        return np.concatenate([weights[k] * v for k, v in blocks(x).items()])
+
+    def jac(x):
+        """Analytic Jacobian of ``fun`` in the scaled parameters (hysteresis: the model's
+        derivatives; TE: its linear map)."""
+        rows = []
+        if hysteresis is not None:
+            d = hysteresis_jacobian(model, unpack(x), hysteresis.torque, direction)
+            w = np.asarray(weights["hysteresis"])
+            block = np.zeros((hysteresis.torque.size, len(fit)))
+            for j, nm in enumerate(fit):
+                if nm in d:
+                    block[:, j] = d[nm] * scale[j]
+            rows.append(block * (w[:, None] if w.ndim else w))
+        if te_rows:
+            te_j = [r.r @ cx for r, (_, cx) in zip(te_rows, te_maps, strict=True)]
+            rows.append(weights["te"] * np.vstack(te_j))
+        return np.vstack(rows)
+
+    res = least_squares(
+        fun, x0, bounds=(lo, hi), method="trf", x_scale=1.0, jac=jac, tr_solver="lsmr"
+    )
+    counts = {"hysteresis": 0 if hysteresis is None else hysteresis.torque.size,
+              "te": sum(r.samples for r in te_rows)}  # fmt: skip
+    rss0 = {"hysteresis": 0.0, "te": sum(r.rss0 for r in te_rows)}
+
+    def block_rms(b):
+        return {k: float(np.sqrt((np.sum(v**2) + rss0[k]) / counts[k])) for k, v in b.items()}
+
+    for k, v in block_rms(blocks(res.x)).items():  # reweight by each block's noise, refit
+        weights[k] = 1.0 / max(v, 1e-15)
+    if hysteresis is not None and torque_noise > 0:
+        # effective variance: the torque reading's noise seen through the curve's local slope
+        p1 = unpack(res.x)
+        dt = min(0.1 * p1["play_transition_torque"], 1e-3 * model.rated_torque)
+        slope = (
+            hysteresis_angle(model, p1, hysteresis.torque + dt, direction)
+            - hysteresis_angle(model, p1, hysteresis.torque - dt, direction)
+        ) / (2 * dt)
+        var_t = (slope * torque_noise * model.rated_torque) ** 2
+        r2 = float(np.mean(blocks(res.x)["hysteresis"] ** 2))
+        var_a = max(r2 - float(np.mean(var_t)), 0.0025 * r2)
+        weights["hysteresis"] = 1.0 / np.sqrt(var_a + var_t)
+    res = least_squares(
+        fun, res.x, bounds=(lo, hi), method="trf", x_scale=1.0, jac=jac, tr_solver="lsmr"
+    )
+    nfev = res.nfev
+    b = blocks(res.x)
+    n = len(fit)
+    jmat = np.asarray(res.jac)
+    norms = np.linalg.norm(jmat, axis=0)
+    norms = np.where(norms > 0, norms, 1.0)
+    jn = jmat / norms
+    # singular values/vectors of Jn from the small Gram matrix (LAPACK on the tall Jn is slow)
+    ev, evec = np.linalg.eigh(jn.T @ jn)
+    order = np.argsort(ev)[::-1]
+    sv = np.sqrt(np.clip(ev[order], 0.0, None))
+    vt = evec[:, order].T
+    tol = sv[0] * 1e-6 if sv.size else 0.0  # Gram matrix: sqrt of eps-level eigenvalues
+    rank = int(np.sum(sv > tol))
+    condition = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf")
+    m_all = sum(counts[k] for k in b)
+    chi2 = float(np.sum(res.fun**2)) + float(sum(np.mean(weights[k] ** 2) * rss0[k] for k in b))
+    s2 = chi2 / max(m_all - rank, 1)
+    inv = np.where(sv > tol, 1.0 / np.where(sv > tol, sv, 1.0) ** 2, 0.0)
+    cov_n = s2 * (vt.T * inv) @ vt  # (JnᵀJn)⁺ on the identified subspace
+    cov_x = cov_n / np.outer(norms, norms)
+    cov = cov_x * np.outer(scale, scale)
+    std_arr = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    flags: dict = {}
+    groups: list = []
+    # null space of J: P = V0 V0ᵀ is independent of the basis chosen within it; a parameter with
+    # a share of P_ii is not identifiable, and two are confounded where P_ij != 0
+    v0 = vt[rank:].T
+    proj = v0 @ v0.T
+    weak = [i for i in range(n) if proj[i, i] > 1e-2]
+    seen: set = set()
+    for i in weak:
+        if i in seen:
+            continue
+        members = [j for j in weak if abs(proj[i, j]) > 1e-3]
+        seen.update(members)
+        group = tuple(fit[j] for j in members)
+        groups.append(group)
+        for nm in group:
+            others = [o for o in group if o != nm]
+            flags[nm] = (
+                "not identifiable: the data see only its combination with " + ", ".join(others)
+                if others
+                else "not identifiable: no data depends on it"
+            )
+    std = {}
+    ci = {}
+    for i, nm in enumerate(fit):
+        if nm in flags:
+            std[nm] = ci[nm] = float("inf")
+            continue
+        std[nm] = float(std_arr[i])
+        ci[nm] = Z95 * std[nm]
+        rng = specs[nm].upper - specs[nm].lower
+        xi = res.x[i]
+        if ci[nm] > max_relative_ci * rng:
+            flags[nm] = (
+                f"poorly identified: 95 % interval ±{ci[nm]:.3g} {specs[nm].unit} exceeds "
+                f"{max_relative_ci:g} of its range"
+            )
+        elif min(xi - lo[i], hi[i] - xi) < 1e-6 * (hi[i] - lo[i]):
+            flags[nm] = "at a bound: interval not valid (the data push it past its range)"
+    d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
+    corr = cov / np.outer(d, d)
+    return CalibrationResult(
+        model=model,
+        params=unpack(res.x),
+        fitted=fit,
+        std=std,
+        ci=ci,
+        correlation=corr,
+        covariance=cov,
+        flags=flags,
+        groups=groups,
+        rank=rank,
+        condition=condition,
+        residual_rms=block_rms(b),
+        residuals=_residuals(model, unpack(res.x), hysteresis, direction, traces),
+        cost=float(res.cost),
+        success=bool(res.success),
+        message=f"{res.message} ({nfev} evaluations)",
+    )
+
+
+def _residuals(model, p, hysteresis, direction, traces) -> dict:
+    """Measured minus model [rad]: hysteresis per sample, TE per trace and direction."""
+    out = {}
+    if hysteresis is not None:
+        out["hysteresis"] = hysteresis.angle - hysteresis_angle(
+            model, p, hysteresis.torque, direction
+        )
+    for k, tr in enumerate(traces):
+        for d, (pos, te) in tr.directions().items():
+            out[f"te {k} {d}"] = te - te_trace(model, p, pos, 1 if d == "forward" else -1)
+    return out
+
+
+# ---- synthetic benches --------------------------------------------------------------------
+def synthetic_bench(
+    model: ReducedRV,
+    params: dict,
+    rng: np.random.Generator,
+    *,
+    samples_per_revolution: int = 4096,
+    hysteresis_points: int = 400,
+    angle_noise: float = arcsec_to_rad(0.3),
+    torque_noise: float = 2e-4,
+    encoder_counts: int = 2**21,
+    speed_rpm: float = 15.0,
+    oil_temperature: float = 40.0,
+    serial: str = "synthetic",
+) -> tuple[HysteresisCurve, TETrace]:
+    """Bench data of a serial with known parameters: hysteresis sweep and one TE trace.
+
+    The hysteresis sweep runs ``0 → +T_r → −T_r → +T_r`` (``hysteresis_points`` per half
+    branch); the torque reading has Gaussian noise of ``torque_noise`` × ``T_r``, the angles
+    Gaussian noise ``angle_noise`` [rad] and are quantised to the encoder's ``encoder_counts``
+    per revolution (TE: both encoders). The TE trace spans one output revolution forward and
+    backward with ``samples_per_revolution`` samples each.
+    """
+    tr = model.rated_torque
+    h = hysteresis_points
+    t_true = np.concatenate([
+        np.linspace(0.0, tr, h, endpoint=False),
+        np.linspace(tr, -tr, 2 * h, endpoint=False),
+        np.linspace(-tr, tr, 2 * h + 1),
+    ])  # fmt: skip
+    direction = np.concatenate([np.ones(h), -np.ones(2 * h), np.ones(2 * h + 1)]).astype(np.int64)
+    q = 2 * np.pi / encoder_counts
+    angle = hysteresis_angle(model, params, t_true, direction)
+    angle = q * np.round((angle + rng.normal(0.0, angle_noise, angle.size)) / q)
+    torque = t_true + rng.normal(0.0, torque_noise * tr, t_true.size)
+    hyst = HysteresisCurve("synthetic", torque, angle, direction, serial=serial)
+    n = samples_per_revolution
+    pos_f = 2 * np.pi * np.arange(n) / n
+    pos_b = pos_f[::-1].copy()
+
+    def measured(pos, d):
+        te = te_trace(model, params, pos, d) + rng.normal(0.0, angle_noise, pos.size)
+        return q * np.round(te / q)
+
+    trace = TETrace(
+        "synthetic", pos_f, measured(pos_f, 1), pos_b, measured(pos_b, -1),
+        speed_rpm=speed_rpm, torque=0.0, oil_temperature=oil_temperature, serial=serial,
+    )  # fmt: skip
+    return hyst, trace
+
+
+def reduced_constants(reducer, families: dict[str, int], *, clearance: float = 0.005) -> ReducedRV:
+    """The reduced model's constants of a whole RV reducer, from its own virtual tests.
+
+    ``K_nom`` is the catalogue rigidity of the reducer as described (its clearances included);
+    ``g_cam``, ``g_car`` [rad/mm] are the backlash added per mm of radial clearance of the cam
+    and carrier crank bearings, by finite difference of the virtual backlash with ``clearance``
+    [mm] added to each in turn.
+    """
+    from gearte.models.rv_catalogue import backlash, catalogue_values
+
+    base = backlash(reducer)
+    k_nom = catalogue_values(reducer, steps_per_segment=2).torsional_rigidity
+    c = reducer.cranks
+    g = []
+    for name in ("cam_bearing_clearance", "carrier_bearing_clearance"):
+        changed = reducer.replace(
+            cranks=type(c)(**{**c.__dict__, name: getattr(c, name) + clearance})
+        )
+        g.append((backlash(changed) - base) / clearance)
+    return ReducedRV(
+        rated_torque=reducer.rated_torque,
+        nominal_rigidity=k_nom,
+        backlash_per_clearance=(g[0], g[1]),
+        families=dict(families),
+    )
