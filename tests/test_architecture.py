@@ -26,6 +26,7 @@ LAYERS: list[tuple[str, ...]] = [
         "gearte.errors",
         "gearte.limits",
         "gearte.units",
+        "gearte.labels",
         "gearte.references",
         "gearte.cases",
     ),

@@ -240,7 +240,6 @@ PENDING = frozenset(
         "gearte.report.outputs.atomic_write_bytes",
         "gearte.report.outputs.atomic_write_text",
         "gearte.report.outputs.safe_label",
-        "gearte.report.outputs.write_outputs",
         "gearte.results.to_jsonable",
         "gearte.runners.rv_dynamics_sim.draw_errors",
         "gearte.runners.rv_dynamics_sim.dte_batch",

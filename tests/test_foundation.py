@@ -87,7 +87,7 @@ def test_results_json_and_report_are_written(tmp_path):
     assert data["case"]["kind"] == "foundation_test" and "gearte_version" in data
     assert paths["results"].stat().st_mode & 0o044 == 0o044  # readable by others, like any file
     html = paths["report"].read_text()
-    assert "data:image/png;base64," in html and "total_length [mm]" in html
+    assert "data:image/png;base64," in html and "Total length" in html and "15 mm" in html
 
 
 def test_failed_report_leaves_nothing_half_written(tmp_path):
@@ -181,7 +181,8 @@ def test_extra_output_files_are_written_beside_results(tmp_path):
     result["demo"].files["table.csv"] = "a,b\n1,2\n"
     paths = write_outputs(result, tmp_path / "o", report=False)
     assert (tmp_path / "o" / "table.csv").read_text() == "a,b\n1,2\n"
-    assert set(paths) == {"results", "table.csv"}
+    # with the tabular results every kind writes as CSV (scalars, series, mappings)
+    assert set(paths) == {"results", "table.csv", "summary.csv", "demo_x.csv", "demo_map.csv"}
     result["demo"].files = {"../escape.csv": "x"}
     with pytest.raises(ValueError, match="bad output file name"):
         write_outputs(result, tmp_path / "o2", report=False)

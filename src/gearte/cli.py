@@ -167,6 +167,11 @@ def main() -> None:
 @_execution_options
 @click.option("--no-report", is_flag=True, help="Write results.json only.")
 @click.option("--no-progress", is_flag=True, help="Hide progress bars.")
+@click.option(
+    "--timings",
+    is_flag=True,
+    help="Print the time of each stage (imports, analyses, figures, writing) as JSON on stderr.",
+)
 @click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
 def run(
     case: str,
@@ -177,16 +182,22 @@ def run(
     scheduler: str | None,
     no_report: bool,
     no_progress: bool,
+    timings: bool,
     debug: bool,
 ) -> None:
     """Run CASE (a .toml file or a bundled case name) and write results.json and report.html."""
 
     def _run() -> None:
+        import time
+
+        t0 = time.perf_counter()
         from gearte.io.case_file import load_case
         from gearte.report.outputs import check_output_dir, safe_label, write_outputs
         from gearte.studies import RunOptions, run_case
 
+        t1 = time.perf_counter()
         c = load_case(case)
+        t2 = time.perf_counter()
         default = os.path.join("out", safe_label(c.case.name or c.case.kind))
         target = check_output_dir(out_dir if out_dir is not None else default)
         with _executor(scheduler, workers) as executor:
@@ -198,12 +209,18 @@ def run(
                 workers=workers,
             )
             result = run_case(c, opts)
+        result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
         paths = write_outputs(result, target, report=not no_report)
         for w in result.warnings:
             click.echo(f"warning: {w}", err=True)
         click.echo(f"{result.name}: {len(result.analyses)} analyses in {result.elapsed_s:.2f} s")
         for p in paths.values():
             click.echo(f"  wrote {p}")
+        if timings:
+            import json
+
+            result.timings["total in gearte"] = time.perf_counter() - t0
+            click.echo(f"timings [s]: {json.dumps(result.timings)}", err=True)
 
     _guarded(_run, debug)
 

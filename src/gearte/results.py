@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -77,6 +78,9 @@ class AnalysisResult:
     files : dict
         Extra output files, plain file name → text (e.g. a compensation table a controller
         loads); written beside ``results.json`` by :func:`gearte.report.write_outputs`.
+    created : float
+        ``time.perf_counter()`` when the result was made; :func:`gearte.studies.run_case` times
+        each analysis as the interval since the previous one's result (or the run's start).
     """
 
     name: str
@@ -86,6 +90,7 @@ class AnalysisResult:
     notes: list[str] = field(default_factory=list)
     data: dict[str, Any] = field(default_factory=dict, repr=False)
     files: dict[str, str] = field(default_factory=dict, repr=False)
+    created: float = field(default_factory=time.perf_counter, repr=False, compare=False)
 
     def __getitem__(self, key: str) -> Any:
         return self.values[key]
@@ -103,13 +108,18 @@ class AnalysisResult:
 class StudyResult:
     """All analyses of one case run.
 
-    ``result["tooth_contact"]["pins_in_mesh"]`` reads a value.
+    ``result["tooth_contact"]["pins_in_mesh"]`` reads a value. ``timings`` holds the time of
+    each stage of the run in seconds (``"imports"``, ``"numba load/compile"``,
+    ``"analysis: <name>"``, ``"figures"``, ``"render"``, ``"write"``, ...), filled
+    by :func:`gearte.studies.run_case`, :func:`gearte.report.write_outputs` and the CLI, and
+    written to ``results.json`` as ``"timings [s]"``.
     """
 
     case: Any
     analyses: list[AnalysisResult] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
+    timings: dict[str, float] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> AnalysisResult:
         for a in self.analyses:
@@ -150,6 +160,7 @@ class StudyResult:
             "references": {k: REFERENCES.get(k, k) for k in self.references},
             "warnings": list(self.warnings) + self._nonfinite_warnings(),
             "elapsed [s]": round(self.elapsed_s, 4),
+            "timings [s]": {k: round(v, 4) for k, v in self.timings.items()},
             "analyses": {a.name: a.to_dict() for a in self.analyses},
         }
 

@@ -37,6 +37,10 @@ __all__ = [
     "KGM2_TO_TMM2",
     "N_PER_M_TO_N_PER_MM",
     "NM_PER_RAD_TO_NMM_PER_RAD",
+    "unit_text",
+    "split_unit",
+    "format_number",
+    "format_quantity",
 ]
 
 DEG_PER_RAD: float = 180.0 / np.pi
@@ -146,3 +150,90 @@ def format_dms(angle_rad: float, *, arcsec_decimals: int = 0) -> str:
     sec_s = f"{sec:.{arcsec_decimals}f}" if arcsec_decimals else f"{int(round(sec))}"
     head = f"{deg}°" if deg else ""
     return f"{sign}{head}{minutes}′{sec_s}″"
+
+
+# --- the one formatter of quantities for people (reports, figure labels, CLI) ------------------
+
+#: Spelling of units for people; keys are the spellings found in result names.
+_UNIT_SPELLING: dict[str, str] = {
+    "um": "µm",
+    "µm": "µm",
+    "um2": "µm²",
+    "mm2": "mm²",
+    "N*m": "N·m",
+    "Nm": "N·m",
+    "N.m": "N·m",
+    "N*mm": "N·mm",
+    "Nmm": "N·mm",
+    "N.mm": "N·mm",
+    "deg": "°",
+    "arcmin": "arcmin",
+    "arcsec": "arcsec",
+    "x input": "× input",
+}
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+#: Units written as a symbol right after the number (``1.03′``, ``71.6″``, ``14°``).
+_ATTACHED = {"arcmin": "′", "arcsec": "″", "deg": "°", "%": " %"}
+
+
+def unit_text(unit: str) -> str:
+    """A unit as people read it: ``um`` → ``µm``, ``N*m/arcmin`` → ``N·m/arcmin``, ``deg`` → ``°``.
+
+    Compound units are spelled part by part (``arcsec/um`` → ``arcsec/µm``)."""
+    unit = unit.strip()
+    if unit in _UNIT_SPELLING:
+        return _UNIT_SPELLING[unit]
+    if "/" in unit:
+        return "/".join(unit_text(p) for p in unit.split("/"))
+    return unit.replace("*", "·")
+
+
+def split_unit(name: str) -> tuple[str, str]:
+    """``"peak_pin_load [N]"`` → ``("peak_pin_load", "N")``; without a unit → ``(name, "")``."""
+    name = str(name)
+    if name.endswith("]") and " [" in name:
+        base, _, unit = name[:-1].rpartition(" [")
+        return base, unit
+    return name, ""
+
+
+def format_number(x: object, digits: int = 4) -> str:
+    """The number ``x`` for people: ``digits`` significant digits, no exponent between 1e-3 and 1e6,
+    integers as integers, booleans as yes/no; NaN, infinities and ``None`` as an em dash."""
+    if x is None:
+        return "—"
+    if isinstance(x, bool | np.bool_):
+        return "yes" if x else "no"
+    if isinstance(x, int | np.integer):
+        return f"{int(x):,}".replace(",", "\u2009") if abs(int(x)) >= 10000 else str(int(x))
+    try:
+        f = float(x)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return str(x)
+    if not np.isfinite(f):
+        return "—"
+    if f == 0:
+        return "0"
+    a = abs(f)
+    if 1e-3 <= a < 1e6:
+        decimals = max(0, digits - 1 - int(np.floor(np.log10(a))))
+        text = f"{f:.{decimals}f}"
+        if "." in text:
+            text = text.rstrip("0").rstrip(".")
+        return "0" if text in ("-0", "") else text
+    mant, _, exp = f"{f:.{digits - 1}e}".partition("e")
+    if "." in mant:
+        mant = mant.rstrip("0").rstrip(".")
+    return f"{mant}×10{str(int(exp)).translate(_SUPERSCRIPT)}"
+
+
+def format_quantity(x: object, unit: str = "", digits: int = 4) -> str:
+    """The value ``x`` with its ``unit`` for people (``digits`` significant digits):
+    ``(1.0339, "arcmin")`` → ``1.034′``, ``(1904.6, "N")`` → ``1905 N``, ``(17.19, "um")`` →
+    ``17.19 µm``, NaN → ``—`` (no unit)."""
+    text = format_number(x, digits)
+    if not unit or text == "—":
+        return text
+    if unit in _ATTACHED:
+        return text + _ATTACHED[unit]
+    return f"{text} {unit_text(unit)}"

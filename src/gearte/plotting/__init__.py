@@ -10,7 +10,7 @@ import importlib
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Figure", "new_figure", "figures_for", "PALETTE"]
+__all__ = ["Figure", "new_figure", "figures_for", "for_analysis", "PALETTE"]
 
 #: Colours used consistently across gearte's plots (colour-blind safe, Okabe–Ito).
 PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000"]
@@ -18,11 +18,22 @@ PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F
 
 @dataclass
 class Figure:
-    """A figure of a report: its title, a caption saying what to read from it, the figure."""
+    """A figure of a report: its title, a caption saying what to read from it, the figure, and
+    the name of the analysis it illustrates (the report places it beside that analysis's table).
+    """
 
     title: str
     caption: str
     fig: Any  # matplotlib.figure.Figure
+    analysis: str = ""
+
+
+def for_analysis(name: str, figs: list[Figure]) -> list[Figure]:
+    """Mark the figures ``figs`` as illustrating the analysis ``name`` (the report shows them
+    beside it)."""
+    for f in figs:
+        f.analysis = name
+    return figs
 
 
 def new_figure(

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import Nmm_to_Nm, rad_to_deg
 
 __all__ = ["figures", "profile_figure", "contact_figures", "sensitivity_figure", "pareto_figure"]
@@ -202,11 +202,11 @@ def pareto_figure(result: Any) -> Figure:
 
 def figures(result: Any) -> list[Figure]:
     """All figures of a ``cycloid_stage`` result."""
-    out = [profile_figure(result["geometry"].data["stage"])]
-    if "tooth_contact" in result:
-        out += contact_figures(result)
+    out = for_analysis("geometry", [profile_figure(result["geometry"].data["stage"])])
     if "geometric_te" in result:
-        out += [sensitivity_figure(result), pareto_figure(result)]
+        out += for_analysis("geometric_te", [sensitivity_figure(result), pareto_figure(result)])
+    if "tooth_contact" in result:
+        out += for_analysis("tooth_contact", contact_figures(result))
     from gearte.plotting.yield_figures import yield_figures
 
     return out + yield_figures(result)

@@ -35,9 +35,12 @@ def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:
     mean, sd = v["backlash_mean [um]"], v["backlash_sd [um]"]
     samples = mm_to_um(np.asarray(mc.samples))
     fig, ax = new_figure()
-    ax.hist(samples, bins=80, density=True, color=PALETTE[5], alpha=0.7, label="Monte-Carlo")
+    from gearte.plotting.display import STRIP_BELOW, distribution
+
+    drawn = distribution(ax, samples, color=PALETTE[5], label="Monte-Carlo", density=True, bins=80)
     x = np.linspace(mean - 4.5 * sd, mean + 4.5 * sd, 300)
-    ax.plot(
+    dens = ax if drawn == "histogram" else ax.twinx()
+    dens.plot(
         x,
         np.exp(-0.5 * ((x - mean) / sd) ** 2) / (sd * math.sqrt(2 * math.pi)),
         color=PALETTE[1],
@@ -50,7 +53,7 @@ def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:
     if lim:
         ax.axvline(lim, color=PALETTE[7], ls=":", lw=1.5, label=f"minimum limit {lim:g} µm")
     ax.set_xlabel("normal backlash [µm]")
-    ax.set_ylabel("probability density [1/µm]")
+    ax.set_ylabel("probability density [1/µm]" if len(samples) >= STRIP_BELOW else "samples")
     ax.legend(loc="upper left", fontsize=8)
     return Figure(
         title,
@@ -189,19 +192,25 @@ def figures(result: Any) -> list[Figure]:
             label = a.title.split("Normal backlash")[0]
             mc_name = f"{prefix}monte_carlo"
             if mc_name in result:
-                figs.append(
-                    backlash_histogram(
-                        a, result[mc_name].data["mc"], f"{label}{a.data['kind']} pair backlash"
-                    )
+                f = backlash_histogram(
+                    a, result[mc_name].data["mc"], f"{label}{a.data['kind']} pair backlash"
                 )
+                f.analysis = mc_name
+                figs.append(f)
             c_name = f"{prefix}contributions"
             if c_name in result:
-                figs.append(
-                    contribution_pareto(result[c_name], f"{label}{a.data['kind']} pair Pareto")
-                )
+                f = contribution_pareto(result[c_name], f"{label}{a.data['kind']} pair Pareto")
+                f.analysis = c_name
+                figs.append(f)
     if "chain" in result:
-        figs.append(chain_diagram(result["chain"]))
-        figs.append(compensation(result))
+        f = chain_diagram(result["chain"])
+        f.analysis = "chain"
+        figs.append(f)
+        f = compensation(result)
+        f.analysis = "compensation" if "compensation" in result else "chain"
+        figs.append(f)
     if "chain_te" in result:
-        figs.append(joint_te(result["chain_te"]))
+        f = joint_te(result["chain_te"])
+        f.analysis = "chain_te"
+        figs.append(f)
     return figs

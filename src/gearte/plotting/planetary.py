@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from gearte.labels import label
 from gearte.plotting import PALETTE, Figure, new_figure
 from gearte.units import rad_to_arcsec
 
@@ -112,7 +113,8 @@ def mc_histograms_figure(result: Any) -> Figure | None:
             e,
             color=PALETTE[k % len(PALETTE)],
             lw=1.4,
-            label=f"{a.name[3:]}: mean {a['mc_mean [arcsec]']:.0f}″, sd {a['mc_sd [arcsec]']:.0f}″",
+            label=f"{label(a.name).removeprefix('Monte-Carlo: ')}: mean "
+            f"{a['mc_mean [arcsec]']:.0f}″, sd {a['mc_sd [arcsec]']:.0f}″",
         )
     ax.set_xlabel("coupled TE amplitude [arcsec]")
     ax.set_ylabel("probability density [1/arcsec]")
@@ -129,4 +131,12 @@ def figures(result: Any) -> list[Figure]:
     from gearte.plotting.yield_figures import yield_figures
 
     out = [phasor_figure(result), te_period_figure(result), mc_histograms_figure(result)]
+    names = [
+        "coupled_te",
+        "coupled_te",
+        next((a.name for a in result.analyses if a.name.startswith("mc_")), ""),
+    ]
+    for f, name in zip(out, names, strict=True):
+        if f is not None:
+            f.analysis = name
     return [f for f in out if f is not None] + yield_figures(result)

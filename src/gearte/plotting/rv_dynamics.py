@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import mm_to_um, rad_to_arcsec
 
 __all__ = ["figures"]
@@ -185,9 +185,11 @@ def _sweep_figure(a) -> Figure:
 def _batch_figure(a) -> Figure:
     fig, ax = new_figure(figsize=(6.0, 3.4))
     rows = a.data["rows"]
-    ax.hist(rows[:, 0], bins=max(5, int(np.sqrt(rows.shape[0]))), color=PALETTE[0])
+    from gearte.plotting.display import distribution
+
+    drawn = distribution(ax, rows[:, 0], color=PALETTE[0])
     ax.set_xlabel("DTE peak-to-peak [arcsec]")
-    ax.set_ylabel("realisations")
+    ax.set_ylabel("realisations" if drawn == "histogram" else "")
     return Figure(
         "DTE peak-to-peak over random error realisations",
         f"{rows.shape[0]} realisations, mean {rows[:, 0].mean():.3g}″.",
@@ -199,15 +201,15 @@ def figures(result) -> list[Figure]:
     """All figures of an ``rv_dynamics`` result."""
     out: list[Figure] = []
     if "contact" in result:
-        out.append(_contact_figure(result["contact"]))
+        out += for_analysis("contact", [_contact_figure(result["contact"])])
         if result["contact"].values.get("load_sweep"):
-            out.append(_load_figure(result["contact"]))
+            out += for_analysis("contact", [_load_figure(result["contact"])])
     if "dte" in result:
-        out += _dte_figures(result["dte"])
+        out += for_analysis("dte", _dte_figures(result["dte"]))
     if "modal" in result:
-        out.append(_campbell_figure(result["modal"]))
+        out += for_analysis("modal", [_campbell_figure(result["modal"])])
     if "speed_sweep" in result:
-        out.append(_sweep_figure(result["speed_sweep"]))
+        out += for_analysis("speed_sweep", [_sweep_figure(result["speed_sweep"])])
     if "batch" in result:
-        out.append(_batch_figure(result["batch"]))
+        out += for_analysis("batch", [_batch_figure(result["batch"])])
     return out

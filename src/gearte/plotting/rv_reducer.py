@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import (
     Nm_to_Nmm,
     Nmm_per_rad_to_Nm_per_arcmin,
+    format_quantity,
     rad_to_arcmin,
     rad_to_arcsec,
     rad_to_deg,
@@ -98,14 +99,14 @@ def _hysteresis(cat, rated: float) -> Figure:
             ang[i100] + rad_to_arcmin((t - 100.0) / 100.0 * rated / k),
             color=PALETTE[1],
             lw=2,
-            label=f"rigidity {Nmm_per_rad_to_Nm_per_arcmin(k):.0f} N*m/arcmin",
+            label=f"rigidity {format_quantity(Nmm_per_rad_to_Nm_per_arcmin(k), 'N*m/arcmin')}",
         )
-    ax.axvspan(-3.0, 3.0, color=PALETTE[2], alpha=0.2,
-               label=f"±3 %: lost motion {rad_to_arcmin(cat.lost_motion):.3f}'")  # fmt: skip
+    lost = format_quantity(rad_to_arcmin(cat.lost_motion), "arcmin")
+    ax.axvspan(-3.0, 3.0, color=PALETTE[2], alpha=0.2, label=f"±3 %: lost motion {lost}")
     ax.axvline(0.0, color="k", lw=0.5)
     ax.set_xlabel("output torque [% rated]")
     ax.set_ylabel("output torsion angle [arcmin]")
-    ax.set_title(f"backlash {rad_to_arcmin(cat.backlash):.3f}'")
+    ax.set_title(f"backlash {format_quantity(rad_to_arcmin(cat.backlash), 'arcmin')}")
     ax.legend(fontsize=8)
     return Figure(
         "Hysteresis curve",
@@ -140,17 +141,19 @@ def figures(result) -> list[Figure]:
     if "load_sharing" in result:
         a = result["load_sharing"]
         ls, ls0 = a.data["load"], a.data.get("load_without_errors")
-        out.append(_pin_map(ls, "Pin-load map"))
+        figs = [_pin_map(ls, "Pin-load map")]
         if ls0 is not None:
-            out.append(_pin_map(ls0, "Pin-load map without errors"))
-        out.append(_peak(ls, ls0))
+            figs.append(_pin_map(ls0, "Pin-load map without errors"))
+        out += for_analysis("load_sharing", [*figs, _peak(ls, ls0)])
     if "transmission_error" in result:
-        out.append(_te(result["transmission_error"].data["te"]))
+        out += for_analysis("transmission_error", [_te(result["transmission_error"].data["te"])])
     if "catalogue" in result:
         cat = result["catalogue"].data["catalogue"]
-        out.append(_hysteresis(cat, Nm_to_Nmm(result["catalogue"]["rated_torque [N*m]"])))
+        rated = Nm_to_Nmm(result["catalogue"]["rated_torque [N*m]"])
+        out += for_analysis("catalogue", [_hysteresis(cat, rated)])
     if "compensation" in result:
-        out.append(_compensation(result["compensation"].data["compensation"]))
+        comp = result["compensation"].data["compensation"]
+        out += for_analysis("compensation", [_compensation(comp)])
     if "geometry" in result:  # the cycloid stage's analyses (run by the cycloid_stage kind)
         from gearte.plotting import cycloid_stage
 

@@ -1,4 +1,11 @@
-"""Render a study result as one self-contained HTML page (jinja2, plots embedded as PNG)."""
+"""Render a study result as one self-contained HTML page (jinja2, figures embedded as PNG).
+
+Layout (summary first): title and run facts; a *Summary* block with every warning (the study's
+and the trade-off warnings of :func:`gearte.report.summary.tradeoff_warnings`) and the headline
+quantities of each analysis with their spec and pass/fail; a table of contents; one section per
+analysis with its tables (:mod:`gearte.report.tables`) beside its figures; references; the case
+input. A print stylesheet puts each analysis on its own page.
+"""
 
 from __future__ import annotations
 
@@ -6,99 +13,177 @@ import base64
 import datetime as _dt
 import io
 import json
+import os
+import pickle
+import time
+from dataclasses import dataclass
 from importlib import resources
 from typing import Any
 
-import numpy as np
+__all__ = ["render_report", "render_figures", "figure_to_png_base64", "RenderedFigure"]
 
-__all__ = ["render_report", "figure_to_png_base64"]
+#: Resolution of the embedded PNGs (a 7-inch figure is 700 px wide, as it is shown).
+DPI = 100
 
 
-def figure_to_png_base64(fig: Any, dpi: int = 110) -> str:
+@dataclass
+class RenderedFigure:
+    """A figure as the report embeds it."""
+
+    title: str
+    caption: str
+    analysis: str
+    png: str  # base64
+    width: int
+    height: int
+
+
+def figure_to_png_base64(fig: Any, dpi: int = DPI) -> str:
     """PNG of a matplotlib figure, base64 encoded."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
     return base64.b64encode(buf.getvalue()).decode("ascii")
 
 
-def _fmt(v: Any) -> str:
-    if isinstance(v, bool | np.bool_):
-        return str(bool(v))
-    if isinstance(v, int | np.integer):
-        return str(int(v))
-    if isinstance(v, float | np.floating):
-        f = float(v)
-        if f == 0 or 1e-3 <= abs(f) < 1e6:
-            return f"{f:.6g}"
-        return f"{f:.4e}"
-    return str(v)
+def _render_one(f: Any) -> RenderedFigure:
+    from gearte.plotting.display import polish
+
+    polish(f.fig)
+    w, h = f.fig.get_size_inches()
+    png = figure_to_png_base64(f.fig)
+    return RenderedFigure(
+        f.title, f.caption, f.analysis, png, int(round(w * DPI)), int(round(h * DPI))
+    )
 
 
-Rows = list[tuple[str, str]]
+def render_figures(
+    result: Any, timings: dict[str, float] | None = None, *, workers: int | None = None
+) -> list[RenderedFigure]:
+    """Build every figure of a study result and render it to PNG.
+
+    Rendering (matplotlib drawing text and lines) is most of a report's time and each figure is
+    independent: with ``workers`` > 1 (default: the cores this process may use) and ``os.fork``
+    available, forked copies of this process render shares of the figures in parallel and send
+    the PNGs back (the figures are not pickled: a fork inherits them). ``timings`` (if given)
+    receives ``"figures"`` (building the matplotlib figures) and ``"render"`` (drawing them to
+    PNG), in seconds [s].
+    """
+    from gearte.plotting import figures_for
+
+    t0 = time.perf_counter()
+    figs = figures_for(result)
+    t1 = time.perf_counter()
+    out = _render_all(figs, _workers() if workers is None else workers)
+    t2 = time.perf_counter()
+    if timings is not None:
+        timings["figures"] = t1 - t0
+        timings["render"] = t2 - t1
+    return out
 
 
-def _rows(
-    values: dict[str, Any],
-) -> tuple[Rows, list[tuple[str, Rows]], list[tuple[str, str, str]]]:
-    """Split values into scalar rows, mapping tables and array summaries."""
-    scalars: list[tuple[str, str]] = []
-    mappings: list[tuple[str, list[tuple[str, str]]]] = []
-    arrays: list[tuple[str, str, str]] = []
-    for k, v in values.items():
-        if isinstance(v, dict):
-            rows = []
-            for a, b in v.items():
-                nested = isinstance(b, dict | list | tuple | np.ndarray)
-                rows.append((str(a), json.dumps(_plain(b)) if nested else _fmt(b)))
-            mappings.append((k, rows))
-        elif isinstance(v, list | tuple | np.ndarray):
-            arr = np.asarray(v, dtype=object)
-            flat = [x for x in arr.ravel() if isinstance(x, int | float | np.integer | np.floating)]
-            summary = f"{arr.shape[0] if arr.ndim else 1} values"
-            if arr.ndim > 1:
-                summary = "×".join(str(s) for s in arr.shape) + " values"
-            if flat:
-                fl = np.asarray(flat, dtype=float)
-                summary += f", min {_fmt(fl.min())}, max {_fmt(fl.max())}"
-            text = ", ".join(_fmt(x) for x in arr.ravel()[:400])
-            if arr.size > 400:
-                text += ", …"
-            arrays.append((k, summary, text))
+def _workers() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+def _cost(f: Any) -> float:
+    """A rough drawing cost of a figure: its axes (ticks, labels) and the points it draws."""
+    points = sum(len(line.get_xdata()) for ax in f.fig.axes for line in ax.get_lines())
+    return len(f.fig.axes) + min(points, 4 * 2400 * len(f.fig.axes)) / 5000.0
+
+
+def _render_all(figs: list[Any], workers: int) -> list[RenderedFigure]:
+    """Render ``figs`` in order, in ``workers`` processes (forked) where that can help."""
+    workers = min(workers, len(figs))
+    if workers < 2 or not hasattr(os, "fork"):
+        return [_render_one(f) for f in figs]
+    # share the figures out, largest first, to the least loaded worker
+    load = [0.0] * workers
+    share: list[list[int]] = [[] for _ in range(workers)]
+    for i in sorted(range(len(figs)), key=lambda i: -_cost(figs[i])):
+        w = load.index(min(load))
+        share[w].append(i)
+        load[w] += _cost(figs[i])
+    children: list[tuple[int, int, list[int]]] = []
+    for idx in share[1:]:
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # child: render its share, send it, leave without cleanup handlers
+            code = 0
+            try:
+                os.close(r)
+                data = pickle.dumps([_render_one(figs[i]) for i in idx])
+                with os.fdopen(w, "wb") as fh:
+                    fh.write(data)
+            except BaseException:  # noqa: BLE001 - the parent renders what a child could not
+                code = 1
+            finally:
+                os._exit(code)
+        os.close(w)
+        children.append((pid, r, idx))
+    done: dict[int, RenderedFigure] = {i: _render_one(figs[i]) for i in share[0]}
+    for pid, r, idx in children:
+        with os.fdopen(r, "rb") as fh:
+            data = fh.read()
+        _, status = os.waitpid(pid, 0)
+        got = pickle.loads(data) if status == 0 and data else None
+        for k, i in enumerate(idx):
+            done[i] = got[k] if got else _render_one(figs[i])
+    return [done[i] for i in range(len(figs))]
+
+
+def _grouped(rows: list[Any]) -> list[list[Any]]:
+    """Consecutive summary rows of the same analysis, together (one title cell each)."""
+    groups: list[list[Any]] = []
+    for r in rows:
+        if groups and groups[-1][0].analysis == r.analysis:
+            groups[-1].append(r)
         else:
-            scalars.append((k, _fmt(v)))
-    return scalars, mappings, arrays
+            groups.append([r])
+    return groups
 
 
-def _plain(v: Any) -> Any:
+def _case_json(result: Any) -> str:
     from gearte.results import to_jsonable
 
-    return to_jsonable(v)
+    return json.dumps(
+        to_jsonable(result.case.model_dump(mode="json")), indent=1, ensure_ascii=False
+    )
 
 
-def render_report(result: Any) -> str:
-    """HTML text of the report of a :class:`~gearte.results.StudyResult`."""
+def render_report(result: Any, figures: list[RenderedFigure] | None = None) -> str:
+    """HTML text of the report of a :class:`~gearte.results.StudyResult`.
+
+    ``figures``: already rendered figures (:func:`render_figures`); rendered here if ``None``.
+    """
     import jinja2
 
     from gearte._version import __version__
-    from gearte.plotting import figures_for
     from gearte.references import REFERENCES
+    from gearte.report.summary import headlines, tradeoff_warnings
+    from gearte.report.tables import analysis_tables
 
-    figs = []
-    for f in figures_for(result):
-        figs.append({"title": f.title, "caption": f.caption, "png": figure_to_png_base64(f.fig)})
-    analyses = []
-    for a in result.analyses:
-        scalars, mappings, arrays = _rows(a.values)
-        analyses.append(
-            {
-                "name": a.name,
-                "title": a.title,
-                "notes": a.notes,
-                "scalars": scalars,
-                "mappings": mappings,
-                "arrays": arrays,
-            }
-        )
+    if figures is None:
+        figures = render_figures(result)
+    names = [a.name for a in result.analyses]
+    by_analysis: dict[str, list[RenderedFigure]] = {n: [] for n in names}
+    for f in figures:
+        # a figure that names no (known) analysis goes with the first one
+        key = f.analysis if f.analysis in by_analysis else (names[0] if names else "")
+        if key:
+            by_analysis[key].append(f)
+    analyses = [
+        {
+            "name": a.name,
+            "title": a.title,
+            "notes": a.notes,
+            "tables": analysis_tables(a),
+            "figures": by_analysis.get(a.name, []),
+        }
+        for a in result.analyses
+    ]
     env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined)
     template = resources.files("gearte.report").joinpath("report.html.j2").read_text("utf-8")
     return env.from_string(template).render(
@@ -109,11 +194,9 @@ def render_report(result: Any) -> str:
         date=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         elapsed=f"{result.elapsed_s:.2f}",
         description=result.case.case.description,
-        warnings=result.warnings,
+        warnings=list(result.warnings) + tradeoff_warnings(result),
+        headline_groups=_grouped(headlines(result)),
         analyses=analyses,
-        figures=figs,
         references=[(k, REFERENCES.get(k, k)) for k in result.references],
-        case_json=json.dumps(
-            _plain(result.case.model_dump(mode="json")), indent=1, ensure_ascii=False
-        ),
+        case_json=_case_json(result),
     )

@@ -300,8 +300,13 @@ def atomic_write_text(path: Path, text: str) -> None:
 def write_outputs(
     result: Any, out_dir: str | os.PathLike[str], *, report: bool = True
 ) -> dict[str, Path]:
-    """Write ``results.json`` (and ``report.html`` unless ``report=False``) and the analyses'
-    extra files into ``out_dir`` as one set, replacing the previous set.
+    """Write ``results.json`` (and ``report.html`` unless ``report=False``), the analyses' extra
+    files and the tabular results as CSV (:func:`gearte.report.tables.csv_files`) into
+    ``out_dir`` as one set, replacing the previous set.
+
+    The time of each stage (``"figures"``, ``"render"``, ``"html"``, ``"csv"``) is added to
+    ``result.timings`` before ``results.json`` is serialised; ``"write"`` (the file set) is added
+    after, so it is in ``result.timings`` but not in ``results.json``.
 
     Returns
     -------
@@ -313,17 +318,32 @@ def write_outputs(
     OutputError
         The folder cannot be written (exit code 4 in the CLI); the previous set is kept.
     """
-    texts: dict[str, str] = {"results.json": result.to_json()}
-    if report:
-        from gearte.report.html import render_report
+    import time
 
-        texts["report.html"] = render_report(result)
+    from gearte.report.tables import csv_files
+
+    timings = result.timings
+    texts: dict[str, str] = {}
+    if report:
+        from gearte.report.html import render_figures, render_report
+
+        figures = render_figures(result, timings)
+        t0 = time.perf_counter()
+        texts["report.html"] = render_report(result, figures)
+        timings["html"] = time.perf_counter() - t0
     keys = {"results.json": "results", "report.html": "report"}
     for analysis in result.analyses:
         for fname, text in analysis.files.items():
             if Path(fname).name != fname or fname in keys or fname == MARKER:
                 raise ValueError(f"analysis {analysis.name!r}: bad output file name {fname!r}")
             texts[fname] = text
+    t0 = time.perf_counter()
+    for fname, text in csv_files(result).items():
+        texts.setdefault(fname, text)
+    timings["csv"] = time.perf_counter() - t0
+    texts = {"results.json": result.to_json(), **texts}
     # Every document exists in memory: only now touch the disk.
+    t0 = time.perf_counter()
     written = write_file_set(out_dir, {k: v.encode("utf-8") for k, v in texts.items()})
+    timings["write"] = time.perf_counter() - t0
     return {keys.get(k, k): p for k, p in written.items()}

@@ -8,8 +8,13 @@ it takes.
 
 from __future__ import annotations
 
+import contextlib
+import importlib.abc
+import importlib.util
 import os
+import sys
 import time
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -100,9 +105,96 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
         from gearte.io.case_file import load_case
 
         case = load_case(case)
+    t_imp = time.perf_counter()
     module = get_kind(case.case.kind)
     check_samples_override(case, (options or RunOptions()).samples)
     t0 = time.perf_counter()
-    result = module.run(case, options or RunOptions())
-    result.elapsed_s = time.perf_counter() - t0
+    with _numba_timer() as numba:
+        result = module.run(case, options or RunOptions())
+    t_end = time.perf_counter()
+    result.elapsed_s = t_end - t0
+    result.timings["imports: study kind"] = t0 - t_imp
+    result.timings.update(numba)
+    result.timings.update(analysis_timings(result.analyses, t0, t_end))
     return result
+
+
+def analysis_timings(analyses: list[Any], start: float, end: float) -> dict[str, float]:
+    """Time of each analysis [s]: the interval from the previous analysis's result (or ``start``)
+    to its own (:attr:`AnalysisResult.created`); work after the last result is ``"analysis:
+    (after the last result)"``. Studies make each result as soon as its analysis is done, so the
+    intervals are the analyses' times (shared set-up falls to the first analysis)."""
+    out: dict[str, float] = {}
+    prev = start
+    for a in sorted(analyses, key=lambda a: a.created):
+        t = min(max(a.created, prev), end)
+        out[f"analysis: {a.name}"] = t - prev
+        prev = t
+    if end - prev > 1e-3:
+        out["analysis: (after the last result)"] = end - prev
+    return out
+
+
+@contextlib.contextmanager
+def _numba_timer() -> Iterator[dict[str, float]]:
+    """Seconds numba spends loading kernels from its cache or compiling them (it holds its
+    compiler lock for both: the ``numba:compiler_lock`` event, outermost holds only) and, if the
+    block imports numba, the import.
+
+    numba is not imported just to time it: if it is not imported yet, a one-shot import hook
+    starts the timer as soon as the study imports it. The mapping is filled when the block ends:
+    ``{"numba load/compile": s, "imports: numba": s}`` (keys absent where nothing happened).
+    """
+    out: dict[str, float] = {}
+    timer: list[Any] = []
+
+    def start() -> None:
+        from numba.core import event
+
+        timer.append(event.TimingListener())
+        event.register("numba:compiler_lock", timer[0])
+
+    hook = None
+    if "numba" in sys.modules:
+        start()
+    else:
+        hook = _AfterImport("numba", out, start)
+        sys.meta_path.insert(0, hook)
+    try:
+        yield out
+    finally:
+        if hook is not None and hook in sys.meta_path:
+            sys.meta_path.remove(hook)
+        if timer:
+            from numba.core import event
+
+            event.unregister("numba:compiler_lock", timer[0])
+            if timer[0].done:
+                out["numba load/compile"] = timer[0].duration
+
+
+class _AfterImport(importlib.abc.MetaPathFinder):
+    """Times the first import of module ``name`` (into ``out["imports: <name>"]``) and calls
+    ``then()`` right after it; removes itself from ``sys.meta_path`` on first use."""
+
+    def __init__(self, name: str, out: dict[str, float], then: Callable[[], None]) -> None:
+        self.name, self.out, self.then = name, out, then
+
+    def find_spec(self, fullname: str, path: Any, target: Any = None) -> Any:
+        if fullname != self.name:
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.util.find_spec(fullname)
+        if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
+            return spec
+        loader = spec.loader
+        inner = loader.exec_module
+
+        def exec_module(module: Any) -> None:
+            t0 = time.perf_counter()
+            inner(module)
+            self.out[f"imports: {self.name}"] = time.perf_counter() - t0
+            self.then()
+
+        loader.exec_module = exec_module  # type: ignore[method-assign]
+        return spec

@@ -1,0 +1,265 @@
+"""The summary block of a report: headline quantities, spec checks and trade-off warnings.
+
+* Headlines: for each analysis, the values whose names (without unit) are in
+  :data:`HEADLINE_KEYS`, in that order (at most :data:`MAX_HEADLINES`); an analysis with none of
+  them shows its first numeric scalars. Before/after pairs show as ``before → after``; shares by
+  item show the largest item.
+* Spec checks: a boolean ``meets_<limit>`` value, and a value with its limit in the same analysis
+  (:data:`SPEC_CHECKS`), give a pass/fail row with the limit.
+* Trade-off warnings: an analysis that recommends a change and reports quantities before and after
+  it (``X_before``/``X_after``) gets a warning when the change worsens any of them other than the
+  first (the one the recommendation aims at), e.g. a compensation that cuts TE while raising the
+  peak pin load. Lower is better unless the name is in :data:`HIGHER_IS_BETTER`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from gearte.labels import label
+from gearte.report.tables import item_label, relative_change
+from gearte.units import format_quantity, split_unit
+
+__all__ = ["HeadlineRow", "headlines", "tradeoff_warnings", "HEADLINE_KEYS", "SPEC_CHECKS"]
+
+MAX_HEADLINES = 4
+
+#: Value names (without unit) that answer "how accurate, how loaded": in order of importance.
+HEADLINE_KEYS: list[str] = [
+    # transmission error and lost motion
+    "geometric_te_mean",
+    "geometric_te_tolerance",
+    "total_te_peak_to_peak",
+    "mean_output_lag",
+    "dte_peak_to_peak",
+    "coupled_te_amplitude",
+    "optimal_assembly_te",
+    "paper_rule_assembly_te_exact",
+    "mc_mean",
+    "mc_sd",
+    "joint_lost_motion_max",
+    "end_effector_error_max",
+    "joint_lost_motion_max_after_shim",
+    "joint_lost_motion_max_after_compensation",
+    "motor_compensation_angle",
+    "shim_thickness",
+    "lost_motion",
+    "lost_motion_max",
+    "backlash",
+    "backlash_mean",
+    "backlash_min",
+    "backlash_max",
+    "mc_backlash_mean",
+    "mc_backlash_sd",
+    "out_of_spec_fraction",
+    "torsional_rigidity",
+    # loads and contact
+    "max_contact_force",
+    "pins_in_mesh",
+    "peak_pin_load",
+    "pairs_in_mesh_min",
+    "pairs_in_mesh_max",
+    "max_normal_deformation",
+    "max_contact_pressure",
+    # causes
+    "dominant_factor",
+    "dominant_source",
+    # geometry
+    "K1",
+    "radial_clearance",
+    "backlash_per_flank",
+]
+
+#: Names (without unit) where a larger value is better (for trade-off warnings).
+HIGHER_IS_BETTER: set[str] = {
+    "pairs_in_mesh_min",
+    "pairs_in_mesh_max",
+    "pins_in_mesh",
+    "pins_in_mesh_min",
+    "pins_in_mesh_max",
+    "torsional_rigidity",
+    "cpk",
+    "cp",
+}
+
+#: (value, limit, relation): the value must be ``>=`` or ``<=`` the limit of the same analysis.
+SPEC_CHECKS: list[tuple[str, str, str]] = [
+    ("backlash_min", "min_backlash_limit", ">="),
+    ("backlash_after_shim_min", "target_min_backlash", ">="),
+    ("joint_lost_motion_max", "joint_lost_motion_limit", "<="),
+]
+
+
+@dataclass
+class HeadlineRow:
+    """One row of the summary table."""
+
+    analysis: str  # machine name (anchor)
+    title: str
+    quantity: str
+    value: str
+    spec: str = ""
+    status: str = ""  # "pass", "fail" or ""
+
+
+def _by_base(values: dict[str, Any]) -> dict[str, tuple[str, Any]]:
+    return {split_unit(k)[0]: (split_unit(k)[1], v) for k, v in values.items()}
+
+
+def _is_num(v: Any) -> bool:
+    return isinstance(v, int | float | np.integer | np.floating) and not isinstance(v, bool)
+
+
+def _finite(v: Any) -> bool:
+    return _is_num(v) and bool(np.isfinite(v))
+
+
+def _text(v: Any, unit: str) -> str:
+    return v if isinstance(v, str) else format_quantity(v, unit)
+
+
+def headlines(result: Any) -> list[HeadlineRow]:
+    """Summary rows of every analysis of a study result (see the module docstring)."""
+    rows: list[HeadlineRow] = []
+    for a in result.analyses:
+        rows += _analysis_headlines(a)
+    return rows
+
+
+def _analysis_headlines(a: Any) -> list[HeadlineRow]:
+    vals = _by_base(a.values)
+    picked: list[HeadlineRow] = []
+
+    def add(quantity: str, value: str, spec: str = "", status: str = "") -> None:
+        picked.append(HeadlineRow(a.name, a.title, quantity, value, spec, status))
+
+    # spec checks first: they are the answer to "does it meet the spec"
+    checked = set()
+    for key, limit, rel in SPEC_CHECKS:
+        if key in vals and limit in vals and _finite(vals[key][1]) and _finite(vals[limit][1]):
+            unit, v = vals[key]
+            lim = vals[limit][1]
+            ok = v >= lim if rel == ">=" else v <= lim
+            sym = "≥" if rel == ">=" else "≤"
+            add(
+                label(key),
+                _text(v, unit),
+                f"{sym} {_text(lim, vals[limit][0])}",
+                "pass" if ok else "fail",
+            )
+            checked |= {key, limit}
+    for base, (_, v) in vals.items():
+        if base.startswith("meets_") and isinstance(v, bool | np.bool_):
+            limit = base[len("meets_") :]
+            if limit in checked:
+                continue  # its value was checked against it above
+            spec = ""
+            if limit in vals and _finite(vals[limit][1]):
+                spec = _text(vals[limit][1], vals[limit][0])
+            add(label(limit), "met" if v else "not met", spec, "pass" if v else "fail")
+            checked.add(limit)
+    for base in HEADLINE_KEYS:
+        if len(picked) >= MAX_HEADLINES:
+            break
+        if base in checked:
+            continue
+        if base in vals:
+            unit, v = vals[base]
+            if _is_num(v) or isinstance(v, str):
+                add(label(base), _text(v, unit))
+            continue
+        if f"{base}_before" in vals and f"{base}_after" in vals:
+            unit, b = vals[f"{base}_before"]
+            _, af = vals[f"{base}_after"]
+            add(label(base), f"{_text(b, unit)} → {_text(af, unit)}")
+    if len(picked) < MAX_HEADLINES:
+        for base, (unit, v) in vals.items():
+            if (
+                "share" in base
+                and isinstance(v, dict)
+                and v
+                and all(_finite(x) for x in v.values())
+            ):
+                item, share = max(v.items(), key=lambda kv: kv[1])
+                add(f"Largest {label(base).lower()}", f"{item_label(item)} ({_text(share, unit)})")
+                break
+    if not picked:
+        for base, (unit, v) in vals.items():
+            if _finite(v) and base not in ("seed", "samples"):
+                add(label(base), _text(v, unit))
+                if len(picked) >= 3:
+                    break
+    return picked
+
+
+def _pairs(values: dict[str, Any]) -> list[tuple[str, str, float, float]]:
+    """(stem, unit, before, after) of the numeric before/after pairs, in order."""
+    vals = _by_base(values)
+    out = []
+    for base, (unit, b) in vals.items():
+        if base.endswith("_before"):
+            stem = base[: -len("_before")]
+            if f"{stem}_after" in vals:
+                af = vals[f"{stem}_after"][1]
+                if _finite(b) and _finite(af):
+                    out.append((stem, unit, float(b), float(af)))
+    return out
+
+
+def _worse(stem: str, before: float, after: float) -> bool:
+    base = stem
+    higher = base in HIGHER_IS_BETTER or base.rsplit("_", 1)[0] in HIGHER_IS_BETTER
+    return after < before if higher else abs(after) > abs(before)
+
+
+def _lower(text: str) -> str:
+    """``"Peak pin load"`` → ``"peak pin load"``; acronyms stay (``"TE peak"``)."""
+    return text[:1].lower() + text[1:] if text[1:2].islower() else text
+
+
+def _change_text(stem: str, unit: str, before: float, after: float) -> str:
+    rel = relative_change(before, after)
+    return f"{_lower(label(stem))} from {_text(before, unit)} to {_text(after, unit)}{rel}"
+
+
+def tradeoff_warnings(result: Any, *, threshold: float = 0.01) -> list[str]:
+    """Warnings for the analyses of ``result`` whose recommendations worsen another reported
+    quantity by more than ``threshold`` [-] (relative; any change of a count)."""
+    out = []
+    for a in result.analyses:
+        pairs = _pairs(a.values)
+        if len(pairs) < 2:
+            continue
+        target = pairs[0]
+        stem, unit, b, af = target
+        worse = []
+        merged: set[str] = set()
+        by_stem = {p[0]: p for p in pairs}
+        for p in pairs[1:]:
+            s, u, pb, pa = p
+            if s in merged or not _worse(s, pb, pa):
+                continue
+            rel = abs(pa - pb) / max(abs(pb), 1e-300)
+            if rel <= threshold and not float(pb).is_integer():
+                continue
+            if s.endswith("_min") and f"{s[:-4]}_max" in by_stem:
+                q = by_stem[f"{s[:-4]}_max"]
+                worse.append(
+                    f"{_lower(label(s[:-4]))} from {_text(pb, u)}–{_text(q[2], u)} to "
+                    f"{_text(pa, u)}–{_text(q[3], u)}"
+                )
+                merged.add(q[0])
+                continue
+            worse.append(_change_text(s, u, pb, pa))
+        if not worse:
+            continue
+        verb = "worsens" if _worse(stem, b, af) else "improves"
+        out.append(
+            f"{a.title}: the recommendation {verb} {_change_text(stem, unit, b, af)}, but changes "
+            + "; ".join(worse)
+            + "."
+        )
+    return out
