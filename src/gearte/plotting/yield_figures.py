@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 
 __all__ = ["yield_figures"]
 
@@ -99,7 +99,5 @@ def yield_figures(result: Any) -> list[Figure]:
     for a in result.analyses:
         if a.name != "yield":
             continue
-        for f in (_histograms(a), _pareto(a)):
-            if f is not None:
-                out.append(f)
+        out += for_analysis(a.name, [f for f in (_histograms(a), _pareto(a)) if f is not None])
     return out
