@@ -81,6 +81,6 @@ def test_implausible_module_is_refused(case):
 def test_rv_dynamics_overlapping_pins_are_refused_by_validate():
     """Issue 13: ``validate`` passed overlapping pins that ``run`` then refused."""
     data = _bundled("li2023_rv")
-    data.setdefault("reducer", {})["pin_radius_mm"] = 8.0
+    data["reducer"]["pins"]["pin_radius_mm"] = 8.0
     (msg,) = _errors(data).values()
-    assert "pins overlap" in msg
+    assert "overlap" in msg
