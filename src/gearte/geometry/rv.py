@@ -442,6 +442,12 @@ class ManufacturingErrors:
     disc_modification : numpy.ndarray
         ``(N, 2)`` errors of disc ``j``'s equidistant and shifted modifications
         ``(δΔr_rp, δΔr_p)`` [mm] (Hu 2020 Table 2 rows f, g per disc), added to the nominal ones.
+    measured_discs : tuple or None
+        Per disc, a :class:`gearte.geometry.measured.MeasuredDisc` (measured flank deviation per
+        tooth and cumulative pitch per tooth, issue 16) or None; None: no measured disc.
+    cam_clearance, carrier_clearance : numpy.ndarray or None
+        Measured radial clearances [mm] of each cam bearing ``(M, N)`` and each crank's carrier
+        bearing ``(M,)``, replacing the ``Cranks`` values; None: those of ``Cranks``.
     """
 
     planet: np.ndarray
@@ -454,6 +460,9 @@ class ManufacturingErrors:
     disc_runout: np.ndarray = field(default_factory=_empty_per_disc)
     disc_pitch: np.ndarray = field(default_factory=_empty_per_disc)
     disc_modification: np.ndarray = field(default_factory=_empty_per_disc)
+    measured_discs: tuple | None = None
+    cam_clearance: np.ndarray | None = None
+    carrier_clearance: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = self.disc_bore.shape[0]
@@ -545,6 +554,11 @@ class ManufacturingErrors:
             self.disc_runout * factor,
             self.disc_pitch * factor,
             self.disc_modification * factor,
+            None
+            if self.measured_discs is None
+            else tuple(None if m is None else m.scaled(factor) for m in self.measured_discs),
+            self.cam_clearance,
+            self.carrier_clearance,
         )
 
     def with_disc_modification(self, errors: np.ndarray) -> ManufacturingErrors:
