@@ -64,8 +64,9 @@ def test_measured_profile_equal_to_equidistant_and_shift_reproduces_that_modific
 
 
 def test_local_bump_on_one_tooth_raises_the_load_of_the_pins_touching_it(design):
-    """+4 µm of material over φ0 ∈ [-80°, -40°] (the flank loaded by a positive torque) of tooth space 10 of disc 1: the pins in contact
-    there carry more, the others of that disc carry less on average."""
+    """+4 µm of material over φ0 ∈ [-80°, -40°] (the flank a positive torque loads) of tooth
+    space 10 of disc 1: the pins in contact there carry more, the others of that disc carry less
+    on average."""
     zp, zc = design.pins.count, design.cycloid_teeth
     phi = np.radians(np.arange(-180.0, 181.0, 2.0))
     bump = np.where((phi > np.radians(-80)) & (phi < np.radians(-40)), 0.004, 0.0)
