@@ -262,8 +262,8 @@ def apply_measurements(
         r = np.asarray(planet_runout, dtype=float).reshape(m, 2)
         ch["planet"] = 0.5 * r[:, :1] * np.stack([np.cos(r[:, 1]), np.sin(r[:, 1])], -1)
     if sun_runout is not None:
-        r = np.asarray(sun_runout, dtype=float).reshape(2)
-        ch["sun"] = 0.5 * r[0] * np.array([np.cos(r[1]), np.sin(r[1])])
+        rs = np.asarray(sun_runout, dtype=float).reshape(2)
+        ch["sun"] = 0.5 * rs[0] * np.array([np.cos(rs[1]), np.sin(rs[1])])
     if cam_clearance is not None:
         ch["cam_clearance"] = np.asarray(cam_clearance, dtype=float).reshape(m, n)
     if carrier_clearance is not None:

@@ -235,7 +235,15 @@ def build_serial(case: Case):
 
 
 def run(case: Case, options=None) -> StudyResult:
-    """The serial's pin loads, TE and lost motion with its measured parts."""
+    """The serial's pin loads, TE and lost motion with its measured parts.
+
+    Parameters
+    ----------
+    case : Case
+        A validated ``rv_serial`` case.
+    options : gearte.studies.RunOptions, optional
+        Passed to the ``rv_reducer`` analyses.
+    """
     design, red, measured = build_serial(case)
     a = case.analyses
     dcase = design.model_copy(
