@@ -8,8 +8,8 @@ Two solvers on a :class:`gearte.models.planetary_errors.TermSet`:
   (lambda = -1) to the group's fixed part, with the signs minimising ``|Σ lambda_i A_i|`` (eq 6);
   groups without a fixed part and different-frequency couplings are left "arbitrary".
 * :func:`optimal_assembly` — the global minimum of the *exact* coupled amplitude
-  ``max_t |Σe(t)|`` over every free angle: a batch of quasi-random (Halton) starts evaluated with the
-  compiled exact kernel, then Nelder–Mead from the best starts. The Nelder–Mead runs compiled
+  ``max_t |Σe(t)|`` over every free angle: a batch of quasi-random (Halton) starts evaluated with
+  the compiled exact kernel, then Nelder–Mead from the best starts. The Nelder–Mead runs compiled
   (:func:`_polish_kernel`, a line-by-line port of SciPy 1.17's ``_minimize_neldermead`` with
   ``adaptive=True`` and no bounds, calling the compiled amplitude directly); its plain twin is
   SciPy's ``minimize(method="Nelder-Mead")`` on the same objective
