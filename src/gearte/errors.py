@@ -17,6 +17,7 @@ __all__ = [
     "SchedulerError",
     "ClusterLostError",
     "BenchFileError",
+    "MeasurementFileError",
     "OutputError",
     "Interrupted",
 ]
@@ -156,3 +157,12 @@ class Interrupted(KeyboardInterrupt):
         self.signum = signum
         self.partial = partial
         super().__init__(f"interrupted by signal {signum}")
+
+
+class MeasurementFileError(BenchFileError):
+    """A metrology file (measured parts: disc profiles, pitch, pins, cranks, bores, run-outs,
+    bearing clearances; :mod:`gearte.io.metrology`) is malformed.
+
+    Same fields as :class:`BenchFileError`: file, line (1-based), column (number and header
+    name) and the reason.
+    """
