@@ -145,9 +145,9 @@ def _check_partial(out: Path, scheduler: str, err: str) -> None:
     # chunks 0-2 finish before chunk 3 stalls; a process pool may not have handed them all back
     kept = re.search(r"first: (\d+) of 10 chunks finished and kept", doc["warnings"][0])
     assert kept, doc["warnings"][0]
-    if scheduler in ("sequential", "threads"):
+    if scheduler == "sequential":
         assert int(kept[1]) == 3
-    else:  # a process pool or a cluster may not have handed them all back yet
+    else:  # a pool may hand back fewer (not yet collected) or more (released after the signal)
         assert 1 <= int(kept[1])
     assert "second: first chunk only, of 3" in doc["warnings"][0]
     assert doc["analyses"]["first"]["values"] == _mc_reference(1000 * int(kept[1]))
