@@ -162,7 +162,7 @@ class ToothContactOptions(_Section):
 
     torque_Nm: float = Field(gt=0, le=1e6, description="Output torque of the stage T [N·m].")
     disc_share: float = Field(
-        default=0.55, gt=0, le=1, description="Share of T carried by the analysed disc (0.55)."
+        gt=0, le=1, description="Share of T carried by the analysed disc (Hu et al.: 0.55)."
     )
     youngs_modulus_MPa: float = Field(default=2.06e5, gt=0, le=1e7, description="E [MPa].")
     poisson_ratio: float = Field(default=0.3, ge=0, lt=0.5, description="μ [-].")
