@@ -442,6 +442,12 @@ class ManufacturingErrors:
     disc_modification : numpy.ndarray
         ``(N, 2)`` errors of disc ``j``'s equidistant and shifted modifications
         ``(δΔr_rp, δΔr_p)`` [mm] (Hu 2020 Table 2 rows f, g per disc), added to the nominal ones.
+    measured_discs : tuple or None
+        Per disc, a :class:`gearte.geometry.measured.MeasuredDisc` (measured flank deviation per
+        tooth and cumulative pitch per tooth, issue 16) or None; None: no measured disc.
+    cam_clearance, carrier_clearance : numpy.ndarray or None
+        Measured radial clearances [mm] of each cam bearing ``(M, N)`` and each crank's carrier
+        bearing ``(M,)``, replacing the ``Cranks`` values; None: those of ``Cranks``.
     """
 
     planet: np.ndarray
@@ -454,6 +460,9 @@ class ManufacturingErrors:
     disc_runout: np.ndarray = field(default_factory=_empty_per_disc)
     disc_pitch: np.ndarray = field(default_factory=_empty_per_disc)
     disc_modification: np.ndarray = field(default_factory=_empty_per_disc)
+    measured_discs: tuple | None = None
+    cam_clearance: np.ndarray | None = None
+    carrier_clearance: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = self.disc_bore.shape[0]
@@ -512,6 +521,8 @@ class ManufacturingErrors:
                 raise ParameterError(f, key, "error given twice for the same part and index")
             seen.add(key)
             vec = e.value * np.array([np.cos(e.angle), np.sin(e.angle)])
+            ci = -1 if e.crank is None else e.crank - 1  # checked above where required
+            dj = -1 if e.disc is None else e.disc - 1
             if e.part == "sun_eccentricity":
                 out.sun[:] = vec
             elif e.part == "sun_assembly":
@@ -519,17 +530,17 @@ class ManufacturingErrors:
             elif e.part == "output_assembly":
                 out.output_seat[:] = vec
             elif e.part == "disc_radial_runout":
-                out.disc_runout[e.disc - 1] = vec
+                out.disc_runout[dj] = vec
             elif e.part == "disc_cumulative_pitch":
-                out.disc_pitch[e.disc - 1] = vec
+                out.disc_pitch[dj] = vec
             elif e.part == "planet_eccentricity":
-                out.planet[e.crank - 1] = vec
+                out.planet[ci] = vec
             elif e.part == "carrier_crank_bore":
-                out.carrier_bore[e.crank - 1] = vec
+                out.carrier_bore[ci] = vec
             elif e.part == "disc_crank_bore":
-                out.disc_bore[e.disc - 1, e.crank - 1] = vec
+                out.disc_bore[dj, ci] = vec
             else:
-                out.cam[e.crank - 1, e.disc - 1] = vec
+                out.cam[ci, dj] = vec
         return out
 
     def scaled(self, factor: float) -> ManufacturingErrors:
@@ -545,6 +556,11 @@ class ManufacturingErrors:
             self.disc_runout * factor,
             self.disc_pitch * factor,
             self.disc_modification * factor,
+            None
+            if self.measured_discs is None
+            else tuple(None if m is None else m.scaled(factor) for m in self.measured_discs),
+            self.cam_clearance,
+            self.carrier_clearance,
         )
 
     def with_disc_modification(self, errors: np.ndarray) -> ManufacturingErrors:
@@ -699,18 +715,7 @@ class RVReducer:
 
     def replace(self, **changes) -> RVReducer:
         """Copy with some of the sections replaced (``discs=..., pins=...``)."""
-        kw = dict(
-            first_stage=self.first_stage,
-            cranks=self.cranks,
-            discs=self.discs,
-            pins=self.pins,
-            supports=self.supports,
-            rated_torque=self.rated_torque,
-            planets=self.planets,
-            errors=self.errors,
-        )
-        kw.update(changes)
-        return RVReducer(**kw)
+        return dataclasses.replace(self, **changes)
 
 
 @dataclass(frozen=True)
@@ -794,23 +799,23 @@ def mass_properties(
         reducer.supports,
     )
 
-    def cyl(radius: float, length: float) -> tuple[float, float]:
-        v = np.pi * radius**2 * length * 1e-9  # mm^3 -> m^3
-        m = float(density) * v
-        return m, 0.5 * m * (radius * 1e-3) ** 2
+    def envelope(body: str, dims: tuple[float, ...], rho: float) -> tuple[float, float]:
+        """Mass [kg] and inertia [kg·m²] of ``body`` from its envelope ``dims`` [mm]."""
 
-    def envelope(body: str) -> tuple[float, float]:
+        def cyl(radius: float, length: float) -> tuple[float, float]:
+            v = np.pi * radius**2 * length * 1e-9  # mm^3 -> m^3
+            m = rho * v
+            return m, 0.5 * m * (radius * 1e-3) ** 2
+
         if body in ("sun", "planet"):
             z = fs.sun_teeth if body == "sun" else fs.planet_teeth
-            return cyl(fs.module * z / 2.0, fs.face_width)
-        if body == "crank":
-            return cyl(cr.shaft_diameter / 2.0, cr.shaft_length)
-        if body == "output":
-            return cyl(sup.carrier_outer_diameter / 2.0, sup.carrier_length)
+            return cyl(fs.module * z / 2.0, dims[0])
+        if body in ("crank", "output"):
+            return cyl(dims[0] / 2.0, dims[1])
         r_out = pins.circle_radius + di.shift_modification - pins.pin_radius
         r_out -= di.equidistant_modification
         m, j = cyl(r_out, di.face_width)
-        rb = di.crank_bore_diameter / 2.0
+        rb = dims[0] / 2.0
         mb, jb = cyl(rb, di.face_width)
         m -= cr.count * mb
         j -= cr.count * (jb + mb * (cr.circle_radius * 1e-3) ** 2)
@@ -826,15 +831,18 @@ def mass_properties(
         "disc": (di.crank_bore_diameter,),
         "output": (sup.carrier_outer_diameter, sup.carrier_length),
     }
-    mass, inertia, derived = {}, {}, []
+    mass: dict[str, float] = {}
+    inertia: dict[str, float] = {}
+    derived: list[str] = []
     for body, keys in _MASS_INPUTS.items():
         if body in given_mass and body in given_inertia:
             mass[body], inertia[body] = float(given_mass[body]), float(given_inertia[body])
             continue
-        missing = [k for k, v in zip(keys, values[body], strict=True) if v is None]
-        if density is None:
-            missing.insert(0, "density_kg_per_m3 (or material)")
-        if missing:
+        dims = tuple(v for v in values[body] if v is not None)
+        if density is None or len(dims) < len(keys):
+            missing = [k for k, v in zip(keys, values[body], strict=True) if v is None]
+            if density is None:
+                missing.insert(0, "density_kg_per_m3 (or material)")
             what = "mass" if body not in given_mass else "inertia"
             raise ParameterError(
                 "reducer." + missing[0].split(" ")[0],
@@ -842,7 +850,7 @@ def mass_properties(
                 f"needed to derive the {body} {what} (or give {body}_mass_kg and "
                 f"{body}_inertia_kgm2 in [reducer.dynamics]); missing: {', '.join(missing)}",
             )
-        m, j = envelope(body)
+        m, j = envelope(body, dims, float(density))
         if m <= 0 or j <= 0:
             raise ParameterError(
                 "reducer." + keys[0], values[body][0], f"leaves no material in the {body}"

@@ -28,6 +28,7 @@ from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer, mass_properties
 from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult
+from gearte.units import N_per_mm_to_N_per_m, Nm_to_Nmm, rad_to_deg
 
 __all__ = [
     "ANALYSES",
@@ -130,12 +131,12 @@ def build_dynamic_model(case, red: RVReducer):
     kw.update(
         input_torsional_stiffness_Nm_per_rad=d.input_torsional_stiffness_Nm_per_rad,
         crank_torsional_stiffness_Nm_per_rad=d.crank_torsional_stiffness_Nm_per_rad,
-        crank_bending_stiffness_N_per_m=d.crank_bending_stiffness_N_per_mm * 1e3,
+        crank_bending_stiffness_N_per_m=N_per_mm_to_N_per_m(d.crank_bending_stiffness_N_per_mm),
         damping_ratio=d.damping_ratio,
         cycloid_stiffness=d.cycloid_stiffness,
         cycloid_mesh_stiffness_N_per_m=None
         if d.cycloid_mesh_stiffness_N_per_mm is None
-        else d.cycloid_mesh_stiffness_N_per_mm * 1e3,
+        else N_per_mm_to_N_per_m(d.cycloid_mesh_stiffness_N_per_mm),
         cycloid_pressure_angle_deg=d.cycloid_pressure_angle_deg,
         involute_harmonics=d.involute_harmonics,
         cycloid_harmonics=d.cycloid_harmonics,
@@ -220,40 +221,40 @@ def _contact(case, model) -> AnalysisResult:
     t_disc = case.operation.output_torque_Nm / case.reducer.discs.count
     sweep = []
     for tq in opts.load_sweep_Nm:
-        mp = mesh_period_contact(pair, tq * 1e3, min(opts.positions, 24))
+        mp = mesh_period_contact(pair, Nm_to_Nmm(tq), min(opts.positions, 24))
         sweep.append(
             {
                 "torque_per_disc [N·m]": tq,
-                "equivalent_pressure_angle_mean [deg]": float(np.degrees(mp.pressure_angle_mean)),
-                "equivalent_mesh_stiffness_mean [N/m]": mp.mesh_stiffness_mean * 1e3,
+                "equivalent_pressure_angle_mean [deg]": float(rad_to_deg(mp.pressure_angle_mean)),
+                "equivalent_mesh_stiffness_mean [N/m]": N_per_mm_to_N_per_m(mp.mesh_stiffness_mean),
                 "pins_in_contact_mean": float(np.mean(mp.pins_in_contact)),
             }
         )
     mean_k, a_k, b_k = model.cycloid_fourier
-    beta = np.degrees(c.pressure_angle)
+    beta = rad_to_deg(c.pressure_angle)
     values = {
-        "equivalent_pressure_angle_mean [deg]": float(np.degrees(c.pressure_angle_mean)),
+        "equivalent_pressure_angle_mean [deg]": float(rad_to_deg(c.pressure_angle_mean)),
         "equivalent_pressure_angle_min [deg]": float(beta.min()),
         "equivalent_pressure_angle_max [deg]": float(beta.max()),
-        "equivalent_mesh_stiffness_mean [N/m]": c.mesh_stiffness_mean * 1e3,
-        "equivalent_mesh_stiffness_min [N/m]": float(c.mesh_stiffness.min() * 1e3),
-        "equivalent_mesh_stiffness_max [N/m]": float(c.mesh_stiffness.max() * 1e3),
+        "equivalent_mesh_stiffness_mean [N/m]": N_per_mm_to_N_per_m(c.mesh_stiffness_mean),
+        "equivalent_mesh_stiffness_min [N/m]": float(N_per_mm_to_N_per_m(c.mesh_stiffness.min())),
+        "equivalent_mesh_stiffness_max [N/m]": float(N_per_mm_to_N_per_m(c.mesh_stiffness.max())),
         "pins_in_contact_min": int(c.pins_in_contact.min()),
         "pins_in_contact_max": int(c.pins_in_contact.max()),
         "max_pin_force [N]": float(c.max_force.max()),
         "max_contact_pressure [MPa]": c.max_contact_pressure,
         "contact_law": pair.contact_law,
         "torque_per_disc [N·m]": t_disc,
-        "mesh_position [deg]": np.degrees(c.mesh_position),
+        "mesh_position [deg]": rad_to_deg(c.mesh_position),
         "equivalent_pressure_angle [deg]": beta,
-        "equivalent_mesh_stiffness [N/m]": c.mesh_stiffness * 1e3,
+        "equivalent_mesh_stiffness [N/m]": N_per_mm_to_N_per_m(c.mesh_stiffness),
         "signed_resultant_pressure_angle_mean [deg]": float(
-            np.degrees(
+            rad_to_deg(
                 np.mean(np.arctan2(c.contact.radial_force_signed, c.contact.tangential_force))
             )
         ),
-        "stiffness_fourier_a [N/m]": a_k * 1e3,
-        "stiffness_fourier_b [N/m]": b_k * 1e3,
+        "stiffness_fourier_a [N/m]": N_per_mm_to_N_per_m(a_k),
+        "stiffness_fourier_b [N/m]": N_per_mm_to_N_per_m(b_k),
         "load_sweep": sweep,
     }
     notes = [

@@ -56,7 +56,7 @@ Case file layout (units in the keys)::
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal, get_args
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -84,8 +84,11 @@ from gearte.studies.cycloid_stage import Errors as CycloidErrors
 from gearte.studies.cycloid_stage import GeometricTEOptions
 from gearte.units import (
     Nm_to_Nmm,
+    Nmm_per_rad_to_Nm_per_arcmin,
+    Nmm_to_Nm,
     arcmin_to_rad,
     deg_to_rad,
+    mm_to_um,
     rad_to_arcmin,
     rad_to_arcsec,
     rad_to_deg,
@@ -140,7 +143,10 @@ class Bearing(StrictModel):
     def stiffness(self) -> float:
         if self.stiffness_N_per_mm is not None:
             return self.stiffness_N_per_mm
-        return palmgren_radial_stiffness(self.rollers, self.roller_length_mm, self.reference_load_N)
+        n, length, load = self.rollers, self.roller_length_mm, self.reference_load_N
+        if n is None or length is None or load is None:  # refused by _one_way
+            raise ParameterError("stiffness_N_per_mm", None, "no stiffness and no Palmgren data")
+        return palmgren_radial_stiffness(n, length, load)
 
 
 class FirstStageSection(StrictModel):
@@ -253,7 +259,7 @@ _Part = Literal[
     "carrier_crank_bore",
     "output_assembly",
 ]
-assert set(ERROR_PARTS) == set(_Part.__args__)  # noqa: S101 - one list of parts
+assert set(ERROR_PARTS) == set(get_args(_Part))  # noqa: S101 - one list of parts
 
 
 class ErrorSection(StrictModel):
@@ -515,11 +521,14 @@ class Case(CaseBase):
 def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer:
     """The :class:`RVReducer` a case's ``[reducer]`` section describes."""
     fs = sec.first_stage
-    mesh = (
-        fs.mesh_stiffness_N_per_mm
-        if fs.mesh_stiffness_N_per_mm is not None
-        else iso6336_mesh_stiffness(fs.face_width_mm)
-    )
+    if fs.mesh_stiffness_N_per_mm is not None:
+        mesh = fs.mesh_stiffness_N_per_mm
+    elif fs.face_width_mm is not None:
+        mesh = iso6336_mesh_stiffness(fs.face_width_mm)
+    else:  # refused by FirstStageSection's validator
+        raise ParameterError(
+            "reducer.first_stage.face_width_mm", None, "give it or mesh_stiffness_N_per_mm"
+        )
     first = FirstStage(
         fs.sun_teeth,
         fs.planet_teeth,
@@ -662,7 +671,7 @@ def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
         "pairs_in_mesh_min": int(ls.pairs_in_mesh.min()),
         "pairs_in_mesh_max": int(ls.pairs_in_mesh.max()),
         "pairs_in_mesh_at_peak": int(ls.pairs_in_mesh[p_peak[0], p_peak[1]]),
-        "output_angle_at_peak [deg]": float(np.degrees(th[p_peak[0]])),
+        "output_angle_at_peak [deg]": float(rad_to_deg(th[p_peak[0]])),
         "max_cam_bearing_load [N]": float(ls.cam_bearing_load.max()),
         "max_carrier_bearing_load [N]": float(ls.carrier_bearing_load.max()),
         "max_mesh_force [N]": float(np.abs(ls.mesh_force).max()),
@@ -697,7 +706,7 @@ def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
             st,
             T,
             disc_share=share,
-            mesh_angle=np.linspace(0, 2 * np.pi / 40, 9),
+            mesh_angle=np.linspace(0, 2 * np.pi / red.pins.count, 9),
             E=red.discs.youngs_modulus,
             mu=red.discs.poisson_ratio,
             contact_law=ls.contact_law,
@@ -724,7 +733,7 @@ def _pin_csv(ls) -> str:
     """Pin-load table: one row per output angle and disc, one column per pin [N]."""
     zp = ls.pin_force.shape[2]
     lines = ["output_angle [deg],disc," + ",".join(f"pin_{k + 1} [N]" for k in range(zp))]
-    for p, th in enumerate(np.degrees(ls.theta)):
+    for p, th in enumerate(rad_to_deg(ls.theta)):
         for j in range(ls.pin_force.shape[1]):
             vals = ",".join(f"{v:.3f}" for v in ls.pin_force[p, j])
             lines.append(f"{th:.4f},{j + 1},{vals}")
@@ -747,7 +756,7 @@ def _transmission_error(red, sec: TESection, law) -> AnalysisResult:
         "mean_output_lag [arcmin]": rad_to_arcmin(-float(te.total.mean())),
         "mean_geometric_lag [arcmin]": rad_to_arcmin(-float(te.geometric.mean())),
         "mean_elastic_lag [arcmin]": rad_to_arcmin(-float(te.elastic.mean())),
-        "output_angle [deg]": np.degrees(th),
+        "output_angle [deg]": rad_to_deg(th),
         "total_te [arcsec]": rad_to_arcsec(te.total),
         "geometric_te [arcsec]": rad_to_arcsec(te.geometric),
     }
@@ -772,7 +781,7 @@ def _transmission_error(red, sec: TESection, law) -> AnalysisResult:
 def _te_csv(te) -> str:
     rows = ["output_angle [deg],total_te [arcsec],geometric_te [arcsec],elastic_te [arcsec]"]
     for th, t, g, e in zip(
-        np.degrees(te.theta),
+        rad_to_deg(te.theta),
         rad_to_arcsec(te.total),
         rad_to_arcsec(te.geometric),
         rad_to_arcsec(te.elastic),
@@ -794,11 +803,11 @@ def _catalogue(red, sec: CatalogueSection, law) -> AnalysisResult:
         law=law,
     )
     values = {
-        "torsional_rigidity [N*m/arcmin]": cat.torsional_rigidity / 1e3 / rad_to_arcmin(1.0),
+        "torsional_rigidity [N*m/arcmin]": Nmm_per_rad_to_Nm_per_arcmin(cat.torsional_rigidity),
         "lost_motion [arcmin]": rad_to_arcmin(cat.lost_motion),
         "backlash [arcmin]": rad_to_arcmin(cat.backlash),
         "hysteresis_loss [arcmin]": rad_to_arcmin(cat.hysteresis_loss),
-        "rated_torque [N*m]": red.rated_torque / 1e3,
+        "rated_torque [N*m]": None if red.rated_torque is None else Nmm_to_Nm(red.rated_torque),
     }
     return AnalysisResult(
         name="catalogue",
@@ -833,7 +842,9 @@ def _compensation(red, sec: CompensationSection) -> AnalysisResult:
         positions=sec.positions,
         grid=sec.grid,
     )
-    values = {"changes [um]": {k: v * 1e3 for k, v in comp.after.changes.items()}}
+    values: dict[str, Any] = {
+        "changes [um]": {k: mm_to_um(v) for k, v in comp.after.changes.items()}
+    }
     for tag, dp in (("before", comp.before), ("after", comp.after)):
         values.update(
             {
