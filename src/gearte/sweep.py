@@ -107,6 +107,16 @@ def parse_vary(spec: str) -> Vary:
     (1.0, 1.1, 1.2, 1.3, 1.4, 1.5)
     >>> parse_vary("stage.pins=38,40").values
     (38, 40)
+
+    Parameters
+    ----------
+    spec : str
+        The ``--vary`` text.
+
+    Returns
+    -------
+    Vary
+        The key and its values.
     """
     key, sep, rhs = spec.partition("=")
     key, rhs = key.strip(), rhs.strip()
@@ -137,7 +147,18 @@ def _as_vary(key: str, spec: Any) -> Vary:
 
 
 def grid_points(vary: Sequence[Vary]) -> list[dict[str, Any]]:
-    """Full-factorial grid, first key varying slowest: ``[{key: value, ...}, ...]``."""
+    """Full-factorial grid, first key varying slowest: ``[{key: value, ...}, ...]``.
+
+    Parameters
+    ----------
+    vary : sequence of Vary
+        The varied keys with their values (:func:`parse_vary`).
+
+    Returns
+    -------
+    list of dict
+        One ``{key: value}`` per grid point.
+    """
     keys = [v.key for v in vary]
     return [
         dict(zip(keys, combo, strict=True))
@@ -528,6 +549,15 @@ def write_sweep(
     """Write ``sweep.csv``, ``sweep.json`` and (unless ``plots=False``) under ``plots/`` one PNG
     per scalar result that varies over the sweep, with one panel per varied key. Figures are
     rendered before any file is written.
+
+    Parameters
+    ----------
+    result : SweepResult
+        The sweep.
+    out_dir : str or os.PathLike
+        Output folder (created).
+    plots : bool
+        Also write the PNG figures.
 
     Returns
     -------

@@ -476,7 +476,20 @@ def _compensation(st, case: Case, o: CompensationOptions) -> AnalysisResult:
 
 
 def run(case: Case, options) -> StudyResult:
-    """Run a ``cycloid_stage`` case; no I/O, no plotting."""
+    """Run a ``cycloid_stage`` case; no I/O, no plotting.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case.
+    options : RunOptions
+        Execution options (workers, scheduler, progress); the runner passes them.
+
+    Returns
+    -------
+    StudyResult
+        Geometry and the analyses whose table is present.
+    """
     st = build_stage(case.stage)
     analyses = [_geometry(st)]
     warnings: list[str] = []
