@@ -65,6 +65,8 @@ def _stage_forces(red, theta, disc, torque):
         cycloid_stage(red),
         torque,
         disc_share=(1.0 - 1.0 / red.ratio) * zc / (zp * n),
+        E=red.discs.youngs_modulus,
+        mu=red.discs.poisson_ratio,
         mesh_angle=np.mod(ecc, 2 * np.pi),
     )
     # RV model: loaded flank sin(phi) < 0 with phi_k = alpha_k - ecc; the stage analysis uses

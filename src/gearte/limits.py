@@ -77,7 +77,24 @@ def no_worker_timeout_s() -> float:
 
 
 def check_memory(field: str, value: Any, nbytes: float, what: str) -> None:
-    """Raise :class:`ParameterError` when ``nbytes`` exceeds the memory budget."""
+    """Raise :class:`ParameterError` when ``nbytes`` exceeds the memory budget.
+
+    Parameters
+    ----------
+    field : str
+        The input the budget check is about (named in the error).
+    value : Any
+        Its value (echoed in the error).
+    nbytes : float
+        Estimated memory need [bytes].
+    what : str
+        What needs it, for the message.
+
+    Raises
+    ------
+    ParameterError
+        Over the budget (``GEARTE_MAX_MEMORY_GB``).
+    """
     limit = max_memory_bytes()
     if nbytes > limit:
         raise ParameterError(
@@ -89,7 +106,24 @@ def check_memory(field: str, value: Any, nbytes: float, what: str) -> None:
 
 
 def check_time(field: str, value: Any, seconds: float, what: str) -> None:
-    """Raise :class:`ParameterError` when an estimated run time exceeds the time budget."""
+    """Raise :class:`ParameterError` when an estimated run time exceeds the time budget.
+
+    Parameters
+    ----------
+    field : str
+        The input the budget check is about (named in the error).
+    value : Any
+        Its value (echoed in the error).
+    seconds : float
+        Estimated run time [s].
+    what : str
+        What takes it, for the message.
+
+    Raises
+    ------
+    ParameterError
+        Over the budget (``GEARTE_MAX_SECONDS``).
+    """
     limit = max_seconds()
     if seconds > limit:
         raise ParameterError(
@@ -101,7 +135,18 @@ def check_time(field: str, value: Any, seconds: float, what: str) -> None:
 
 
 def check_sweep_points(n: int) -> None:
-    """Raise :class:`ParameterError` when a sweep grid has more points than allowed."""
+    """Raise :class:`ParameterError` when a sweep grid has more points than allowed.
+
+    Parameters
+    ----------
+    n : int
+        Number of grid points [-].
+
+    Raises
+    ------
+    ParameterError
+        Over ``GEARTE_MAX_SWEEP_POINTS``.
+    """
     limit = max_sweep_points()
     if n > limit:
         raise ParameterError(

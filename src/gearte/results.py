@@ -33,7 +33,18 @@ def _display() -> ModuleType:
 
 
 def to_jsonable(obj: Any) -> Any:
-    """Convert numpy scalars/arrays, tuples and nested mappings to plain JSON types."""
+    """Convert numpy scalars/arrays, tuples and nested mappings to plain JSON types.
+
+    Parameters
+    ----------
+    obj : Any
+        A result value: numbers, numpy scalars or arrays, sequences, mappings.
+
+    Returns
+    -------
+    Any
+        The same structure in plain JSON types (NaN/inf as ``None``).
+    """
     if isinstance(obj, dict):
         return {str(k): to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):

@@ -611,7 +611,7 @@ def open_executor(
     retries : int
         Dask only: extra attempts of a chunk that raised.
     connect_timeout_s : float
-        Dask only: seconds to wait for the scheduler before :class:`SchedulerError`.
+        Dask only: time to wait for the scheduler before :class:`SchedulerError` [s].
 
     Raises
     ------

@@ -97,6 +97,13 @@ def check_samples_override(case: Any, samples: int | None) -> None:
 def run_case(case: Any, options: RunOptions | None = None) -> Any:
     """Run a case: a validated ``Case``, a path to a TOML file, a bundled name or a dict.
 
+    Parameters
+    ----------
+    case : Case, str, os.PathLike or dict
+        What to run.
+    options : RunOptions, optional
+        Execution options; default :class:`RunOptions` ().
+
     Returns
     -------
     gearte.results.StudyResult
