@@ -119,10 +119,6 @@ def _problems(func) -> list[str]:
     return out
 
 
-def test_pending_names_exist():
-    assert PENDING <= set(FUNCTIONS), sorted(PENDING - set(FUNCTIONS))
-
-
 def test_the_meta_test_finds_undocumented_parameters_and_missing_references():
     def f(length: float, n: int) -> float:
         """Eq 3 of Hu et al. 2020.
@@ -142,42 +138,9 @@ def test_the_meta_test_finds_undocumented_parameters_and_missing_references():
     ]
 
 
-# Functions whose docstrings do not meet the rule yet (the debt, listed when the meta-test came in).
-# test_docstring_debt_only_shrinks fails when one of them is fixed and still listed.
-PENDING = frozenset(
-    {
-        "gearte.geometry.rv.iso6336_mesh_stiffness",
-        "gearte.models.rv_catalogue.virtual_loop",  # issue 17, docs pending
-        "gearte.runners.bench_calibration.calibrate",  # issue 17, docs pending
-        "gearte.runners.bench_calibration.reduced_constants",  # issue 17, docs pending
-        "gearte.runners.bench_calibration.synthetic_bench",  # issue 17, docs pending
-        "gearte.runners.bench_diagnosis.diagnose",  # issue 17, docs pending
-        "gearte.models.rv_catalogue.backlash",
-        "gearte.models.rv_catalogue.catalogue_values",
-        "gearte.models.rv_catalogue.torque_path",
-        "gearte.models.rv_catalogue.torsion_test",
-        "gearte.models.rv_dynamics.parameters.errors_from_reducer",
-        "gearte.models.rv_dynamics.parameters.parameters_from_reducer",
-        "gearte.models.rv_load_sharing.contact_law",
-        "gearte.models.rv_load_sharing.cycloid_stage",
-        "gearte.models.rv_load_sharing.mesh_period",
-        "gearte.models.rv_load_sharing.solver_law",
-        "gearte.models.rv_load_sharing.transmission_error",
-        "gearte.runners.rv_dynamics_sim.draw_errors",
-        "gearte.runners.rv_dynamics_sim.dte_batch",
-        "gearte.studies.rv_reducer.build_reducer",
-        "gearte.studies.rv_reducer.run",
-    }
-)
-
-
 def test_public_functions_document_parameters_units_and_references():
-    failures = {n: _problems(f) for n, f in FUNCTIONS.items() if n not in PENDING}
+    """Every public function, no exceptions (the debt list of issue 11 is paid)."""
+    assert len(FUNCTIONS) > 300, len(FUNCTIONS)  # the walk found the package's public API
+    failures = {n: _problems(f) for n, f in FUNCTIONS.items()}
     failures = {n: p for n, p in failures.items() if p}
     assert not failures, "\n".join(f"{n}: {'; '.join(p)}" for n, p in sorted(failures.items()))
-
-
-def test_docstring_debt_only_shrinks():
-    """A function of PENDING that now meets the rule must leave the list."""
-    fixed = sorted(n for n in PENDING if not _problems(FUNCTIONS[n]))
-    assert not fixed, f"remove from PENDING (they pass now): {fixed}"
