@@ -28,7 +28,7 @@ import numpy as np
 
 from gearte.errors import ParameterError
 
-__all__ = ["MeasuredDisc", "tooth_and_parameter"]
+__all__ = ["MeasuredDisc", "tooth_and_parameter", "apply_measurements", "measurements_of"]
 
 
 def tooth_and_parameter(pin: np.ndarray, phase: np.ndarray, teeth: int):
@@ -176,3 +176,136 @@ class MeasuredDisc:
             None if self.cumulative_pitch is None else self.cumulative_pitch * factor,
             self.serial,
         )
+
+
+def _rot2(v: np.ndarray, ang: np.ndarray | float) -> np.ndarray:
+    c, s = np.cos(ang), np.sin(ang)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
+
+
+def apply_measurements(
+    reducer,
+    *,
+    discs: list[MeasuredDisc | None] | None = None,
+    disc_bores: np.ndarray | None = None,
+    cam_eccentricity: np.ndarray | None = None,
+    cam_phase: np.ndarray | None = None,
+    planet_runout: np.ndarray | None = None,
+    sun_runout: np.ndarray | None = None,
+    pin_diameters: np.ndarray | None = None,
+    slot_radial: np.ndarray | None = None,
+    slot_tangential: np.ndarray | None = None,
+    cam_clearance: np.ndarray | None = None,
+    carrier_clearance: np.ndarray | None = None,
+):
+    """The reducer with measured part values in place of the design's (None: keep the design's).
+
+    Parameters
+    ----------
+    reducer : gearte.geometry.rv.RVReducer
+        The design (its errors are kept for every family not measured).
+    discs : list of MeasuredDisc or None, optional
+        Per disc (in assembly order), its measured flanks and pitch.
+    disc_bores : numpy.ndarray, optional
+        ``(N, M, 2)`` crank-bore centres of each disc in its own frame [mm].
+    cam_eccentricity, cam_phase : numpy.ndarray, optional
+        ``(M, N)`` measured eccentricity [mm] and eccentric direction from the nominal [rad] of
+        cam ``j`` of the crank at carrier position ``i``.
+    planet_runout : numpy.ndarray, optional
+        ``(M, 2)`` run-out (TIR) [mm] and high-point angle [rad] of each planet.
+    sun_runout : numpy.ndarray, optional
+        ``(2,)`` run-out [mm] and angle [rad] of the sun.
+    pin_diameters : numpy.ndarray, optional
+        ``(z_p,)`` pin diameters [mm].
+    slot_radial, slot_tangential : numpy.ndarray, optional
+        ``(z_p,)`` pin-slot centre deviations [mm].
+    cam_clearance, carrier_clearance : numpy.ndarray, optional
+        ``(M, N)`` and ``(M,)`` measured bearing clearances [mm].
+
+    Returns
+    -------
+    gearte.geometry.rv.RVReducer
+
+    Notes
+    -----
+    Error vectors in the frames of :mod:`gearte.geometry.rv`: bore error = measured − nominal
+    centre (nominal ``R_dc u(2 pi i / M)``) turned into the bore's radial frame; cam error =
+    ``e u(phase) − a u(0)``; planet and sun eccentricity = run-out / 2 at the high point; pin
+    radius error = diameter / 2 − ``r_rp``.
+    """
+    import dataclasses
+
+    err = reducer.error_set
+    m, n = reducer.cranks.count, reducer.discs.count
+    ch: dict = {}
+    if discs is not None:
+        if len(discs) != n:
+            raise ParameterError("discs", len(discs), f"needs one entry per disc ({n})")
+        for j, d in enumerate(discs):
+            if d is not None and d.teeth != reducer.cycloid_teeth:
+                raise ParameterError(
+                    f"discs[{j}].teeth", d.teeth, f"the design has {reducer.cycloid_teeth} teeth"
+                )
+        ch["measured_discs"] = tuple(discs)
+    if disc_bores is not None:
+        xy = np.asarray(disc_bores, dtype=float).reshape(n, m, 2)
+        ang = 2.0 * np.pi * np.arange(m) / m
+        nominal = reducer.cranks.circle_radius * np.stack([np.cos(ang), np.sin(ang)], -1)
+        ch["disc_bore"] = _rot2(xy - nominal[None], -ang[None, :])
+    if cam_eccentricity is not None:
+        e = np.asarray(cam_eccentricity, dtype=float).reshape(m, n)
+        ph = np.zeros((m, n)) if cam_phase is None else np.asarray(cam_phase, float).reshape(m, n)
+        ch["cam"] = np.stack(
+            [e * np.cos(ph) - reducer.cranks.eccentricity, e * np.sin(ph)], axis=-1
+        )
+    if planet_runout is not None:
+        r = np.asarray(planet_runout, dtype=float).reshape(m, 2)
+        ch["planet"] = 0.5 * r[:, :1] * np.stack([np.cos(r[:, 1]), np.sin(r[:, 1])], -1)
+    if sun_runout is not None:
+        rs = np.asarray(sun_runout, dtype=float).reshape(2)
+        ch["sun"] = 0.5 * rs[0] * np.array([np.cos(rs[1]), np.sin(rs[1])])
+    if cam_clearance is not None:
+        ch["cam_clearance"] = np.asarray(cam_clearance, dtype=float).reshape(m, n)
+    if carrier_clearance is not None:
+        ch["carrier_clearance"] = np.asarray(carrier_clearance, dtype=float).reshape(m)
+    pins = reducer.pins
+    pch: dict = {}
+    if pin_diameters is not None:
+        pch["radius_errors"] = 0.5 * np.asarray(pin_diameters, dtype=float) - pins.pin_radius
+    if slot_radial is not None:
+        pch["radial_position_errors"] = np.asarray(slot_radial, dtype=float)
+    if slot_tangential is not None:
+        pch["tangential_position_errors"] = np.asarray(slot_tangential, dtype=float)
+    out = reducer.with_errors(dataclasses.replace(err, **ch))
+    if pch:
+        out = out.replace(pins=dataclasses.replace(pins, **pch))
+    return out
+
+
+def measurements_of(reducer) -> dict[str, np.ndarray]:
+    """What a metrology lab would measure on ``reducer``'s parts: the inverse of
+    :func:`apply_measurements` (keyword → array, same units and shapes).
+
+    Parameters
+    ----------
+    reducer : gearte.geometry.rv.RVReducer
+        A reducer with errors (its disc bore, cam, planet, sun and pin errors are converted).
+    """
+    err = reducer.error_set
+    m = reducer.cranks.count
+    ang = 2.0 * np.pi * np.arange(m) / m
+    nominal = reducer.cranks.circle_radius * np.stack([np.cos(ang), np.sin(ang)], -1)
+    cam = err.cam + np.array([reducer.cranks.eccentricity, 0.0])
+    pl, sun = err.planet, err.sun
+    return {
+        "disc_bores": nominal[None] + _rot2(err.disc_bore, ang[None, :]),
+        "cam_eccentricity": np.hypot(cam[..., 0], cam[..., 1]),
+        "cam_phase": np.arctan2(cam[..., 1], cam[..., 0]),
+        "planet_runout": np.stack(
+            [2.0 * np.hypot(pl[:, 0], pl[:, 1]), np.arctan2(pl[:, 1], pl[:, 0])], -1
+        ),
+        "sun_runout": np.array([2.0 * np.hypot(*sun), np.arctan2(sun[1], sun[0])]),
+        "pin_diameters": 2.0 * (reducer.pins.pin_radius + reducer.pins.radius_errors),
+        "slot_radial": reducer.pins.radial_position_errors.copy(),
+        "slot_tangential": reducer.pins.tangential_position_errors.copy(),
+    }
