@@ -115,6 +115,15 @@ def _tree_hash() -> str:
     return h.hexdigest()[:16]
 
 
+def _short_ref(ref: str) -> str:
+    """``"Jiang J., Zhong X., … (2024). Title"`` → ``"Jiang et al. 2024"``."""
+    import re
+
+    surname = re.split(r"[ ,]", ref.strip(), maxsplit=1)[0]
+    year = re.search(r"\((\d{4})\)", ref)
+    return f"{surname} et al. {year.group(1)}" if year else ref.split(".")[0]
+
+
 def _md_cell(text: str) -> str:
     return str(text).replace("|", "\\|")
 
@@ -192,7 +201,7 @@ def gallery_pages(manifest: dict[str, Any] | None) -> dict[str, str]:
     for case_name, m in manifest.items():
         ref = REFERENCES.get(m["paper"], m["paper"])
         index.append(
-            f"| [{_md_cell(m['title'])}]({case_name}.md) | {_md_cell(ref.split('.')[0])} | "
+            f"| [{_md_cell(m['title'])}]({case_name}.md) | {_short_ref(ref)} | "
             f"{len(m['figures'])} | {m['seconds']} |"
         )
         p = [

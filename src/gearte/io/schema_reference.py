@@ -90,9 +90,11 @@ def unit_of(name: str, description: str = "") -> str:
         return f"{UNITS[parts[-3]]}/{parts[-1]}"
     if len(parts) >= 2 and parts[-1] in UNITS:
         return UNITS[parts[-1]]
-    m = re.search(r"\[([^\]]+)\]", description)
-    if m and len(m.group(1)) <= 12 and not m.group(1).startswith("-"):
-        return unit_text(m.group(1))
+    for m in re.finditer(r"\[([^\]]+)\]", description):
+        parts = re.split(r"[/·*]", m.group(1).strip())
+        known = set(UNITS) | set(UNITS.values()) | {"µm", "N·m", "N·mm", "1"}
+        if all(p.strip() in known for p in parts):
+            return unit_text(m.group(1).strip())
     return ""
 
 
@@ -169,8 +171,10 @@ def _toml(v: Any) -> str:
 
 
 def _number(v: Any) -> str:
-    """A bound for people: ``-1000.0`` → ``-1000``, ``1e-06`` stays."""
-    if isinstance(v, float) and v.is_integer() and abs(v) < 1e15:
+    """A bound for people: ``-1000.0`` → ``-1000``, ``1e9`` for 1000000000, ``1e-06`` stays."""
+    if isinstance(v, int | float) and abs(v) >= 1e6:
+        return f"{v:g}".replace("e+0", "e").replace("e+", "e")
+    if isinstance(v, float) and v.is_integer():
         return str(int(v))
     return str(v)
 
