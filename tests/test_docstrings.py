@@ -221,7 +221,6 @@ PENDING = frozenset(
         "gearte.models.rv_catalogue.catalogue_values",
         "gearte.models.rv_catalogue.torque_path",
         "gearte.models.rv_catalogue.torsion_test",
-        "gearte.models.rv_dynamics.parameters.errors_from_reducer",
         "gearte.models.rv_dynamics.parameters.parameters_from_reducer",
         "gearte.models.rv_load_sharing.contact_law",
         "gearte.models.rv_load_sharing.cycloid_stage",
