@@ -41,7 +41,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("gearte.studies",),
     ("gearte.plotting",),
     ("gearte.report",),
-    ("gearte.sweep",),
+    ("gearte.sweep", "gearte.export"),
     ("gearte.cli", "gearte.__main__", "gearte"),
 ]
 

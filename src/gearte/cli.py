@@ -313,6 +313,66 @@ def sweep(
 
 
 @main.command()
+@click.argument("case")
+@click.option(
+    "--format",
+    "formats",
+    multiple=True,
+    type=click.Choice(["dxf", "csv"], case_sensitive=False),
+    default=("dxf", "csv"),
+    show_default=True,
+    help="Profile format; repeat for several.",
+)
+@click.option(
+    "--chordal-tolerance-um",
+    type=float,
+    default=1.0,
+    show_default=True,
+    help="Largest distance between a chord of the polyline and the profile [µm].",
+)
+@click.option(
+    "--out",
+    "out_dir",
+    default=None,
+    help="Output folder, replaced as a whole (default: out/export_<case name>).",
+)
+@click.option("--no-compensation", is_flag=True, help="Skip the compensation tables.")
+@click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
+def export(
+    case: str,
+    formats: tuple[str, ...],
+    chordal_tolerance_um: float,
+    out_dir: str | None,
+    no_compensation: bool,
+    debug: bool,
+) -> None:
+    """Write the modified cycloid profile of CASE (DXF, CSV) and its compensation tables (CSV).
+
+    Works for cycloid_stage and rv_reducer cases; see docs/export.md.
+    """
+
+    def _export() -> None:
+        from gearte.export import export_case
+        from gearte.io.case_file import load_case
+        from gearte.report.outputs import check_output_dir, safe_label
+
+        c = load_case(case)
+        default = os.path.join("out", f"export_{safe_label(c.case.name or c.case.kind)}")
+        target = check_output_dir(out_dir if out_dir is not None else default)
+        paths = export_case(
+            c,
+            target,
+            formats=formats,
+            chordal_tolerance_um=chordal_tolerance_um,
+            compensation=not no_compensation,
+        )
+        for p in paths.values():
+            click.echo(f"  wrote {p}")
+
+    _guarded(_export, debug)
+
+
+@main.command()
 @click.argument("cases", nargs=-1, required=True)
 def validate(cases: tuple[str, ...]) -> None:
     """Check case files without running them; print every problem, one per line."""

@@ -16,6 +16,7 @@ __all__ = [
     "DivergenceError",
     "SchedulerError",
     "BenchFileError",
+    "MeasurementFileError",
     "OutputError",
     "Interrupted",
 ]
@@ -133,3 +134,12 @@ class Interrupted(KeyboardInterrupt):
         self.signum = signum
         self.partial = partial
         super().__init__(f"interrupted by signal {signum}")
+
+
+class MeasurementFileError(BenchFileError):
+    """A metrology file (measured parts: disc profiles, pitch, pins, cranks, bores, run-outs,
+    bearing clearances; :mod:`gearte.io.metrology`) is malformed.
+
+    Same fields as :class:`BenchFileError`: file, line (1-based), column (number and header
+    name) and the reason.
+    """

@@ -458,6 +458,12 @@ class ManufacturingErrors:
     disc_modification : numpy.ndarray
         ``(N, 2)`` errors of disc ``j``'s equidistant and shifted modifications
         ``(δΔr_rp, δΔr_p)`` [mm] (Hu 2020 Table 2 rows f, g per disc), added to the nominal ones.
+    measured_discs : tuple or None
+        Per disc, a :class:`gearte.geometry.measured.MeasuredDisc` (measured flank deviation per
+        tooth and cumulative pitch per tooth, issue 16) or None; None: no measured disc.
+    cam_clearance, carrier_clearance : numpy.ndarray or None
+        Measured radial clearances [mm] of each cam bearing ``(M, N)`` and each crank's carrier
+        bearing ``(M,)``, replacing the ``Cranks`` values; None: those of ``Cranks``.
     """
 
     planet: np.ndarray
@@ -470,6 +476,9 @@ class ManufacturingErrors:
     disc_runout: np.ndarray = field(default_factory=_empty_per_disc)
     disc_pitch: np.ndarray = field(default_factory=_empty_per_disc)
     disc_modification: np.ndarray = field(default_factory=_empty_per_disc)
+    measured_discs: tuple | None = None
+    cam_clearance: np.ndarray | None = None
+    carrier_clearance: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = self.disc_bore.shape[0]
@@ -563,6 +572,11 @@ class ManufacturingErrors:
             self.disc_runout * factor,
             self.disc_pitch * factor,
             self.disc_modification * factor,
+            None
+            if self.measured_discs is None
+            else tuple(None if m is None else m.scaled(factor) for m in self.measured_discs),
+            self.cam_clearance,
+            self.carrier_clearance,
         )
 
     def with_disc_modification(self, errors: np.ndarray) -> ManufacturingErrors:
@@ -750,7 +764,8 @@ class PinContacts:
         disc's modified profile (nominal modifications + that disc's modification errors),
         minus the pin-radius error, plus the pin-centre error on the normal, minus the disc's
         radial run-out on the normal, minus the arm × the local rotation of the cumulative
-        pitch deviation.
+        pitch deviation, plus the change a measured disc causes
+        (:meth:`gearte.geometry.measured.MeasuredDisc.gap_change`).
     """
 
     theta: np.ndarray
@@ -839,6 +854,9 @@ def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
             psi = np.arctan2(lever[:, j, :, 1], lever[:, j, :, 0]) - th[:, None]
             ang = np.arctan2(err.disc_pitch[j, 1], err.disc_pitch[j, 0])
             g = g - arm[:, j] * 0.5 * fp * np.sin(psi - ang) / (a * zc)
+        measured = None if err.measured_discs is None else err.measured_discs[j]
+        if measured is not None:  # measured flank per tooth and pitch per tooth (issue 16)
+            g = g + measured.gap_change(np.arange(zp)[None, :], phi[:, j], arm[:, j], a * zc)
         gap[:, j] = g
     return PinContacts(th, n, lever, arm, phi, gap)
 

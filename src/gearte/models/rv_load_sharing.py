@@ -293,6 +293,11 @@ def _point_row(row: np.ndarray, dof: int, r: np.ndarray, n: np.ndarray, sign: fl
         row[:, dof + 2] += sign * (r[:, 0] * n[:, 1] - r[:, 1] * n[:, 0])
 
 
+def _measured(design: float, measured: np.ndarray | None, index) -> float:
+    """A bearing's clearance [mm]: the measured one of that bearing if given, else the design's."""
+    return design if measured is None else float(measured[index])
+
+
 def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     """Spring and contact rows of ``reducer`` at output angles ``theta`` [rad].
 
@@ -367,7 +372,7 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
                 r,
                 -eps @ d,
                 reducer.cranks.carrier_bearing_stiffness,
-                reducer.cranks.carrier_bearing_clearance,
+                _measured(reducer.cranks.carrier_bearing_clearance, err.carrier_clearance, i),
             )
     labels["carrier_bearing"] = slice(start, len(rows))
 
@@ -387,7 +392,7 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
                     r,
                     (eps_cam - eps_bore) @ d,
                     reducer.cranks.cam_bearing_stiffness,
-                    reducer.cranks.cam_bearing_clearance,
+                    _measured(reducer.cranks.cam_bearing_clearance, err.cam_clearance, (i, j)),
                 )
     labels["cam_bearing"] = slice(start, len(rows))
 

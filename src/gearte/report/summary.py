@@ -23,7 +23,14 @@ from gearte.labels import label
 from gearte.report.tables import item_label, relative_change
 from gearte.units import format_quantity, split_unit
 
-__all__ = ["HeadlineRow", "headlines", "tradeoff_warnings", "HEADLINE_KEYS", "SPEC_CHECKS"]
+__all__ = [
+    "HeadlineRow",
+    "headlines",
+    "analysis_headlines",
+    "tradeoff_warnings",
+    "HEADLINE_KEYS",
+    "SPEC_CHECKS",
+]
 
 MAX_HEADLINES = 4
 
@@ -125,11 +132,12 @@ def headlines(result: Any) -> list[HeadlineRow]:
     """Summary rows of every analysis of a study result (see the module docstring)."""
     rows: list[HeadlineRow] = []
     for a in result.analyses:
-        rows += _analysis_headlines(a)
+        rows += analysis_headlines(a)
     return rows
 
 
-def _analysis_headlines(a: Any) -> list[HeadlineRow]:
+def analysis_headlines(a: Any) -> list[HeadlineRow]:
+    """Summary rows of the analysis ``a`` (an AnalysisResult; see the module docstring)."""
     vals = _by_base(a.values)
     picked: list[HeadlineRow] = []
 

@@ -919,12 +919,16 @@ def _cycloid_analyses(case: Case, options) -> tuple[list[AnalysisResult], list[s
     return out, list(res.warnings)
 
 
-def run(case: Case, options=None) -> StudyResult:
-    """Run the analyses a case asks for; every one reads the same :class:`RVReducer`."""
+def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyResult:
+    """Run the analyses a case asks for; every one reads the same :class:`RVReducer`.
+
+    ``reducer`` replaces the one the case describes (a measured serial, ``rv_serial``); its
+    errors are compared with the design's errors removed.
+    """
     from gearte.models.rv_load_sharing import contact_law
 
-    red = build_reducer(case.reducer)
-    has_errors = bool(case.reducer.errors)
+    red = build_reducer(case.reducer) if reducer is None else reducer
+    has_errors = bool(case.reducer.errors) or reducer is not None
     red0 = build_reducer(case.reducer, with_errors=False) if has_errors else None
     law = contact_law(red)  # the reducer's own law (reducer.contact_law of the case)
     a = case.analyses

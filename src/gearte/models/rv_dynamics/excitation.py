@@ -44,8 +44,8 @@ __all__ = ["disc_rotation_error", "has_pin_errors", "loaded_disc_rotation"]
 def has_pin_errors(reducer: RVReducer) -> bool:
     """Whether ``reducer`` has an error that acts on single pin contacts.
 
-    Per-pin radius or position errors, disc radial run-out, disc cumulative pitch error or a
-    per-disc modification error.
+    Per-pin radius or position errors, disc radial run-out, disc cumulative pitch error, a
+    per-disc modification error or a measured disc.
     """
     e, p = reducer.error_set, reducer.pins
     return bool(
@@ -55,6 +55,7 @@ def has_pin_errors(reducer: RVReducer) -> bool:
         or np.any(p.radius_errors != 0)
         or np.any(p.radial_position_errors != 0)
         or np.any(p.tangential_position_errors != 0)
+        or (e.measured_discs is not None and any(m is not None for m in e.measured_discs))
     )
 
 
