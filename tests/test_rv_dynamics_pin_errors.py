@@ -146,3 +146,25 @@ def test_dynamic_analyses_run_with_disc_profile_errors():
 
     runout = {"part": "disc_radial_runout", "disc": 1, "value_um": 10.0, "angle_deg": 0.0}
     assert dte([runout]) > 1.5 * dte([])
+
+
+def test_measured_disc_enters_the_dynamics_like_the_same_modification_error():
+    """A measured disc whose flank deviation is −4 µm everywhere (issue 16's MeasuredDisc) is the
+    equidistant modification error δΔr_rp = +4 µm: the same pin clearances
+    (geometry.rv.pin_contacts), hence the same rotation excitation of the dynamics."""
+    from gearte.geometry.measured import MeasuredDisc
+
+    red = build_reducer(load_case("han2023_rv110e_no_errors").reducer)
+    zc = red.cycloid_teeth
+    phi = np.linspace(-np.pi, np.pi, 201)
+    disc = MeasuredDisc(zc, tuple([phi] * zc), tuple([np.full(phi.size, -0.004)] * zc))
+    e = red.error_set
+    measured = red.with_errors(dataclasses.replace(e, measured_discs=(disc, None)))
+    modified = red.with_errors(
+        dataclasses.replace(e, disc_modification=np.array([[0.004, 0.0], [0.0, 0.0]]))
+    )
+    assert has_pin_errors(measured)
+    a = disc_rotation_error(measured, 539e3, samples_per_mesh=2)
+    b = disc_rotation_error(modified, 539e3, samples_per_mesh=2)
+    assert np.max(np.abs(b)) > 0
+    np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12)
