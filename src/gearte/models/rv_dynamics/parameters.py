@@ -258,6 +258,16 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
     Per-pin and disc-profile errors are not parameters: :func:`errors_from_reducer` turns them
     into the discs' rotation excitation.
 
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (geometry [mm], stiffnesses [N/mm], material [MPa]).
+
+    Returns
+    -------
+    RVDynamicsParameters
+        The parameters of the lumped model.
+
     Raises
     ------
     ParameterError
@@ -356,6 +366,20 @@ def errors_from_reducer(
     ``output_torque_Nm`` [N·m], ``samples_per_mesh`` output angles per mesh period).
     ``paper004`` adds the errors the description does not hold (sun_eccentricity, sun_assembly,
     output_assembly, pin_composite, output_bearing_clearance_mm).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description with its measured errors and clearances.
+    output_torque_Nm : float, optional
+        Output torque [N·m] at which the pin-error excitation is computed.
+    samples_per_mesh : int
+        Output angles per mesh period of the excitation table [-].
+
+    Returns
+    -------
+    RVErrors
+        The errors of the dynamic model (amplitudes [mm], phases [rad], disc rotations [rad]).
 
     Raises
     ------
