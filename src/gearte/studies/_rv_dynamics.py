@@ -24,7 +24,6 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer, mass_properties
 from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult
@@ -140,7 +139,6 @@ def build_dynamic_model(case, red: RVReducer):
     )
 
     d, op = case.reducer.dynamics, case.operation
-    _check_representable(red)
     mp = mass_properties(red, case.reducer.density, d.given("mass"), d.given("inertia"))
     kw: dict[str, Any] = {f"{b}_mass_kg": v for b, v in mp.mass_kg.items()}
     kw.update({f"{b}_inertia_kgm2": v for b, v in mp.inertia_kgm2.items()})
@@ -173,6 +171,7 @@ def build_dynamic_model(case, red: RVReducer):
         sun_assembly=polar(e.sun_seat),
         output_assembly=polar(e.output_seat),
         output_bearing_clearance_mm=red.supports.main_bearing_clearance,
+        output_torque_Nm=op.output_torque_Nm,
     )
     return RVDynamicModel(params, errors), mp
 
@@ -202,29 +201,10 @@ def batch_tolerances(red: RVReducer, scale: float = 1.0):
     )
 
 
-def _check_representable(red: RVReducer) -> None:
-    """The disc profile errors the quasi-static model reads but the dynamics cannot hold."""
-    amp = red.error_set.amplitudes()
-    for part in ("disc_radial_runout", "disc_cumulative_pitch"):
-        if amp[part] > 0:
-            raise ParameterError(
-                "reducer.errors",
-                part,
-                "disc profile errors are read by the quasi-static analyses only: the dynamic "
-                "model has one equivalent cycloid–pin spring per disc and cannot hold them; "
-                "leave them out of a case that asks for dynamic analyses",
-            )
-    if np.any(red.error_set.disc_modification != 0):
-        raise ParameterError(
-            "reducer.discs.equidistant_modification_errors_um/shift_modification_errors_um",
-            red.error_set.disc_modification.tolist(),
-            "per-disc modification errors are read by the quasi-static analyses only (the "
-            "dynamic model's discs share one cycloid–pin pair)",
-        )
-
-
 def _has_errors(red: RVReducer) -> bool:
-    return any(v > 0 for v in red.error_set.amplitudes().values())
+    from gearte.models.rv_dynamics.excitation import has_pin_errors
+
+    return any(v > 0 for v in red.error_set.amplitudes().values()) or has_pin_errors(red)
 
 
 # --- analyses --------------------------------------------------------------------------------
@@ -401,7 +381,10 @@ def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
     ]
     if _has_errors(red):
         notes.append(
-            "Errors: the case's [[reducer.errors]], the same the quasi-static model reads."
+            "Errors: the case's [[reducer.errors]] and per-pin errors, the same the "
+            "quasi-static model reads; pin, disc run-out, cumulative pitch and per-disc "
+            "modification errors act as each disc's loaded rotation shift computed from the "
+            "same pin clearances (gearte.models.rv_dynamics.excitation)."
         )
     if opts.duration_s * sources["output rotation"] < 0.99 and _has_errors(red):
         warnings.append(
@@ -519,7 +502,7 @@ def _batch(case, red, model, options) -> AnalysisResult:
         notes=[
             "Each part's error amplitude uniform in [0, tolerance] (the largest of the case's "
             f"errors of that part × {s:g}), phase uniform in [0, 2π), independently per crank "
-            f"and disc; seed {seed}.",
+            f"and disc; seed {seed}. Pin and disc-profile errors are not drawn.",
             "Peak-to-peak over the simulated span after settling, reduced inside the kernel.",
         ],
         data={"rows": res["rows"]},

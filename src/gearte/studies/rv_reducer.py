@@ -62,6 +62,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from gearte.errors import ConvergenceError, ParameterError
+from gearte.geometry.planetary import SunPlanets
 from gearte.geometry.rv import (
     ERROR_PARTS,
     Cranks,
@@ -683,6 +684,16 @@ class Case(CaseBase):
 # ------------------------------------------------------------------------------------------
 # Case -> domain objects
 # ------------------------------------------------------------------------------------------
+#: ``[reducer.first_stage]`` key of each :class:`SunPlanets` field.
+_GEAR_SET_KEYS = {
+    "z_sun": "sun_teeth",
+    "z_planet": "planet_teeth",
+    "module": "module_mm",
+    "pressure_angle": "pressure_angle_deg",
+    "n_planets": "planets",
+}
+
+
 def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer:
     """The :class:`RVReducer` a case's ``[reducer]`` section describes.
 
@@ -707,15 +718,18 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         raise ParameterError(
             "reducer.first_stage.face_width_mm", None, "give it or mesh_stiffness_N_per_mm"
         )
-    first = FirstStage(
-        fs.sun_teeth,
-        fs.planet_teeth,
-        fs.module_mm,
-        deg_to_rad(fs.pressure_angle_deg),
-        mesh,
-        fs.sun_support_stiffness_N_per_mm,
-        fs.face_width_mm,
-    )
+    try:  # the planetary kind's gear set (its checks, its messages), named by the RV keys
+        gears = SunPlanets(
+            fs.sun_teeth,
+            fs.planet_teeth,
+            fs.module_mm,
+            float(deg_to_rad(fs.pressure_angle_deg)),
+            n_planets=fs.planets,
+        )
+    except ParameterError as exc:
+        key = _GEAR_SET_KEYS.get(exc.field, exc.field)
+        raise ParameterError(f"first_stage.{key}", exc.value, exc.reason) from None
+    first = FirstStage(gears, mesh, fs.sun_support_stiffness_N_per_mm, fs.face_width_mm)
     c = sec.cranks
     cranks = Cranks(
         c.count,
