@@ -63,7 +63,7 @@ HALF_WIDTH_FACTOR = HU2020_HALF_WIDTH_FACTOR
 
 
 def compliance_constants(
-    rho: float, r: float, E: float, mu: float, b: float, law: str = "hu2020"
+    rho: float, r: float, E: float, mu: float, b: float, *, law: str
 ) -> tuple[float, float]:
     """Constants (A [mm/N], B [N]) with δ(F) = A F (2/3 + ln(B/F)) for a contact law.
 
@@ -80,7 +80,8 @@ def compliance_constants(
     b : float
         Face width of one disc [mm].
     law : {"hu2020", "line_contact"}
-        The law of :mod:`gearte.models.contact_law` (Hu 2020 eq 38–39 by default, as printed).
+        The law of :mod:`gearte.models.contact_law` (``"hu2020"``: eq 38–39 as printed); no
+        default, the caller names it.
 
     Notes
     -----
@@ -139,7 +140,7 @@ def half_width(F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float
 
 
 def max_normal_deformation(
-    F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float, law: str = "hu2020"
+    F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float, *, law: str
 ) -> np.ndarray:
     """Maximum normal deformation δ_max [mm] under the pin force F [N] (eq 38).
 
@@ -158,7 +159,8 @@ def max_normal_deformation(
     b : float
         Face width of one disc [mm].
     law : {"hu2020", "line_contact"}
-        :func:`gearte.models.contact_law.approach` of this law (Hu 2020 eq 38–39 by default).
+        :func:`gearte.models.contact_law.approach` of this law (``"hu2020"``: eq 38–39 as
+        printed); no default, the caller names it.
 
     Returns
     -------
@@ -167,7 +169,8 @@ def max_normal_deformation(
 
     Examples
     --------
-    >>> round(float(max_normal_deformation(1910.3, -43.598, 2.978, 2.06e5, 0.3, 11.0)), 4)
+    >>> d = max_normal_deformation(1910.3, -43.598, 2.978, 2.06e5, 0.3, 11.0, law="hu2020")
+    >>> round(float(d), 4)
     0.0116
 
     References

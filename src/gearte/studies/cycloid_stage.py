@@ -164,8 +164,8 @@ class ToothContactOptions(_Section):
     disc_share: float = Field(
         gt=0, le=1, description="Share of T carried by the analysed disc (Hu et al.: 0.55)."
     )
-    youngs_modulus_MPa: float = Field(default=2.06e5, gt=0, le=1e7, description="E [MPa].")
-    poisson_ratio: float = Field(default=0.3, ge=0, lt=0.5, description="μ [-].")
+    youngs_modulus_MPa: float = Field(gt=0, le=1e7, description="E of disc and pins [MPa].")
+    poisson_ratio: float = Field(ge=0, lt=0.5, description="μ of disc and pins [-].")
     mesh_positions: int = Field(
         default=1, ge=1, le=100000, description="Mesh positions over one tooth pitch (1: paper's)."
     )
@@ -200,7 +200,12 @@ class CompensationOptions(_Section):
         min_length=1,
         description="Factors allowed to change (default: the negative-coefficient ones).",
     )
-    rule: Literal["equal_share", "equal_change", "tolerance_weighted"] = "equal_share"
+    rule: Literal["equal_share", "equal_change", "tolerance_weighted"] = Field(
+        "equal_share",
+        description="How the TE change is shared among the factors: equal_share (same TE share "
+        "each), equal_change (same change each) or tolerance_weighted (least change in units of "
+        "each tolerance).",
+    )
 
 
 class Analyses(_Section):
