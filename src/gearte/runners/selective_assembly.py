@@ -341,13 +341,15 @@ def _unit_responses(design: RVReducer, model: LinearTE, field: str, shape: tuple
     ``field``: ``shape + (P,)``; the offsets come from :func:`assemble` (exactly linear)."""
     theta = model.system.theta
     h = 1e-3  # mm; any value: the offsets are linear in the errors
-    zero = design.with_errors(dataclasses.replace(design.error_set, **{field: np.zeros(shape)}))
+    changes: dict = {field: np.zeros(shape)}
+    zero = design.with_errors(dataclasses.replace(design.error_set, **changes))
     sys0 = assemble(zero, theta)
     out = np.zeros((*shape, theta.size))
     for idx in itertools.product(*(range(s) for s in shape)):
         arr = np.zeros(shape)
         arr[idx] = h
-        red = design.with_errors(dataclasses.replace(design.error_set, **{field: arr}))
+        changes[field] = arr
+        red = design.with_errors(dataclasses.replace(design.error_set, **changes))
         s1 = assemble(red, theta)
         out[idx] = model.response(
             (s1.spring_e - sys0.spring_e) / h, (s1.contact_gap - sys0.contact_gap) / h
@@ -428,7 +430,9 @@ def _contributions(design: RVReducer, lot: Lot, model: LinearTE):
     for k in range(lot.crank_sets):
         for o in c_orients:
             cr = _oriented_cranks(lot, k, o)
-            cam = cam_errors(cr["cam_eccentricity"], cr["cam_phase"], design.cranks.eccentricity)
+            ecc, phase = cr["cam_eccentricity"], cr["cam_phase"]
+            assert ecc is not None and phase is not None  # noqa: S101 - a lot always has cams
+            cam = cam_errors(ecc, phase, design.cranks.eccentricity)
             t = np.einsum("ijd,ijdp->p", cam, u_cam)
             if cr["planet_runout"] is not None:
                 t = t + np.einsum("id,idp->p", runout_errors(cr["planet_runout"]), u_planet)

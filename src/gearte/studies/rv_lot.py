@@ -308,7 +308,7 @@ def run(case: Case, options=None) -> StudyResult:
         o = table.orientation(int(best.disc_orientation[r]), int(best.crank_orientation[r]))
         ds, cs = lot.disc_serials[d], lot.crank_serials[c]
         n, m = len(ds), len(cs)
-        row = {"reducer": f"R-{r + 1:04d}"}
+        row: dict[str, object] = {"reducer": f"R-{r + 1:04d}"}
         for j in range(n):
             row[f"disc_slot_{j + 1}"] = ds[(j + o.disc_shift) % n]
         row["disc_bore_1_on_crank_position"] = 1 + o.disc_index
@@ -359,7 +359,7 @@ def run(case: Case, options=None) -> StudyResult:
             files={"assembly_instructions.csv": csv},
         )
     ]
-    if grading is not None and chosen is not None and backlash is not None:
+    if grading is not None and chosen is not None and backlash is not None and grades is not None:
         lo, hi = grading.backlash_window_arcmin
         out.append(
             AnalysisResult(
