@@ -231,10 +231,18 @@ def run(
     "--vary",
     "vary",
     multiple=True,
-    required=True,
     metavar="KEY=START:STOP:N",
     help="A case parameter to vary (dotted path, e.g. stage.eccentricity_mm=1.0:1.6:7, or "
-    "KEY=V1,V2,...). Repeat for a full-factorial grid.",
+    "KEY=V1,V2,...); coupled keys: K1,K2=A1:A2,B1:B2 (the points (A1, A2), (B1, B2)). Repeat "
+    "for a full-factorial grid.",
+)
+@click.option(
+    "--points",
+    "points_file",
+    default=None,
+    metavar="TABLE.csv",
+    help="Coupled points from a CSV table: a header of keys, one row per point (one axis of "
+    "the grid, combined with any --vary).",
 )
 @click.option(
     "--out",
@@ -250,6 +258,7 @@ def run(
 def sweep(
     case: str,
     vary: tuple[str, ...],
+    points_file: str | None,
     out_dir: str | None,
     seed: int | None,
     samples: int | None,
@@ -259,14 +268,20 @@ def sweep(
     no_progress: bool,
     debug: bool,
 ) -> None:
-    """Run CASE over a grid of parameter values; write sweep.csv, sweep.json and plots."""
+    """Run CASE over a grid of parameter values; write sweep.csv, sweep.json, index.html and
+    plots. Points that do not validate are skipped and listed with the reason."""
 
     def _sweep() -> None:
+        from gearte.errors import ParameterError
         from gearte.io.case_file import load_case
         from gearte.report.outputs import check_output_dir, safe_label
-        from gearte.sweep import parse_vary, run_sweep, write_sweep
+        from gearte.sweep import Coupled, Vary, parse_vary, read_points, run_sweep, write_sweep
 
-        varies = [parse_vary(v) for v in vary]
+        varies: list[Vary | Coupled] = [parse_vary(v) for v in vary]
+        if points_file is not None:
+            varies.append(read_points(points_file))
+        if not varies:
+            raise ParameterError("--vary", "", "give at least one --vary KEY=... or --points")
         c = load_case(case)
         default = os.path.join("out", f"sweep_{safe_label(c.case.name or c.case.kind)}")
         target = check_output_dir(out_dir if out_dir is not None else default)
@@ -297,13 +312,21 @@ def sweep(
                 sys.exit(128 + exc.signum)
             raise
         paths = write_sweep(result, target, plots=not no_plots)
-        failed = [e for e in result.errors if e]
         click.echo(
             f"{result.name}: {len(result.points)} points × {len(result.columns)} scalar results "
             f"in {result.elapsed_s:.2f} s ({result.backend})"
         )
-        if failed:
-            click.echo(f"warning: {len(failed)} point(s) failed; see the error column", err=True)
+        statuses = result.statuses
+        for what, label in (("invalid", "did not validate (skipped)"), ("failed", "failed")):
+            bad = [i for i, st in enumerate(statuses) if st == what]
+            if bad:
+                click.echo(f"warning: {len(bad)} point(s) {label}:", err=True)
+                for i in bad[:10]:
+                    where = ", ".join(f"{k}={v!r}" for k, v in result.points[i].items())
+                    click.echo(f"  #{i} {where}: {result.errors[i]}", err=True)
+                if len(bad) > 10:
+                    click.echo(f"  ... {len(bad) - 10} more in {paths['index']}", err=True)
+        click.echo(f"  wrote {paths['index']}")
         click.echo(f"  wrote {paths['csv']}")
         click.echo(f"  wrote {paths['json']}")
         if paths["plots"]:

@@ -504,7 +504,7 @@ def run(case: Case, options) -> StudyResult:
                     "Angles are measured counter-clockwise from the reference angle "
                     f"({terms.reference_angle}) at t = 0 (planet 1 on the x axis).",
                     "optimal_assembly_te: global minimum of the exact amplitude max|Σe(t)| over "
-                    "every free angle (Sobol starts + Nelder-Mead).",
+                    "every free angle (quasi-random starts + Nelder-Mead).",
                     "paper_rule_assembly_te: Wang's own measure |c| + Σ|group amplitude| at his "
                     "±1 rule (eq 6, Table 3); paper_rule_assembly_te_exact: exact amplitude at "
                     "those angles with the rule's 'arbitrary' angles at their given values.",
