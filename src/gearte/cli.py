@@ -5,9 +5,10 @@ so ``gearte --help`` answers fast.
 
 Exit codes (docs/errors.md): 0 ok · 1 the analysis failed (non-convergence, divergence) · 2 bad
 input · 3 internal error (a bug: please report it, ``--debug`` shows the traceback) · 4 the outputs
-cannot be written (read-only, disk full, file-size limit, a path under a file) · 130 / 143
-stopped by SIGINT (Ctrl-C) / SIGTERM: previous outputs kept; an interrupted sweep writes the points
-that finished, marked partial.
+cannot be written (read-only, disk full, file-size limit, a path under a file) · 5 the cluster
+was lost mid-run (finished chunks written, marked partial) · 130 / 143 stopped by SIGINT (Ctrl-C)
+/ SIGTERM: previous outputs kept; an interrupted sweep writes the points that finished, an
+interrupted Monte-Carlo its finished chunks, marked partial.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ EXIT_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
 EXIT_OUTPUT = 4
+EXIT_CLUSTER_LOST = 5
 EXIT_SIGINT = 130  # 128 + SIGINT
 EXIT_SIGTERM = 143  # 128 + SIGTERM
 
@@ -56,6 +58,7 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     """Run ``fn`` turning gearte's errors into clean messages and exit codes."""
     from gearte.errors import (
         CaseFileError,
+        ClusterLostError,
         ConvergenceError,
         DivergenceError,
         GearteError,
@@ -72,7 +75,15 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
 
         signum = int(getattr(exc, "signum", signal.SIGINT))
         name = signal.Signals(signum).name
-        _error("interrupted", f"stopped by {name}; nothing written, previous outputs kept")
+        written = getattr(exc, "written", None)
+        if written is not None:
+            _error(
+                "interrupted",
+                f"stopped by {name}: the finished chunks were written to {written}, marked "
+                'partial ("partial": true; its first warning says what was cut)',
+            )
+        else:
+            _error("interrupted", f"stopped by {name}; nothing written, previous outputs kept")
         sys.exit(128 + signum)
     except BrokenPipeError:  # output piped into `head` and closed: not an error of ours
         sys.stderr.close()
@@ -86,6 +97,15 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     except FileNotFoundError as exc:
         _error("not found", str(exc).strip("'\""))
         sys.exit(EXIT_BAD_INPUT)
+    except ClusterLostError as exc:
+        written = getattr(exc, "written", None)
+        kept = (
+            f"the finished chunks were written to {written}, marked partial"
+            if written is not None
+            else "nothing finished was kept; previous outputs kept"
+        )
+        _error("cluster lost", f"{exc}; {kept}")
+        sys.exit(EXIT_CLUSTER_LOST)
     except SchedulerError as exc:
         _error("scheduler", str(exc))
         sys.exit(EXIT_BAD_INPUT)
@@ -107,6 +127,19 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
             "traceback and report it.",
         )
         sys.exit(EXIT_INTERNAL)
+
+
+def _write_partial(exc: BaseException, target: Any) -> None:
+    """A run stopped mid-way (signal, lost cluster) with finished chunks: write them as the
+    output set, ``results.json`` only, marked ``"partial": true``; say so. The exception then
+    propagates to :func:`_guarded` for the exit code."""
+    partial = getattr(exc, "partial", None)
+    if partial is None:
+        return
+    from gearte.report.outputs import write_outputs
+
+    paths = write_outputs(partial, target, report=False)
+    exc.written = paths["results"]  # type: ignore[attr-defined]
 
 
 @contextlib.contextmanager
@@ -191,6 +224,7 @@ def run(
         import time
 
         t0 = time.perf_counter()
+        from gearte.errors import ClusterLostError
         from gearte.io.case_file import load_case
         from gearte.report.outputs import check_output_dir, safe_label, write_outputs
         from gearte.studies import RunOptions, run_case
@@ -208,7 +242,11 @@ def run(
                 scheduler=executor,
                 workers=workers,
             )
-            result = run_case(c, opts)
+            try:
+                result = run_case(c, opts)
+            except (KeyboardInterrupt, ClusterLostError) as exc:
+                _write_partial(exc, target)
+                raise
         result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
         paths = write_outputs(result, target, report=not no_report)
         for w in result.warnings:

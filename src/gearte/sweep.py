@@ -151,6 +151,16 @@ def parse_vary(spec: str) -> Vary | Coupled:
     (38, 40)
     >>> parse_vary("stage.pins,stage.cycloid_teeth=38:37,40:39").rows
     ((38, 37), (40, 39))
+
+    Parameters
+    ----------
+    spec : str
+        The ``--vary`` text.
+
+    Returns
+    -------
+    Vary or Coupled
+        The key (or coupled keys) and its values.
     """
     key, sep, rhs = spec.partition("=")
     key, rhs = key.strip(), rhs.strip()
@@ -256,7 +266,18 @@ def _as_vary(key: str, spec: Any) -> Vary | Coupled:
 
 def grid_points(vary: Sequence[Vary | Coupled]) -> list[dict[str, Any]]:
     """Full-factorial grid, first key varying slowest: ``[{key: value, ...}, ...]``; coupled
-    keys form one axis (their rows)."""
+    keys form one axis (their rows).
+
+    Parameters
+    ----------
+    vary : sequence of Vary or Coupled
+        The varied keys with their values (:func:`parse_vary`).
+
+    Returns
+    -------
+    list of dict
+        One ``{key: value}`` per grid point.
+    """
     axes = [[dict(zip(v.keys, row, strict=True)) for row in v.rows] for v in vary]
     return [{k: x for d in combo for k, x in d.items()} for combo in itertools.product(*axes)]
 
@@ -698,6 +719,15 @@ def write_sweep(
     ``plots/`` one PNG per scalar result that varies over the sweep, with one panel per varied
     key. The index page links every figure and lists the points that were skipped as invalid or
     failed, with their reasons. Figures are rendered before any file is written.
+
+    Parameters
+    ----------
+    result : SweepResult
+        The sweep.
+    out_dir : str or os.PathLike
+        Output folder (created).
+    plots : bool
+        Also write the PNG figures.
 
     Returns
     -------

@@ -154,7 +154,20 @@ def did_you_mean(key: str, known: set[str]) -> str:
 
 def format_validation_errors(exc: Any, root: Any = None) -> list[tuple[str, str]]:
     """Turn a pydantic ``ValidationError`` into ``(field, message)`` pairs, one per problem;
-    with ``root`` (the ``Case`` class), unknown keys get a "did you mean" hint."""
+    with ``root`` (the ``Case`` class), unknown keys get a "did you mean" hint.
+
+    Parameters
+    ----------
+    exc : pydantic.ValidationError
+        The validation error.
+    root : type, optional
+        The ``Case`` class the input was validated against (for "did you mean" hints).
+
+    Returns
+    -------
+    list of (str, str)
+        ``(dotted field, message)`` pairs.
+    """
     out: list[tuple[str, str]] = []
     for err in exc.errors(include_url=False):
         loc = ".".join(str(p) for p in _user_loc(root, tuple(err.get("loc", ())))) or "(case)"

@@ -504,6 +504,21 @@ def _round_shim(x: float, step: float, how: str) -> float:
 
 
 def run(case: Case, options) -> StudyResult:
+    """Run a ``gear_chain`` case: each stage's lost motion, the joint and end-effector error,
+    shim and motor compensation; no I/O, no plotting.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case.
+    options : RunOptions
+        Execution options (workers, scheduler, progress); the runner passes them.
+
+    Returns
+    -------
+    StudyResult
+        The analyses and warnings.
+    """
     conf = case.analysis.confidence
     analyses: list[AnalysisResult] = []
     warnings: list[str] = []

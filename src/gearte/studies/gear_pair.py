@@ -411,7 +411,26 @@ def analyse_pair(
     prefix: str = "",
     title_prefix: str = "",
 ) -> list[AnalysisResult]:
-    """Backlash, Monte-Carlo and contribution analyses of one pair (shared with gear_chain)."""
+    """Backlash, Monte-Carlo and contribution analyses of one pair (shared with gear_chain).
+
+    Parameters
+    ----------
+    spec : SpurPairSpec or BevelPairSpec
+        The pair and its tolerances.
+    analysis : PairAnalysisSpec
+        What to compute (confidence, Monte-Carlo samples, seed).
+    options : RunOptions
+        Execution options (workers, scheduler, progress); the runner passes them.
+    prefix : str
+        Prefix of the analysis names (a chain's stage).
+    title_prefix : str
+        Prefix of the analysis titles.
+
+    Returns
+    -------
+    list of AnalysisResult
+        Backlash, Monte-Carlo and contribution analyses.
+    """
     from gearte.tolerance.contributions import group_shares, sobol_indices, variance_shares
     from gearte.tolerance.montecarlo import monte_carlo
 
@@ -577,6 +596,20 @@ def analyse_pair(
 
 
 def run(case: Case, options) -> StudyResult:
+    """Run a ``gear_pair`` case (:func:`analyse_pair` on its pair); no I/O, no plotting.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case.
+    options : RunOptions
+        Execution options (workers, scheduler, progress); the runner passes them.
+
+    Returns
+    -------
+    StudyResult
+        The analyses and warnings.
+    """
     analyses = analyse_pair(case.pair, case.analysis, options)
     warnings = []
     if not analyses[0].values["meets_min_backlash_limit"]:
