@@ -200,7 +200,12 @@ class CompensationOptions(_Section):
         min_length=1,
         description="Factors allowed to change (default: the negative-coefficient ones).",
     )
-    rule: Literal["equal_share", "equal_change", "tolerance_weighted"] = "equal_share"
+    rule: Literal["equal_share", "equal_change", "tolerance_weighted"] = Field(
+        "equal_share",
+        description="How the TE change is shared among the factors: equal_share (same TE share "
+        "each), equal_change (same change each) or tolerance_weighted (least change in units of "
+        "each tolerance).",
+    )
 
 
 class Analyses(_Section):
