@@ -227,17 +227,5 @@ PENDING = frozenset(
         "rv_reducer.ToothContactSection.clearance_model",
         "rv_reducer.ToothContactSection.mesh_positions",
         "rv_reducer.ToothContactSection.start_force_N",
-        "rv_serial.Analyses.catalogue",
-        "rv_serial.Analyses.load_sharing",
-        "rv_serial.Analyses.transmission_error",
-        "rv_serial.FilesSection.bearing_clearance",
-        "rv_serial.FilesSection.crank_eccentricity",
-        "rv_serial.FilesSection.disc_bores",
-        "rv_serial.FilesSection.disc_pitch",
-        "rv_serial.FilesSection.disc_profile",
-        "rv_serial.FilesSection.pins",
-        "rv_serial.FilesSection.planet_runout",
-        "rv_serial.FilesSection.sun_runout",
-        "rv_serial.SerialSection.sun",
     }
 )

@@ -56,12 +56,24 @@ _FILES = (
 class LotFiles(StrictModel):
     """Measurement files of the lot (``docs/metrology.md``), relative to the case file."""
 
-    disc_profile: str | None = None
-    disc_pitch: str | None = None
-    disc_bores: str | None = None
-    crank_eccentricity: str
-    planet_runout: str | None = None
-    bearing_clearance: str | None = None
+    disc_profile: str | None = Field(
+        default=None, description="disc flank deviation per tooth (format disc_profile)"
+    )
+    disc_pitch: str | None = Field(
+        default=None, description="disc cumulative pitch per tooth (format disc_pitch)"
+    )
+    disc_bores: str | None = Field(
+        default=None, description="crank-bore centres per disc (format disc_bores)"
+    )
+    crank_eccentricity: str = Field(
+        description="cam eccentricity and phase per crank (format crank_eccentricity)"
+    )
+    planet_runout: str | None = Field(
+        default=None, description="planet run-out; a planet carries its crank's serial (runout)"
+    )
+    bearing_clearance: str | None = Field(
+        default=None, description="cam and carrier bearing clearances per crank"
+    )
 
     @field_validator(*_FILES)
     @classmethod
@@ -70,8 +82,12 @@ class LotFiles(StrictModel):
 
 
 class LotSection(StrictModel):
-    disc_sets: list[list[str]] = Field(min_length=1, max_length=2000)
-    crank_sets: list[list[str]] = Field(min_length=1, max_length=2000)
+    disc_sets: list[list[str]] = Field(
+        min_length=1, max_length=2000, description="serials of the N discs of each disc set"
+    )
+    crank_sets: list[list[str]] = Field(
+        min_length=1, max_length=2000, description="serials of the M cranks of each crank set"
+    )
     files: LotFiles
 
     @model_validator(mode="after")
@@ -93,15 +109,22 @@ class SelectiveAssemblySection(StrictModel):
     torque_Nm: float = Field(gt=0, le=1e6, description="output torque of the TE spec")
     positions: int = Field(default=360, ge=16, le=7200, description="output angles per rev")
     te_spec_arcsec: float = Field(gt=0, le=3600, description="total TE peak-to-peak spec")
-    objective: Literal["count_in_spec", "worst"] = "count_in_spec"
-    random_assemblies: int = Field(default=200, ge=100, le=100000)
-    seed: int = Field(default=1, ge=0)
+    objective: Literal["count_in_spec", "worst"] = Field(
+        default="count_in_spec",
+        description="most reducers in spec, or the smallest worst TE (docs/selective-assembly.md)",
+    )
+    random_assemblies: int = Field(
+        default=200, ge=100, le=100000, description="random assemblies of the comparison"
+    )
+    seed: int = Field(default=1, ge=0, description="seed of the random assemblies")
     verify: bool = Field(default=True, description="full-model check of the chosen reducers")
 
 
 class PinGradingSection(StrictModel):
     grades_um: list[float] = Field(min_length=1, max_length=50, description="diameter oversizes")
-    backlash_window_arcmin: tuple[float, float]
+    backlash_window_arcmin: tuple[float, float] = Field(
+        description="[lower, upper] backlash a graded reducer must meet"
+    )
 
     @model_validator(mode="after")
     def _window(self) -> PinGradingSection:
@@ -116,8 +139,12 @@ class PinGradingSection(StrictModel):
 
 
 class Analyses(StrictModel):
-    selective_assembly: SelectiveAssemblySection
-    pin_grading: PinGradingSection | None = None
+    selective_assembly: SelectiveAssemblySection = Field(
+        description="which parts form each reducer, in which orientation"
+    )
+    pin_grading: PinGradingSection | None = Field(
+        default=None, description="pin diameter grade per reducer for a backlash window"
+    )
 
 
 class Case(CaseBase):

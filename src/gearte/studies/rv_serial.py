@@ -65,14 +65,14 @@ _FILE_PARTS = {
 class FilesSection(StrictModel):
     """Measurement files (``docs/metrology.md``), relative to the case file."""
 
-    disc_profile: str | None = None
-    disc_pitch: str | None = None
-    disc_bores: str | None = None
-    crank_eccentricity: str | None = None
-    bearing_clearance: str | None = None
-    planet_runout: str | None = None
-    sun_runout: str | None = None
-    pins: str | None = None
+    disc_profile: str | None = Field(default=None, description="disc flank deviation per tooth")
+    disc_pitch: str | None = Field(default=None, description="disc cumulative pitch per tooth")
+    disc_bores: str | None = Field(default=None, description="crank-bore centres per disc")
+    crank_eccentricity: str | None = Field(default=None, description="cam eccentricity, phase")
+    bearing_clearance: str | None = Field(default=None, description="bearing clearances")
+    planet_runout: str | None = Field(default=None, description="planet run-out (format runout)")
+    sun_runout: str | None = Field(default=None, description="sun run-out (format runout)")
+    pins: str | None = Field(default=None, description="pin diameters and pin-slot positions")
 
     @field_validator(*_FILES)
     @classmethod
@@ -85,9 +85,9 @@ class SerialSection(StrictModel):
     discs: list[str] | None = Field(default=None, description="disc serials, disc 1 first")
     cranks: list[str] | None = Field(default=None, description="crank serials by position")
     planets: list[str] | None = Field(default=None, description="planet serials by position")
-    sun: str | None = None
+    sun: str | None = Field(default=None, description="sun serial")
     pins: str | None = Field(default=None, description="pin-ring serial")
-    files: FilesSection
+    files: FilesSection = Field(description="measurement files, relative to the case file")
 
     @model_validator(mode="after")
     def _files_and_parts(self) -> SerialSection:
@@ -109,9 +109,15 @@ class SerialSection(StrictModel):
 
 
 class Analyses(StrictModel):
-    load_sharing: rv.LoadSharingSection | None = None
-    transmission_error: rv.TESection | None = None
-    catalogue: rv.CatalogueSection | None = None
+    load_sharing: rv.LoadSharingSection | None = Field(
+        default=None, description="pin loads over one revolution (as rv_reducer)"
+    )
+    transmission_error: rv.TESection | None = Field(
+        default=None, description="loaded, geometric and elastic TE (as rv_reducer)"
+    )
+    catalogue: rv.CatalogueSection | None = Field(
+        default=None, description="lost motion, backlash, rigidity (as rv_reducer)"
+    )
 
 
 class Case(CaseBase):
