@@ -65,14 +65,30 @@ _FILE_PARTS = {
 class FilesSection(StrictModel):
     """Measurement files (``docs/metrology.md``), relative to the case file."""
 
-    disc_profile: str | None = Field(default=None, description="disc flank deviation per tooth")
-    disc_pitch: str | None = Field(default=None, description="disc cumulative pitch per tooth")
-    disc_bores: str | None = Field(default=None, description="crank-bore centres per disc")
-    crank_eccentricity: str | None = Field(default=None, description="cam eccentricity, phase")
-    bearing_clearance: str | None = Field(default=None, description="bearing clearances")
-    planet_runout: str | None = Field(default=None, description="planet run-out (format runout)")
-    sun_runout: str | None = Field(default=None, description="sun run-out (format runout)")
-    pins: str | None = Field(default=None, description="pin diameters and pin-slot positions")
+    disc_profile: str | None = Field(
+        None, description="Measurement file of the discs' profiles (docs/metrology.md)."
+    )
+    disc_pitch: str | None = Field(
+        None, description="Measurement file of the discs' cumulative pitch (docs/metrology.md)."
+    )
+    disc_bores: str | None = Field(
+        None, description="Measurement file of the discs' crank bores (docs/metrology.md)."
+    )
+    crank_eccentricity: str | None = Field(
+        None, description="Measurement file of the cranks' eccentricities (docs/metrology.md)."
+    )
+    bearing_clearance: str | None = Field(
+        None, description="Measurement file of the bearing clearances (docs/metrology.md)."
+    )
+    planet_runout: str | None = Field(
+        None, description="Measurement file of the planets' run-out (docs/metrology.md)."
+    )
+    sun_runout: str | None = Field(
+        None, description="Measurement file of the sun's run-out (docs/metrology.md)."
+    )
+    pins: str | None = Field(
+        None, description="Measurement file of the pin ring (docs/metrology.md)."
+    )
 
     @field_validator(*_FILES)
     @classmethod
@@ -85,9 +101,9 @@ class SerialSection(StrictModel):
     discs: list[str] | None = Field(default=None, description="disc serials, disc 1 first")
     cranks: list[str] | None = Field(default=None, description="crank serials by position")
     planets: list[str] | None = Field(default=None, description="planet serials by position")
-    sun: str | None = Field(default=None, description="sun serial")
+    sun: str | None = Field(None, description="Serial of the sun gear.")
     pins: str | None = Field(default=None, description="pin-ring serial")
-    files: FilesSection = Field(description="measurement files, relative to the case file")
+    files: FilesSection
 
     @model_validator(mode="after")
     def _files_and_parts(self) -> SerialSection:
@@ -110,13 +126,13 @@ class SerialSection(StrictModel):
 
 class Analyses(StrictModel):
     load_sharing: rv.LoadSharingSection | None = Field(
-        default=None, description="pin loads over one revolution (as rv_reducer)"
+        None, description="Pin load sharing of this serial (as rv_reducer's)."
     )
     transmission_error: rv.TESection | None = Field(
-        default=None, description="loaded, geometric and elastic TE (as rv_reducer)"
+        None, description="Loaded TE of this serial (as rv_reducer's)."
     )
     catalogue: rv.CatalogueSection | None = Field(
-        default=None, description="lost motion, backlash, rigidity (as rv_reducer)"
+        None, description="Virtual torsion test of this serial (as rv_reducer's)."
     )
 
 
