@@ -20,11 +20,12 @@ past the memory bound is not; and the input recorded in ``results.json`` must ke
 value's type (no coercion through ``run`` either).
 
 Measurement files are fuzzed too (``--files N``): the bundled bench files (TE traces, hysteresis
-curve, :mod:`gearte.io.bench`) and one file of each metrology format written from seeded parts
-(:mod:`gearte.io.metrology`), mutated line- and cell-wise (hostile cells, deleted, duplicated or
-swapped rows, ×50 blow-ups, renamed or re-united columns, hostile metadata, cut or corrupted
-bytes), read by their reader: a complete object with finite numbers, or one
-``BenchFileError``/``MeasurementFileError`` line naming the file; anything else is a crash.
+curve, :mod:`gearte.io.bench`), one file of each metrology format written from seeded parts and
+the bundled lot's metrology files (:mod:`gearte.io.metrology`), mutated line- and cell-wise
+(hostile cells, deleted, duplicated or swapped rows, ×50 blow-ups, renamed or re-united columns,
+hostile metadata, cut or corrupted bytes), read by their reader: a complete object with finite
+numbers, or one ``BenchFileError``/``MeasurementFileError`` line naming the file; anything else
+is a crash.
 
 Small runs are part of the test suite (``tests/test_fuzz_cases.py``, hypothesis-driven); the long
 job is ``make fuzz`` (``python tests/fuzzing.py --count 10000 --files 10000 --runs 300``), which
@@ -451,7 +452,29 @@ def measurement_corpus() -> dict[str, tuple[str, str]]:
             path = Path(d) / f"{fmt}.csv"
             write(path, data)
             files[fmt] = (fmt, path.read_text("utf-8"))
+    # the bundled lot's files (examples/lots/*/), cut to the parts of their first two serials
+    for path in sorted((case_path("synthetic_rv_bench").parent / "lots").glob("*/*.csv")):
+        text = path.read_text("utf-8")
+        fmt = re.search(r"^#\s*format:\s*(\w+)", text, re.M)
+        if fmt and fmt[1] in METROLOGY_READERS:
+            files[f"lot {path.parent.name}/{path.name}"] = (fmt[1], _first_serials(text, 2))
     return files
+
+
+def _first_serials(text: str, n: int) -> str:
+    """A metrology file with the rows of its first ``n`` serial numbers only."""
+    lines = text.splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln and not ln.startswith("#"))
+    serials: list[str] = []
+    kept = []
+    for ln in lines[head + 1 :]:
+        serial = ln.split(",", 1)[0]
+        if serial not in serials:
+            serials.append(serial)
+        if len(serials) > n:
+            break
+        kept.append(ln)
+    return "\n".join([*lines[: head + 1], *kept]) + "\n"
 
 
 def _thin(text: str, every: int) -> str:
