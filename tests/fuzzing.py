@@ -305,8 +305,9 @@ RUN_SAMPLES = 4
 RUN_BUDGETS = {"GEARTE_MAX_SECONDS": "20", "GEARTE_MAX_MEMORY_GB": "2"}
 
 
-class _Alarm(BaseException):
-    """The per-run alarm (a BaseException, so the CLI's last-resort handler does not take it)."""
+class _Alarm(KeyboardInterrupt):
+    """The per-run alarm: stops the run as Ctrl-C would (also inside a compiled kernel, where
+    CPython reports it as a SystemError caused by it); the run's exit is then a time-out."""
 
 
 def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
@@ -326,7 +327,10 @@ def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
     args = ["run", str(path), "--out", str(out), "--no-report", "--no-progress"]
     args += ["--samples", str(RUN_SAMPLES), "--workers", "1"]
 
+    fired = []
+
     def alarm(_signum: int, _frame: Any) -> None:
+        fired.append(True)
         raise _Alarm
 
     old_env = {k: os.environ.get(k) for k in RUN_BUDGETS}
@@ -357,6 +361,8 @@ def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
             else:
                 os.environ[k] = v
     last = (err.getvalue().strip().splitlines() or [""])[-1][:200]
+    if fired:
+        return Outcome("run_timeout", f"over {timeout_s} s (exit {code})")
     if code not in (0, 1, 2):
         return Outcome("run_bug", f"exit {code}: {err.getvalue()[-300:]}")
     if code == 0:
