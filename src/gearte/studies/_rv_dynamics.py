@@ -60,8 +60,12 @@ class ContactOptions(StrictModel):
 
 
 class ModalOptions(StrictModel):
-    speed_min_rpm: float = Field(100.0, gt=0, le=2e4)
-    speed_max_rpm: float = Field(3000.0, gt=0, le=2e4)
+    speed_min_rpm: float = Field(
+        100.0, gt=0, le=2e4, description="Lowest input speed of the Campbell diagram [rpm]."
+    )
+    speed_max_rpm: float = Field(
+        3000.0, gt=0, le=2e4, description="Highest input speed of the Campbell diagram [rpm]."
+    )
     resonance_margin: float = Field(0.1, gt=0, lt=1, description="relative band around a mode")
 
     @model_validator(mode="after")
@@ -74,7 +78,9 @@ class ModalOptions(StrictModel):
 class DTEOptions(StrictModel):
     duration_s: float = Field(0.5, gt=0, le=60, description="simulated time after settling [s]")
     settle_s: float = Field(0.1, ge=0, le=10, description="settling time from static equilibrium")
-    method: Literal["rk4", "dopri5", "scipy"] = "rk4"
+    method: Literal["rk4", "dopri5", "scipy"] = Field(
+        "rk4", description="Integrator: fixed-step RK4, adaptive DOPRI5, or scipy's solve_ivp."
+    )
     step_fraction: float = Field(0.85, gt=0, le=1, description="RK4 step / stability limit")
     record_dt_s: float = Field(1e-4, gt=0, le=0.1, description="recording interval [s]")
 
@@ -82,11 +88,15 @@ class DTEOptions(StrictModel):
 class SpeedSweepOptions(StrictModel):
     """DTE peak-to-peak over a range of input speeds (resonances of the mesh excitation)."""
 
-    speed_min_rpm: float = Field(300.0, gt=0, le=2e4)
-    speed_max_rpm: float = Field(3000.0, gt=0, le=2e4)
-    count: int = Field(19, ge=2, le=500)
+    speed_min_rpm: float = Field(
+        300.0, gt=0, le=2e4, description="Lowest input speed of the sweep [rpm]."
+    )
+    speed_max_rpm: float = Field(
+        3000.0, gt=0, le=2e4, description="Highest input speed of the sweep [rpm]."
+    )
+    count: int = Field(19, ge=2, le=500, description="Input speeds in the sweep [-].")
     duration_s: float = Field(0.1, gt=0, le=10, description="simulated time per speed [s]")
-    settle_s: float = Field(0.1, ge=0, le=10)
+    settle_s: float = Field(0.1, ge=0, le=10, description="Settling time at each speed [s].")
 
     @model_validator(mode="after")
     def _order(self):
@@ -96,11 +106,17 @@ class SpeedSweepOptions(StrictModel):
 
 
 class BatchOptions(StrictModel):
-    samples: int = Field(16, ge=1, le=100000)
-    duration_s: float = Field(0.5, gt=0, le=60)
-    settle_s: float = Field(0.1, ge=0, le=10)
-    seed: int = Field(0, ge=0)
-    chunk_size: int = Field(4, ge=1, le=10000)
+    samples: int = Field(
+        16, ge=1, le=100000, description="Random error realisations simulated [-]."
+    )
+    duration_s: float = Field(
+        0.5, gt=0, le=60, description="Simulated time per realisation after settling [s]."
+    )
+    settle_s: float = Field(0.1, ge=0, le=10, description="Settling time before recording [s].")
+    seed: int = Field(0, ge=0, description="Seed of the random realisations.")
+    chunk_size: int = Field(
+        4, ge=1, le=10000, description="Realisations per chunk of the execution layer."
+    )
     tolerance_scale: float = Field(1.0, gt=0, le=10, description="× Table 3 amplitudes")
 
 
