@@ -207,7 +207,9 @@ def test_bad_parameters():
 
 def test_paper_stiffness_puts_first_mode_near_cycloid_mesh():
     """With the paper's printed k_cr = 2.62e8 N/m and β = 3.8° the output's torsional mode
-    falls near the cycloid mesh frequency (322 Hz at 1500 rpm): the model must warn."""
+    falls near the cycloid mesh frequency (322.3 Hz at 1500 rpm): the model must warn. The paper
+    prints no natural frequency; gearte's first elastic mode is 337.857 Hz, 4.8 % above the mesh
+    frequency (docs/validation/li2023.md); 1e-5 relative (an eigenvalue of fixed matrices)."""
     m = RVDynamicModel(
         li2023_parameters(
             modified=True,
@@ -217,16 +219,17 @@ def test_paper_stiffness_puts_first_mode_near_cycloid_mesh():
         )
     )
     assert m.cycloid_fourier[0] == pytest.approx(2.62e5)
-    assert 300.0 < m.modal().frequencies[0] < 360.0
+    assert m.modal().frequencies[0] == pytest.approx(337.857, rel=1e-5)
     assert any("cycloid mesh" in w for w in m.resonance_warnings(0.1))
 
 
 def _li2023_reducer(errors=None):
+    from gearte.geometry.planetary import SunPlanets
     from gearte.geometry.rv import Cranks, Discs, FirstStage, PinRing, RVReducer, Supports
 
     eps = 1.556394  # contact ratio of 12/36, m = 1.5, α = 20° (checked below)
     return RVReducer(
-        first_stage=FirstStage(12, 36, 1.5, np.deg2rad(20.0), 1.4e5 * eps, 4.68e4),
+        first_stage=FirstStage(SunPlanets(12, 36, 1.5, np.deg2rad(20.0)), 1.4e5 * eps, 4.68e4),
         cranks=Cranks(3, 36.0, 1.3, 2.84e5, 5.76e5),
         discs=Discs(2, 12.0, -0.01, -0.05, 2.06e5, 0.3),
         pins=PinRing(40, 3.0, 85.8),

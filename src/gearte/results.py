@@ -2,23 +2,49 @@
 
 Names of values carry their unit in brackets (``"max_contact_force [N]"``); dimensionless names
 have none (``"K1"``). Arrays become lists in JSON; non-finite numbers become ``null``.
+
+In Jupyter both result objects show a summary table (``_repr_html_``), give pandas tables
+(``to_pandas()``, extra ``gearte[notebooks]``) and matplotlib figures (``plot()``). That display
+belongs to the report layer, above this one (docs/architecture.md, "Layers"): it is found by
+name, :data:`DISPLAY_MODULE`, imported when first asked for (as ``gearte.io.kinds`` finds the
+study kinds), so this module imports nothing above it.
 """
 
 from __future__ import annotations
 
+import importlib
 import json
 import math
 import time
 from dataclasses import dataclass, field
+from types import ModuleType
 from typing import Any
 
 import numpy as np
 
-__all__ = ["AnalysisResult", "StudyResult", "to_jsonable"]
+__all__ = ["AnalysisResult", "StudyResult", "to_jsonable", "DISPLAY_MODULE"]
+
+DISPLAY_MODULE = "gearte.report.notebook"
+"""The module that displays results in notebooks (HTML summary, pandas tables, figures)."""
+
+
+def _display() -> ModuleType:
+    return importlib.import_module(DISPLAY_MODULE)
 
 
 def to_jsonable(obj: Any) -> Any:
-    """Convert numpy scalars/arrays, tuples and nested mappings to plain JSON types."""
+    """Convert numpy scalars/arrays, tuples and nested mappings to plain JSON types.
+
+    Parameters
+    ----------
+    obj : Any
+        A result value: numbers, numpy scalars or arrays, sequences, mappings.
+
+    Returns
+    -------
+    Any
+        The same structure in plain JSON types (NaN/inf as ``None``).
+    """
     if isinstance(obj, dict):
         return {str(k): to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
@@ -81,6 +107,9 @@ class AnalysisResult:
     created : float
         ``time.perf_counter()`` when the result was made; :func:`gearte.studies.run_case` times
         each analysis as the interval since the previous one's result (or the run's start).
+    study : StudyResult or None
+        The study result holding this analysis (set by :class:`StudyResult`); :meth:`plot`
+        needs it, since figures are drawn from the whole study.
     """
 
     name: str
@@ -91,9 +120,50 @@ class AnalysisResult:
     data: dict[str, Any] = field(default_factory=dict, repr=False)
     files: dict[str, str] = field(default_factory=dict, repr=False)
     created: float = field(default_factory=time.perf_counter, repr=False, compare=False)
+    study: Any = field(default=None, repr=False, compare=False)
 
     def __getitem__(self, key: str) -> Any:
         return self.values[key]
+
+    def _repr_html_(self) -> str:
+        """Jupyter's view: the analysis's headline rows and results table."""
+        return str(_display().analysis_html(self))
+
+    def to_pandas(self, key: str | None = None) -> Any:
+        """The analysis as a pandas DataFrame (needs the extra ``gearte[notebooks]``).
+
+        Parameters
+        ----------
+        key : str, optional
+            ``None``: every scalar value (columns ``quantity``, ``unit``, ``value``). A value's
+            name with or without its unit (``"te"`` or ``"te [arcmin]"``): that value as a table
+            (records one row each, a mapping one row per item, a 1-D series one column beside
+            the other series of its length, a 2-D array one column per row).
+
+        Raises
+        ------
+        KeyError
+            When ``key`` names no value of the analysis (the message lists them).
+        ImportError
+            When pandas is not installed (the message names the extra).
+        """
+        return _display().analysis_frame(self, key)
+
+    def plot(self) -> list[Any]:
+        """The report's figures of this analysis, as matplotlib figures (none shown; in Jupyter
+        ``display(fig)`` or leave one as a cell's last value).
+
+        Raises
+        ------
+        ValueError
+            When the analysis belongs to no :class:`StudyResult` (figures need the study).
+        """
+        if self.study is None:
+            raise ValueError(
+                f"analysis {self.name!r} belongs to no StudyResult; plot it with "
+                f"study_result.plot({self.name!r})"
+            )
+        return list(_display().study_figures(self.study, self.name))
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -120,10 +190,21 @@ class StudyResult:
     warnings: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
     timings: dict[str, float] = field(default_factory=dict)
+    #: True when the run was stopped and sampled analyses used only their finished chunks
+    #: (``"partial": true`` in ``results.json``; the first warning says what was cut).
+    partial: bool = False
+
+    def __post_init__(self) -> None:
+        self._link()
+
+    def _link(self) -> None:
+        for a in self.analyses:
+            a.study = self
 
     def __getitem__(self, name: str) -> AnalysisResult:
         for a in self.analyses:
             if a.name == name:
+                a.study = self
                 return a
         raise KeyError(f"no analysis {name!r}; have {[a.name for a in self.analyses]}")
 
@@ -159,6 +240,7 @@ class StudyResult:
             },
             "references": {k: REFERENCES.get(k, k) for k in self.references},
             "warnings": list(self.warnings) + self._nonfinite_warnings(),
+            **({"partial": True} if self.partial else {}),
             "elapsed [s]": round(self.elapsed_s, 4),
             "timings [s]": {k: round(v, 4) for k, v in self.timings.items()},
             "analyses": {a.name: a.to_dict() for a in self.analyses},
@@ -176,6 +258,35 @@ class StudyResult:
                     f"{a.name}: {n} non-finite value(s) (NaN/inf) written as null in {shown}"
                 )
         return out
+
+    def _repr_html_(self) -> str:
+        """Jupyter's view: the report's summary block (headlines, spec checks, warnings)."""
+        return str(_display().study_html(self))
+
+    def to_pandas(self) -> Any:
+        """Every scalar value of every analysis as a pandas DataFrame with the columns
+        ``analysis``, ``quantity``, ``unit``, ``value`` (the rows of ``summary.csv``); one
+        analysis's series and tables: ``result[name].to_pandas(key)``. Needs the extra
+        ``gearte[notebooks]``.
+
+        Raises
+        ------
+        ImportError
+            When pandas is not installed (the message names the extra).
+        """
+        return _display().study_frame(self)
+
+    def plot(self, analysis: str | None = None) -> list[Any]:
+        """The report's figures as matplotlib figures: all of them, or those of the analysis
+        named ``analysis``. Nothing is shown (no pyplot); in Jupyter ``display(fig)``.
+
+        Raises
+        ------
+        KeyError
+            When ``analysis`` names no analysis of this result.
+        """
+        self._link()
+        return list(_display().study_figures(self, analysis))
 
     def to_json(self, indent: int | None = 1) -> str:
         return json.dumps(self.to_dict(), indent=indent, ensure_ascii=False, allow_nan=False)

@@ -58,6 +58,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gearte.errors import ParameterError
+from gearte.geometry.planetary import SunPlanets
 from gearte.units import um_to_mm
 
 __all__ = [
@@ -72,6 +73,8 @@ __all__ = [
     "MassProperties",
     "mass_properties",
     "RVReducer",
+    "PinContacts",
+    "pin_contacts",
     "palmgren_radial_stiffness",
     "iso6336_mesh_stiffness",
 ]
@@ -131,6 +134,22 @@ def iso6336_mesh_stiffness(face_width: float, c_gamma: float = 20.0) -> float:
     """Mean involute mesh stiffness [N/mm] = ``c_gamma`` [N/(mm·µm)] × face width [mm] × 1000.
 
     ISO 6336-1:2019, 9.3 gives ``c_gamma ≈ 20 N/(mm·µm)`` for solid steel spur gears.
+
+    Parameters
+    ----------
+    face_width : float
+        Face width of the mesh [mm].
+    c_gamma : float
+        Mesh stiffness per face width [N/(mm·µm)].
+
+    Returns
+    -------
+    float
+        Mean mesh stiffness [N/mm].
+
+    References
+    ----------
+    ISO 6336-1:2019, clause 9.3.
     """
     if face_width <= 0:
         raise ParameterError("face_width", face_width, "must be > 0 mm")
@@ -139,16 +158,16 @@ def iso6336_mesh_stiffness(face_width: float, c_gamma: float = 20.0) -> float:
 
 @dataclass(frozen=True)
 class FirstStage:
-    """Involute first stage: sun (input) and ``M`` planets, each fixed to a crankshaft.
+    """Involute first stage: sun (input) and ``M`` planets, each fixed to a crankshaft; no ring.
+
+    Its gears are the gear set of the ``planetary`` kind without a ring
+    (:class:`gearte.geometry.planetary.SunPlanets`: the same class, the same validation).
 
     Attributes
     ----------
-    sun_teeth, planet_teeth : int
-        ``z_1``, ``z_2``.
-    module : float
-        Normal module [mm].
-    pressure_angle : float
-        Standard pressure angle [rad].
+    gears : SunPlanets
+        Sun and planets: tooth numbers ``z_1``, ``z_2``, module [mm], standard pressure angle
+        [rad], number of planets (= cranks), planet position angles.
     mesh_stiffness : float
         Sun–planet mesh stiffness along the line of action [N/mm].
     sun_support_stiffness : float
@@ -157,21 +176,15 @@ class FirstStage:
         Face width of the sun and planets [mm] (needed only to derive their masses).
     """
 
-    sun_teeth: int
-    planet_teeth: int
-    module: float
-    pressure_angle: float
+    gears: SunPlanets
     mesh_stiffness: float
     sun_support_stiffness: float
     face_width: float | None = None
 
     def __post_init__(self) -> None:
-        _check_int("first_stage.sun_teeth", self.sun_teeth, 6)
-        _check_int("first_stage.planet_teeth", self.planet_teeth, 6)
-        _check_pos("first_stage.module", self.module)
-        if not 0 < self.pressure_angle < np.pi / 4:
+        if self.gears.z_ring is not None:
             raise ParameterError(
-                "first_stage.pressure_angle", self.pressure_angle, "must be in (0, pi/4) rad"
+                "first_stage.ring", self.gears.z_ring, "an RV first stage has no ring"
             )
         _check_pos("first_stage.mesh_stiffness", self.mesh_stiffness)
         _check_pos("first_stage.sun_support_stiffness", self.sun_support_stiffness)
@@ -179,10 +192,29 @@ class FirstStage:
             _check_pos("first_stage.face_width", self.face_width)
 
     @property
+    def sun_teeth(self) -> int:
+        """``z_1`` [-]."""
+        return self.gears.z_sun
+
+    @property
+    def planet_teeth(self) -> int:
+        """``z_2`` [-]."""
+        return self.gears.z_planet
+
+    @property
+    def module(self) -> float:
+        """Module [mm]."""
+        return self.gears.module
+
+    @property
+    def pressure_angle(self) -> float:
+        """Standard pressure angle [rad]."""
+        return self.gears.pressure_angle
+
+    @property
     def base_radii(self) -> tuple[float, float]:
         """Base radii of sun and planet [mm]."""
-        c = np.cos(self.pressure_angle) * self.module / 2.0
-        return float(self.sun_teeth * c), float(self.planet_teeth * c)
+        return self.gears.base_radius("sun"), self.gears.base_radius("planet")
 
 
 @dataclass(frozen=True)
@@ -442,6 +474,12 @@ class ManufacturingErrors:
     disc_modification : numpy.ndarray
         ``(N, 2)`` errors of disc ``j``'s equidistant and shifted modifications
         ``(δΔr_rp, δΔr_p)`` [mm] (Hu 2020 Table 2 rows f, g per disc), added to the nominal ones.
+    measured_discs : tuple or None
+        Per disc, a :class:`gearte.geometry.measured.MeasuredDisc` (measured flank deviation per
+        tooth and cumulative pitch per tooth, issue 16) or None; None: no measured disc.
+    cam_clearance, carrier_clearance : numpy.ndarray or None
+        Measured radial clearances [mm] of each cam bearing ``(M, N)`` and each crank's carrier
+        bearing ``(M,)``, replacing the ``Cranks`` values; None: those of ``Cranks``.
     """
 
     planet: np.ndarray
@@ -454,6 +492,9 @@ class ManufacturingErrors:
     disc_runout: np.ndarray = field(default_factory=_empty_per_disc)
     disc_pitch: np.ndarray = field(default_factory=_empty_per_disc)
     disc_modification: np.ndarray = field(default_factory=_empty_per_disc)
+    measured_discs: tuple | None = None
+    cam_clearance: np.ndarray | None = None
+    carrier_clearance: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = self.disc_bore.shape[0]
@@ -512,6 +553,8 @@ class ManufacturingErrors:
                 raise ParameterError(f, key, "error given twice for the same part and index")
             seen.add(key)
             vec = e.value * np.array([np.cos(e.angle), np.sin(e.angle)])
+            ci = -1 if e.crank is None else e.crank - 1  # checked above where required
+            dj = -1 if e.disc is None else e.disc - 1
             if e.part == "sun_eccentricity":
                 out.sun[:] = vec
             elif e.part == "sun_assembly":
@@ -519,17 +562,17 @@ class ManufacturingErrors:
             elif e.part == "output_assembly":
                 out.output_seat[:] = vec
             elif e.part == "disc_radial_runout":
-                out.disc_runout[e.disc - 1] = vec
+                out.disc_runout[dj] = vec
             elif e.part == "disc_cumulative_pitch":
-                out.disc_pitch[e.disc - 1] = vec
+                out.disc_pitch[dj] = vec
             elif e.part == "planet_eccentricity":
-                out.planet[e.crank - 1] = vec
+                out.planet[ci] = vec
             elif e.part == "carrier_crank_bore":
-                out.carrier_bore[e.crank - 1] = vec
+                out.carrier_bore[ci] = vec
             elif e.part == "disc_crank_bore":
-                out.disc_bore[e.disc - 1, e.crank - 1] = vec
+                out.disc_bore[dj, ci] = vec
             else:
-                out.cam[e.crank - 1, e.disc - 1] = vec
+                out.cam[ci, dj] = vec
         return out
 
     def scaled(self, factor: float) -> ManufacturingErrors:
@@ -545,6 +588,11 @@ class ManufacturingErrors:
             self.disc_runout * factor,
             self.disc_pitch * factor,
             self.disc_modification * factor,
+            None
+            if self.measured_discs is None
+            else tuple(None if m is None else m.scaled(factor) for m in self.measured_discs),
+            self.cam_clearance,
+            self.carrier_clearance,
         )
 
     def with_disc_modification(self, errors: np.ndarray) -> ManufacturingErrors:
@@ -582,7 +630,8 @@ class RVReducer:
     rated_torque : float or None
         Rated output torque [N·mm] (catalogue value; needed by the virtual torsion test only).
     planets : int, optional
-        Number of planets of the first stage; must equal ``cranks.count`` (default: equal).
+        Number of planets of the first stage; must equal ``cranks.count`` (default: that of
+        ``first_stage.gears``).
 
     Raises
     ------
@@ -602,7 +651,13 @@ class RVReducer:
     errors: ManufacturingErrors | None = None
 
     def __post_init__(self) -> None:
-        planets = self.cranks.count if self.planets is None else self.planets
+        planets = self.first_stage.gears.n_planets if self.planets is None else self.planets
+        if planets != self.first_stage.gears.n_planets:
+            raise ParameterError(
+                "first_stage.planets",
+                planets,
+                f"must equal the gear set's n_planets = {self.first_stage.gears.n_planets}",
+            )
         if planets != self.cranks.count:
             raise ParameterError(
                 "first_stage.planets",
@@ -699,18 +754,127 @@ class RVReducer:
 
     def replace(self, **changes) -> RVReducer:
         """Copy with some of the sections replaced (``discs=..., pins=...``)."""
-        kw = dict(
-            first_stage=self.first_stage,
-            cranks=self.cranks,
-            discs=self.discs,
-            pins=self.pins,
-            supports=self.supports,
-            rated_torque=self.rated_torque,
-            planets=self.planets,
-            errors=self.errors,
+        return dataclasses.replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class PinContacts:
+    """Geometry and initial clearance of every pin contact of every disc at output angles.
+
+    Attributes (shape ``(P, N, z_p)`` over output angles, discs and pins, plus a trailing 2 for
+    vectors)
+    ----------
+    theta : numpy.ndarray
+        Output (carrier) angles [rad], ``(P,)``.
+    normal : numpy.ndarray
+        Unit contact normal ``n`` (from the pitch point towards the pin centre), ground frame.
+    lever : numpy.ndarray
+        Contact point − disc centre [mm].
+    arm : numpy.ndarray
+        ``lever × n`` [mm]: the moment arm of the normal about the disc centre (the rotation
+        column of the contact row; negative on the flank that carries the output torque).
+    phase : numpy.ndarray
+        Meshing phase ``φ = α_k − χ_j`` of pin ``k`` on disc ``j`` [rad].
+    gap : numpy.ndarray
+        Initial normal clearance [mm] at the nominal positions: the eq-32 clearance of the
+        disc's modified profile (nominal modifications + that disc's modification errors),
+        minus the pin-radius error, plus the pin-centre error on the normal, minus the disc's
+        radial run-out on the normal, minus the arm × the local rotation of the cumulative
+        pitch deviation, plus the change a measured disc causes
+        (:meth:`gearte.geometry.measured.MeasuredDisc.gap_change`).
+    """
+
+    theta: np.ndarray
+    normal: np.ndarray
+    lever: np.ndarray
+    arm: np.ndarray
+    phase: np.ndarray
+    gap: np.ndarray
+
+
+def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
+    """Contact normals, arms and initial clearances of all pins of all discs (every error family).
+
+    The one computation of the pin clearances that the quasi-static model
+    (:func:`gearte.models.rv_load_sharing.assemble`) and the dynamics
+    (:func:`gearte.models.rv_dynamics.disc_rotation_error`) read.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The description with its errors (per-pin radius and position, disc run-out and
+        cumulative pitch, per-disc modification errors).
+    theta : numpy.ndarray
+        Output angles [rad], ``(P,)``.
+
+    Returns
+    -------
+    PinContacts
+
+    Notes
+    -----
+    Disc ``j``'s eccentric points along ``χ_j = −z_c θ + 2π j / N`` (module conventions); its
+    pitch point is ``P_j = a z_p ê(χ_j)``; the normal of pin ``k`` (centre ``p_k`` at
+    ``α_k = 2π k / z_p``) passes through ``P_j`` and ``p_k`` (Hu 2020 eq 36), the contact point
+    lies ``r_rp`` inside the pin centre on it. The clearance of the modified profile is Hu 2020
+    eq 32 (:func:`gearte.geometry.cycloid.normal_clearance_unclosed`). Disc errors are in the
+    disc frame, which turns with the carrier (angle ``θ``): the run-out ``r`` translates the
+    profile (gap ``−n·r``); the cumulative pitch deviation ``s(ψ) = ΔF_p/2 sin(ψ − angle)`` at
+    the contact's disc-frame angle ``ψ`` turns the flank locally by ``s / r_c`` (gap
+    ``−arm · s / r_c``).
+
+    References
+    ----------
+    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481, eq 32, 36.
+    doi:10.3390/app10020481
+    """
+    from gearte.geometry.cycloid import normal_clearance_unclosed
+
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    P = th.size
+    N = reducer.discs.count
+    pins, err = reducer.pins, reducer.error_set
+    zp, zc = pins.count, reducer.cycloid_teeth
+    a = reducer.cranks.eccentricity
+    alpha_k = 2.0 * np.pi * np.arange(zp) / zp
+    pin_dir = np.stack([np.cos(alpha_k), np.sin(alpha_k)], -1)  # (zp, 2)
+    pin_pos = pins.circle_radius * pin_dir
+    pin_err = pins.radial_position_errors[:, None] * pin_dir + pins.tangential_position_errors[
+        :, None
+    ] * np.stack([-pin_dir[:, 1], pin_dir[:, 0]], -1)
+    ecc = -zc * th[:, None] + 2.0 * np.pi * np.arange(N)[None, :] / N  # (P, N)
+    cdir = np.stack([np.cos(ecc), np.sin(ecc)], -1)  # (P, N, 2)
+    v = pin_pos[None, None] - (a * zp * cdir)[:, :, None, :]  # (P, N, zp, 2)
+    n = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    lever = pin_pos[None, None] - pins.pin_radius * n - (a * cdir)[:, :, None, :]
+    arm = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
+    phi = alpha_k[None, None, :] - ecc[:, :, None]
+    gap = np.empty((P, N, zp))
+    c, s_ = np.cos(th), np.sin(th)
+    for j in range(N):
+        d_rp, d_p = err.disc_modification[j]
+        g = normal_clearance_unclosed(
+            phi[:, j],
+            z_p=zp,
+            r_p=pins.circle_radius,
+            a=a,
+            dr_rp=reducer.discs.equidistant_modification + d_rp,
+            dr_p=reducer.discs.shift_modification + d_p,
         )
-        kw.update(changes)
-        return RVReducer(**kw)
+        g = g - pins.radius_errors[None, :] + np.sum(n[:, j] * pin_err[None], axis=-1)
+        rx, ry = err.disc_runout[j]
+        runout = np.stack([rx * c - ry * s_, rx * s_ + ry * c], -1)  # disc frame -> ground
+        g = g - np.sum(n[:, j] * runout[:, None, :], axis=-1)
+        fp = float(np.hypot(*err.disc_pitch[j]))
+        if fp > 0.0:
+            psi = np.arctan2(lever[:, j, :, 1], lever[:, j, :, 0]) - th[:, None]
+            ang = np.arctan2(err.disc_pitch[j, 1], err.disc_pitch[j, 0])
+            g = g - arm[:, j] * 0.5 * fp * np.sin(psi - ang) / (a * zc)
+        measured = None if err.measured_discs is None else err.measured_discs[j]
+        if measured is not None:  # measured flank per tooth and pitch per tooth (issue 16)
+            g = g + measured.gap_change(np.arange(zp)[None, :], phi[:, j], arm[:, j], a * zc)
+        gap[:, j] = g
+    return PinContacts(th, n, lever, arm, phi, gap)
 
 
 @dataclass(frozen=True)
@@ -794,23 +958,23 @@ def mass_properties(
         reducer.supports,
     )
 
-    def cyl(radius: float, length: float) -> tuple[float, float]:
-        v = np.pi * radius**2 * length * 1e-9  # mm^3 -> m^3
-        m = float(density) * v
-        return m, 0.5 * m * (radius * 1e-3) ** 2
+    def envelope(body: str, dims: tuple[float, ...], rho: float) -> tuple[float, float]:
+        """Mass [kg] and inertia [kg·m²] of ``body`` from its envelope ``dims`` [mm]."""
 
-    def envelope(body: str) -> tuple[float, float]:
+        def cyl(radius: float, length: float) -> tuple[float, float]:
+            v = np.pi * radius**2 * length * 1e-9  # mm^3 -> m^3
+            m = rho * v
+            return m, 0.5 * m * (radius * 1e-3) ** 2
+
         if body in ("sun", "planet"):
             z = fs.sun_teeth if body == "sun" else fs.planet_teeth
-            return cyl(fs.module * z / 2.0, fs.face_width)
-        if body == "crank":
-            return cyl(cr.shaft_diameter / 2.0, cr.shaft_length)
-        if body == "output":
-            return cyl(sup.carrier_outer_diameter / 2.0, sup.carrier_length)
+            return cyl(fs.module * z / 2.0, dims[0])
+        if body in ("crank", "output"):
+            return cyl(dims[0] / 2.0, dims[1])
         r_out = pins.circle_radius + di.shift_modification - pins.pin_radius
         r_out -= di.equidistant_modification
         m, j = cyl(r_out, di.face_width)
-        rb = di.crank_bore_diameter / 2.0
+        rb = dims[0] / 2.0
         mb, jb = cyl(rb, di.face_width)
         m -= cr.count * mb
         j -= cr.count * (jb + mb * (cr.circle_radius * 1e-3) ** 2)
@@ -826,15 +990,18 @@ def mass_properties(
         "disc": (di.crank_bore_diameter,),
         "output": (sup.carrier_outer_diameter, sup.carrier_length),
     }
-    mass, inertia, derived = {}, {}, []
+    mass: dict[str, float] = {}
+    inertia: dict[str, float] = {}
+    derived: list[str] = []
     for body, keys in _MASS_INPUTS.items():
         if body in given_mass and body in given_inertia:
             mass[body], inertia[body] = float(given_mass[body]), float(given_inertia[body])
             continue
-        missing = [k for k, v in zip(keys, values[body], strict=True) if v is None]
-        if density is None:
-            missing.insert(0, "density_kg_per_m3 (or material)")
-        if missing:
+        dims = tuple(v for v in values[body] if v is not None)
+        if density is None or len(dims) < len(keys):
+            missing = [k for k, v in zip(keys, values[body], strict=True) if v is None]
+            if density is None:
+                missing.insert(0, "density_kg_per_m3 (or material)")
             what = "mass" if body not in given_mass else "inertia"
             raise ParameterError(
                 "reducer." + missing[0].split(" ")[0],
@@ -842,7 +1009,7 @@ def mass_properties(
                 f"needed to derive the {body} {what} (or give {body}_mass_kg and "
                 f"{body}_inertia_kgm2 in [reducer.dynamics]); missing: {', '.join(missing)}",
             )
-        m, j = envelope(body)
+        m, j = envelope(body, dims, float(density))
         if m <= 0 or j <= 0:
             raise ParameterError(
                 "reducer." + keys[0], values[body][0], f"leaves no material in the {body}"

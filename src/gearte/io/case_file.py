@@ -137,8 +137,32 @@ def _fields_at(root: Any, loc: tuple[Any, ...]) -> set[str]:
     return {name for m in models for name in m.model_fields}
 
 
-def did_you_mean(key: str, known: set[str]) -> str:
-    """A hint for an unknown key: the field with another unit suffix, or a close spelling."""
+def _in_base_unit(unit: str) -> tuple[str, float] | None:
+    """``(dimension, size of one ``unit`` in the dimension's base unit)`` of a key suffix (mm, N·mm,
+    N, MPa, rad), or ``None`` for a suffix that is no known unit."""
+    from gearte import units as u
+
+    table: dict[str, tuple[str, float]] = {
+        "mm": ("length", 1.0),
+        "um": ("length", float(u.um_to_mm(1.0))),
+        "m": ("length", 1000.0),
+        "Nmm": ("torque", 1.0),
+        "Nm": ("torque", float(u.Nm_to_Nmm(1.0))),
+        "N": ("force", 1.0),
+        "kN": ("force", 1000.0),
+        "MPa": ("stress", 1.0),
+        "GPa": ("stress", 1000.0),
+        "rad": ("angle", 1.0),
+        "deg": ("angle", float(u.deg_to_rad(1.0))),
+        "arcmin": ("angle", float(u.arcmin_to_rad(1.0))),
+        "arcsec": ("angle", float(u.arcsec_to_rad(1.0))),
+    }
+    return table.get(unit)
+
+
+def did_you_mean(key: str, known: set[str], value: Any = None) -> str:
+    """A hint for an unknown key: the field with another unit suffix (with ``value``, a number,
+    converted to that unit), or a close spelling."""
     import difflib
 
     stem, _, unit = key.rpartition("_")
@@ -146,15 +170,34 @@ def did_you_mean(key: str, known: set[str]) -> str:
         same_stem = sorted(k for k in known if k.rpartition("_")[0] == stem and k != key)
         if same_stem:
             k = same_stem[0]
-            given = _UNITS.get(k.rpartition("_")[2], k.rpartition("_")[2])
-            return f"did you mean {k!r}? (this field is given in {given}, not {unit})"
+            target = k.rpartition("_")[2]
+            given = _UNITS.get(target, target)
+            hint = f"did you mean {k!r}? (this field is given in {given}, not {unit}"
+            a, b = _in_base_unit(unit), _in_base_unit(target)
+            number = isinstance(value, int | float) and not isinstance(value, bool)
+            if number and a is not None and b is not None and a[0] == b[0]:
+                hint += f": write {k} = {float(value) * a[1] / b[1]:.6g}"
+            return hint + ")"
     close = difflib.get_close_matches(key, sorted(known), n=1, cutoff=0.6)
     return f"did you mean {close[0]!r}?" if close else ""
 
 
 def format_validation_errors(exc: Any, root: Any = None) -> list[tuple[str, str]]:
     """Turn a pydantic ``ValidationError`` into ``(field, message)`` pairs, one per problem;
-    with ``root`` (the ``Case`` class), unknown keys get a "did you mean" hint."""
+    with ``root`` (the ``Case`` class), unknown keys get a "did you mean" hint.
+
+    Parameters
+    ----------
+    exc : pydantic.ValidationError
+        The validation error.
+    root : type, optional
+        The ``Case`` class the input was validated against (for "did you mean" hints).
+
+    Returns
+    -------
+    list of (str, str)
+        ``(dotted field, message)`` pairs.
+    """
     out: list[tuple[str, str]] = []
     for err in exc.errors(include_url=False):
         loc = ".".join(str(p) for p in _user_loc(root, tuple(err.get("loc", ())))) or "(case)"
@@ -169,7 +212,7 @@ def format_validation_errors(exc: Any, root: Any = None) -> list[tuple[str, str]
             msg = "unknown key (not allowed here; check spelling and section)"
             loc_t = _user_loc(root, tuple(err.get("loc", ())))
             if root is not None and loc_t:
-                hint = did_you_mean(str(loc_t[-1]), _fields_at(root, loc_t[:-1]))
+                hint = did_you_mean(str(loc_t[-1]), _fields_at(root, loc_t[:-1]), err.get("input"))
                 if hint:
                     msg = f"unknown key; {hint}"
         if "input" in err and kind not in ("missing",) and not isinstance(err["input"], dict):
@@ -231,10 +274,86 @@ def load_case_dict(
     module = get_kind(kind)
     if name is not None and "name" not in meta:
         data = {**data, "case": {**meta, "name": name}}
+    context = {"case_dir": base_dir}
     try:
-        return module.Case.model_validate(data, context={"case_dir": base_dir})
+        case = module.Case.model_validate(data, context=context)
     except ValidationError as exc:
-        raise CaseFileError(source, format_validation_errors(exc, module.Case)) from None
+        errors = format_validation_errors(exc, module.Case)
+        errors += _checks_beside_errors(module.Case, kind, data, context, exc)
+        raise CaseFileError(source, errors) from None
+    from gearte.io.plausibility import plausibility_problems
+
+    problems = plausibility_problems(kind, case)
+    if problems:
+        raise CaseFileError(source, problems)
+    return case
+
+
+class _NotValidated(Exception):
+    """A cross-field check used a section that did not validate (the check is skipped)."""
+
+
+class _Placeholder:
+    """Stands for a section that did not validate: any use of it stops the check using it."""
+
+    __slots__ = ("_key",)
+
+    def __init__(self, key: str) -> None:
+        object.__setattr__(self, "_key", key)
+
+    def __getattr__(self, name: str) -> Any:
+        raise _NotValidated(object.__getattribute__(self, "_key"))
+
+
+def _checks_beside_errors(
+    root: Any, kind: str, data: dict[str, Any], context: dict[str, Any], exc: Any
+) -> list[tuple[str, str]]:
+    """The case-level cross-field checks (``root``'s "after" model validators) and the
+    plausibility checks, run on the sections that did validate when others did not.
+
+    pydantic runs a model's after-validators only when all its fields are valid, so a
+    contradiction between sections (a rule that needs tolerances, an analysis that needs a
+    section) would be reported only after the field errors are fixed. Here each top-level section
+    is validated on its own; the sections with errors become placeholders, and a check that
+    touches a placeholder is skipped (it cannot be judged), every other check runs.
+    """
+    from pydantic import TypeAdapter, ValidationError
+
+    errs = exc.errors(include_url=False)
+    if any(not e.get("loc") for e in errs):  # the case-level checks ran (and failed)
+        return []
+    failed = {str(e["loc"][0]) for e in errs}
+    values: dict[str, Any] = {}
+    for name, info in root.model_fields.items():
+        key = info.alias or name
+        if key in failed or (key not in data and info.is_required()):
+            values[name] = _Placeholder(key)
+        elif key not in data:
+            values[name] = info.get_default(call_default_factory=True)
+        else:
+            try:
+                adapter: TypeAdapter[Any] = TypeAdapter(info.annotation)
+                values[name] = adapter.validate_python(data[key], context=context)
+            except (ValidationError, TypeError):
+                values[name] = _Placeholder(key)
+    case = root.model_construct(**values)
+    out: list[tuple[str, str]] = []
+    for dec in root.__pydantic_decorators__.model_validators.values():
+        if dec.info.mode != "after":
+            continue
+        try:
+            dec.func(case)
+        except (_NotValidated, TypeError, AttributeError):
+            continue
+        except (ValueError, AssertionError) as err:
+            out.append(("(case)", str(err)))
+    from gearte.io.plausibility import plausibility_problems
+
+    try:
+        out += plausibility_problems(kind, case)
+    except (_NotValidated, TypeError, AttributeError):
+        pass
+    return out
 
 
 def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:

@@ -114,6 +114,9 @@ class TermSet:
     reference_angle: str | None = None  # an angle held at 0: the assembly datum
     magnitudes: tuple[str, ...] = field(init=False)
     angles: tuple[str, ...] = field(init=False)
+    _arrays: dict[str, np.ndarray] | None = field(
+        default=None, init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         if not self.terms:
@@ -310,7 +313,11 @@ def frequency_basis(terms: TermSet) -> tuple[Fraction, tuple[int, ...], np.ndarr
 
 
 def _term_arrays(terms: TermSet) -> dict[str, np.ndarray]:
-    """Flat arrays describing the terms, for the vectorised / compiled evaluation."""
+    """Flat arrays describing the terms, for the vectorised / compiled evaluation; computed once
+    per :class:`TermSet` (the fraction arithmetic of :func:`frequency_basis` is slow) and kept on
+    it (callers must not write to them)."""
+    if terms._arrays is not None:
+        return terms._arrays
     _, harm, group = frequency_basis(terms)
     mag_idx = np.array([terms.magnitudes.index(t.magnitude) for t in terms.terms], dtype=np.int64)
     ang_idx = np.array(
@@ -321,7 +328,7 @@ def _term_arrays(terms: TermSet) -> dict[str, np.ndarray]:
     gain = np.array([t.gain for t in terms.terms], dtype=np.float64)
     phase = np.array([t.phase for t in terms.terms], dtype=np.float64)
     fsign = np.array([np.sign(float(t.frequency)) for t in terms.terms], dtype=np.float64)
-    return {
+    arr = {
         "harmonics": np.asarray(harm, dtype=np.int64),
         "group": group,
         "mag_idx": mag_idx,
@@ -331,6 +338,8 @@ def _term_arrays(terms: TermSet) -> dict[str, np.ndarray]:
         "phase": phase,
         "fsign": fsign,
     }
+    object.__setattr__(terms, "_arrays", arr)
+    return arr
 
 
 def group_phasors(
@@ -391,11 +400,51 @@ def group_phasors(
 
 # --------------------------------------------------------------------------- sample kernel
 @njit(cache=True, nogil=True)
+def _row_phasors(mags, i, sa, ca, o, gain, mag_idx, ang_idx, coeff, c0, s0, fsign, group, zr, zi):
+    """Constant part c (returned) and group phasors (zr, zi, filled) of sample i, from the
+    sines/cosines ``sa[o + v], ca[o + v]`` of its angles and the terms' phase tables c0, s0."""
+    c = 0.0
+    for g in range(zr.shape[0]):
+        zr[g] = 0.0
+        zi[g] = 0.0
+    for k in range(gain.shape[0]):
+        a = gain[k] * mags[i, mag_idx[k]]
+        v = ang_idx[k]
+        if v >= 0:  # phase + coeff * theta, coeff = ±1
+            cp = c0[k] * ca[o + v] - coeff[k] * s0[k] * sa[o + v]
+            sp = s0[k] * ca[o + v] + coeff[k] * c0[k] * sa[o + v]
+        else:
+            cp = c0[k]
+            sp = s0[k]
+        gi = group[k]
+        if gi < 0:
+            c += a * sp
+        elif fsign[k] > 0:
+            zr[gi] += a * cp
+            zi[gi] += a * sp
+        else:
+            zr[gi] -= a * cp
+            zi[gi] += a * sp
+    return c
+
+
+@njit(cache=True, nogil=True)
+def _phase_tables(phase):
+    """cos and sin of the terms' constant phases."""
+    K = phase.shape[0]
+    c0 = np.empty(K)
+    s0 = np.empty(K)
+    for k in range(K):
+        c0[k] = math.cos(phase[k])
+        s0[k] = math.sin(phase[k])
+    return c0, s0
+
+
+@njit(cache=True, nogil=True)
 def _sample_kernel(mags, angs, gain, mag_idx, ang_idx, coeff, phase, fsign, group, nh, M):
     """Phasor sums and exact extremes for each sample (row) of magnitudes and angles."""
     n = mags.shape[0]
     G = nh.shape[0]
-    K = gain.shape[0]
     V = angs.shape[1]
     tab = node_tables(nh, M)
     buf = np.empty(M)
@@ -408,37 +457,13 @@ def _sample_kernel(mags, angs, gain, mag_idx, ang_idx, coeff, phase, fsign, grou
     sa = np.empty(n * V)
     ca = np.empty(n * V)
     sincos_into(flat, sa, ca)
-    c0 = np.empty(K)
-    s0 = np.empty(K)
-    for k in range(K):
-        c0[k] = math.cos(phase[k])
-        s0[k] = math.sin(phase[k])
+    c0, s0 = _phase_tables(phase)
     fmax = np.empty(n)
     fmin = np.empty(n)
     for i in range(n):
-        o = i * V
-        c = 0.0
-        for g in range(G):
-            zr[g] = 0.0
-            zi[g] = 0.0
-        for k in range(K):
-            a = gain[k] * mags[i, mag_idx[k]]
-            v = ang_idx[k]
-            if v >= 0:  # phase + coeff * theta, coeff = ±1
-                cp = c0[k] * ca[o + v] - coeff[k] * s0[k] * sa[o + v]
-                sp = s0[k] * ca[o + v] + coeff[k] * c0[k] * sa[o + v]
-            else:
-                cp = c0[k]
-                sp = s0[k]
-            gi = group[k]
-            if gi < 0:
-                c += a * sp
-            elif fsign[k] > 0:
-                zr[gi] += a * cp
-                zi[gi] += a * sp
-            else:
-                zr[gi] -= a * cp
-                zi[gi] += a * sp
+        c = _row_phasors(
+            mags, i, sa, ca, i * V, gain, mag_idx, ang_idx, coeff, c0, s0, fsign, group, zr, zi
+        )
         if G == 0:
             fmax[i] = c
             fmin[i] = c

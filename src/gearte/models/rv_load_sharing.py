@@ -46,8 +46,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
-from gearte.geometry.cycloid import CycloidStage, normal_clearance_unclosed
-from gearte.geometry.rv import RVReducer
+from gearte.geometry.cycloid import CycloidStage
+from gearte.geometry.rv import RVReducer, pin_contacts
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     check_law,
@@ -87,6 +87,20 @@ def cycloid_stage(reducer: RVReducer) -> CycloidStage:
     """The reducer's cycloid–pin stage as a :class:`gearte.geometry.cycloid.CycloidStage`.
 
     Its validation (K1 < 1, no undercut, pins fit, non-interfering eq 32 clearance) applies.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    CycloidStage
+        The stage (K1, clearances and curvature of Hu et al.'s eq 3, 32 and 40).
+
+    References
+    ----------
+    Hu et al. (2020) eq 1–4, 32–40, doi:10.3390/app10020481.
     """
     return CycloidStage(
         z_p=reducer.pins.count,
@@ -166,6 +180,20 @@ def contact_law(
 
     The constants (ρ from :meth:`CycloidStage.curvature_radius`, pin radius ``stage.r``, E, ν,
     b) are those the cycloid-stage contact analysis uses, so both analyses share one law.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    law : {"line_contact", "hu2020", "linear"}, optional
+        The law's name; ``None``: the reducer's own.
+    stiffness : float
+        Constant pin-contact stiffness of ``"linear"`` [N/mm].
+
+    Returns
+    -------
+    PinContactLaw
+        The law with its constants.
     """
     if law is None:
         law = getattr(reducer.discs, "contact_law", DEFAULT_LAW)
@@ -186,7 +214,22 @@ def contact_law(
 def solver_law(
     reducer: RVReducer, system: RVSystem, law: PinContactLaw | ContactLaw | None
 ) -> ContactLaw:
-    """The solver law for ``system``: ``law`` as given, or built from a :class:`PinContactLaw`."""
+    """The solver law for ``system``: ``law`` as given, or built from a :class:`PinContactLaw`.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    system : RVSystem
+        The spring and contact rows the law is for.
+    law : PinContactLaw or ContactLaw, optional
+        The law; ``None``: the reducer's own.
+
+    Returns
+    -------
+    ContactLaw
+        The solver's law.
+    """
     return as_solver_law(contact_law(reducer) if law is None else law, system)
 
 
@@ -293,6 +336,11 @@ def _point_row(row: np.ndarray, dof: int, r: np.ndarray, n: np.ndarray, sign: fl
         row[:, dof + 2] += sign * (r[:, 0] * n[:, 1] - r[:, 1] * n[:, 0])
 
 
+def _measured(design: float, measured: np.ndarray | None, index) -> float:
+    """A bearing's clearance [mm]: the measured one of that bearing if given, else the design's."""
+    return design if measured is None else float(measured[index])
+
+
 def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     """Spring and contact rows of ``reducer`` at output angles ``theta`` [rad].
 
@@ -367,7 +415,7 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
                 r,
                 -eps @ d,
                 reducer.cranks.carrier_bearing_stiffness,
-                reducer.cranks.carrier_bearing_clearance,
+                _measured(reducer.cranks.carrier_bearing_clearance, err.carrier_clearance, i),
             )
     labels["carrier_bearing"] = slice(start, len(rows))
 
@@ -387,7 +435,7 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
                     r,
                     (eps_cam - eps_bore) @ d,
                     reducer.cranks.cam_bearing_stiffness,
-                    reducer.cranks.cam_bearing_clearance,
+                    _measured(reducer.cranks.cam_bearing_clearance, err.cam_clearance, (i, j)),
                 )
     labels["cam_bearing"] = slice(start, len(rows))
 
@@ -416,56 +464,20 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     spring_e = np.stack(offs, axis=1)
     spring_k = np.asarray(ks)
 
-    # pin contacts
-    pins = reducer.pins
-    alpha_k = 2.0 * np.pi * np.arange(zp) / zp
-    pin_pos = pins.circle_radius * _u(alpha_k)  # (zp, 2)
-    pin_err = pins.radial_position_errors[:, None] * _u(alpha_k) + pins.tangential_position_errors[
-        :, None
-    ] * _u(alpha_k + np.pi / 2)
+    # pin contacts: normals, arms and initial clearances with every error family
+    # (gearte.geometry.rv.pin_contacts, the one computation the dynamics reads too)
+    pc = pin_contacts(reducer, th)
     cB = np.zeros((P, N * zp, nd))
-    cg = np.zeros((P, N * zp))
-    cphase = np.zeros((P, N * zp))
     group = np.repeat(np.arange(N), zp)
     pin_index = np.tile(np.arange(zp), N)
     for j in range(N):
-        cdir = _u(ecc[:, j])  # (P, 2)
-        ppt = a * zp * cdir
-        centre = a * cdir
-        v = pin_pos[None, :, :] - ppt[:, None, :]  # (P, zp, 2)
-        n = v / np.linalg.norm(v, axis=-1, keepdims=True)
-        contact = pin_pos[None] - pins.pin_radius * n
-        lever = contact - centre[:, None, :]
         dof = lay.disc(j)
         sl = slice(j * zp, (j + 1) * zp)
-        cB[:, sl, dof] = n[..., 0]
-        cB[:, sl, dof + 1] = n[..., 1]
-        cB[:, sl, dof + 2] = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
-        phi = alpha_k[None, :] - ecc[:, j][:, None]
-        d_rp, d_p = err.disc_modification[j]
-        gap = normal_clearance_unclosed(
-            phi,
-            z_p=zp,
-            r_p=pins.circle_radius,
-            a=a,
-            dr_rp=reducer.discs.equidistant_modification + d_rp,
-            dr_p=reducer.discs.shift_modification + d_p,
-        )
-        gap = gap - pins.radius_errors[None, :] + np.sum(n * pin_err[None], axis=-1)
-        # disc profile errors (disc frame; the disc turns with the carrier, angle th):
-        # radial run-out moves the whole profile like a disc translation,
-        runout = _rot(np.broadcast_to(err.disc_runout[j], (P, 2)), th)
-        gap = gap - np.sum(n * runout[:, None, :], axis=-1)
-        # the cumulative pitch deviation s(psi) turns the flank at the contact like a local
-        # rotation s / r_c of the disc (psi: disc-frame angle of the contact point)
-        fp = np.hypot(*err.disc_pitch[j])
-        if fp > 0.0:
-            psi = np.arctan2(lever[..., 1], lever[..., 0]) - th[:, None]
-            ang = np.arctan2(err.disc_pitch[j, 1], err.disc_pitch[j, 0])
-            s_dev = 0.5 * fp * np.sin(psi - ang)
-            gap = gap - cB[:, sl, dof + 2] * s_dev / (a * zc)
-        cg[:, sl] = gap
-        cphase[:, sl] = phi
+        cB[:, sl, dof] = pc.normal[:, j, :, 0]
+        cB[:, sl, dof + 1] = pc.normal[:, j, :, 1]
+        cB[:, sl, dof + 2] = pc.arm[:, j]
+    cg = pc.gap.reshape(P, N * zp)
+    cphase = pc.phase.reshape(P, N * zp)
 
     unit = np.zeros(nd)
     unit[lay.output_rotation] = -1.0  # load torque resists the drive
@@ -633,6 +645,16 @@ def mesh_period(reducer: RVReducer) -> float:
 
     The eccentric turns ``-z_c θ`` and the pattern repeats when the pin phases have moved by one
     pin pitch ``2π / z_p``; the mesh-stiffness ripple of the TE has this period.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    float
+        The mesh period of the output angle [rad].
     """
     return 2.0 * np.pi / (reducer.pins.count * reducer.cycloid_teeth)
 
@@ -683,11 +705,18 @@ def transmission_error(
     theta : array_like, optional
         Output angles [rad] (default 360 over one revolution).
     zero_load_fraction : float
-        The geometric TE is solved at ``zero_load_fraction * torque`` in the same direction, so
+        [-] The geometric TE is solved at ``zero_load_fraction * torque`` in the same direction, so
         that the contacts close their clearance without deflecting (a zero torque leaves the
         output free within its backlash).
     mesh_samples : int
         Positions per mesh period in the refinement around the extremes (0: no refinement).
+    law : PinContactLaw or ContactLaw, optional
+        Pin-contact law; default the reducer's own (:func:`contact_law`).
+
+    Returns
+    -------
+    TransmissionError
+        Total, geometric and elastic output angle error [rad] over ``theta``.
     """
     if not torque > 0:
         raise ParameterError("torque", torque, "must be > 0 N·mm for the TE analysis")

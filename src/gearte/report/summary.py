@@ -23,7 +23,14 @@ from gearte.labels import label
 from gearte.report.tables import item_label, relative_change
 from gearte.units import format_quantity, split_unit
 
-__all__ = ["HeadlineRow", "headlines", "tradeoff_warnings", "HEADLINE_KEYS", "SPEC_CHECKS"]
+__all__ = [
+    "HeadlineRow",
+    "headlines",
+    "analysis_headlines",
+    "tradeoff_warnings",
+    "HEADLINE_KEYS",
+    "SPEC_CHECKS",
+]
 
 MAX_HEADLINES = 4
 
@@ -55,6 +62,9 @@ HEADLINE_KEYS: list[str] = [
     "mc_backlash_mean",
     "mc_backlash_sd",
     "out_of_spec_fraction",
+    "reducers_in_spec",
+    "reducers_in_spec_random_mean",
+    "reducers_in_spec_orientation_only",
     "torsional_rigidity",
     # loads and contact
     "max_contact_force",
@@ -125,11 +135,12 @@ def headlines(result: Any) -> list[HeadlineRow]:
     """Summary rows of every analysis of a study result (see the module docstring)."""
     rows: list[HeadlineRow] = []
     for a in result.analyses:
-        rows += _analysis_headlines(a)
+        rows += analysis_headlines(a)
     return rows
 
 
-def _analysis_headlines(a: Any) -> list[HeadlineRow]:
+def analysis_headlines(a: Any) -> list[HeadlineRow]:
+    """Summary rows of the analysis ``a`` (an AnalysisResult; see the module docstring)."""
     vals = _by_base(a.values)
     picked: list[HeadlineRow] = []
 

@@ -8,8 +8,12 @@ Two solvers on a :class:`gearte.models.planetary_errors.TermSet`:
   (lambda = -1) to the group's fixed part, with the signs minimising ``|Σ lambda_i A_i|`` (eq 6);
   groups without a fixed part and different-frequency couplings are left "arbitrary".
 * :func:`optimal_assembly` — the global minimum of the *exact* coupled amplitude
-  ``max_t |Σe(t)|`` over every free angle: a batch of quasi-random starts evaluated with the
-  compiled exact kernel, then Nelder–Mead from the best starts.
+  ``max_t |Σe(t)|`` over every free angle: a batch of quasi-random (Halton) starts evaluated with
+  the compiled exact kernel, then Nelder–Mead from the best starts. The Nelder–Mead runs compiled
+  (:func:`_polish_kernel`, a line-by-line port of SciPy 1.17's ``_minimize_neldermead`` with
+  ``adaptive=True`` and no bounds, calling the compiled amplitude directly); its plain twin is
+  SciPy's ``minimize(method="Nelder-Mead")`` on the same objective
+  (:func:`_polish_scipy`, used by the tests and ``benchmarks/bench_planetary_assembly.py``).
 
 Units: magnitudes [mm], angles [rad].
 """
@@ -21,17 +25,34 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from gearte.errors import ParameterError
 from gearte.models.planetary_errors import (
     TermSet,
+    _phase_tables,
+    _row_phasors,
+    _term_arrays,
     coupled_te,
     frequency_basis,
     keyed_vector,
     sample_extremes,
 )
+from gearte.solvers.trig_extremes import (
+    SINCOS_MAX_ARG,
+    extremes_kernel,
+    grid_points,
+    node_tables,
+    sincos_into,
+)
 
-__all__ = ["AssemblyPlan", "paper_rule_assembly", "optimal_assembly", "relevant_angles"]
+__all__ = [
+    "AssemblyPlan",
+    "halton_starts",
+    "paper_rule_assembly",
+    "optimal_assembly",
+    "relevant_angles",
+]
 
 
 @dataclass(frozen=True)
@@ -197,6 +218,192 @@ def paper_rule_assembly(
     return _plan(terms, mags, ang, tuple(rule))
 
 
+def halton_starts(n: int, d: int, seed: int) -> np.ndarray:
+    """``n`` quasi-random points in the unit cube ``[0, 1)^d`` [-]: the Halton sequence (radical
+    inverses of ``i = 1..n`` in the first ``d`` primes) with a random Cranley–Patterson shift
+    drawn from ``numpy.random.default_rng(seed)``.
+
+    Low discrepancy along every axis like a scrambled Sobol set, in plain numpy: SciPy's
+    ``qmc.Sobol`` costs a ~1 s import of ``scipy.stats`` per run.
+    """
+    if n < 1 or d < 1:
+        raise ParameterError("starts", (n, d), "need at least one start in at least 1 dimension")
+    primes: list[int] = []
+    k = 2
+    while len(primes) < d:
+        if all(k % p for p in primes):
+            primes.append(k)
+        k += 1
+    out = np.empty((n, d))
+    for j, b in enumerate(primes):
+        i = np.arange(1, n + 1, dtype=np.int64)
+        r = np.zeros(n)
+        f = 1.0
+        while i.any():
+            f /= b
+            r += f * (i % b)
+            i //= b
+        out[:, j] = r
+    return np.mod(out + np.random.default_rng(seed).random(d), 1.0)
+
+
+# --------------------------------------------------------------------------- compiled polish
+@njit(cache=True, nogil=True)
+def _amplitude(x, ws):
+    """max |Σe| [mm] with the free angles ``x`` [rad] (the objective of the polish); ``ws`` the
+    tuple built by :func:`_polish_kernel`. inf if an angle leaves the exact range of sincos."""
+    base, pos, th, sa, ca, mags, gain, mag_idx, ang_idx, coeff, c0, s0, fsign, group = ws[:14]
+    nh, tab, buf, zr, zi, wr, wi = ws[14:]
+    for v in range(th.shape[0]):
+        th[v] = base[v]
+    for j in range(pos.shape[0]):
+        th[pos[j]] = x[j]
+    for v in range(th.shape[0]):
+        if not abs(th[v]) <= SINCOS_MAX_ARG:
+            return np.inf
+    sincos_into(th, sa, ca)
+    c = _row_phasors(
+        mags, 0, sa, ca, 0, gain, mag_idx, ang_idx, coeff, c0, s0, fsign, group, zr, zi
+    )
+    if nh.shape[0] == 0:
+        return abs(c)
+    fx, fn = extremes_kernel(c, zr, zi, nh, tab, buf, wr, wi)
+    return max(fx, -fn)
+
+
+@njit(cache=True, nogil=True)
+def _sort_simplex(sim, fsim):
+    """Order the vertices by value (stable insertion sort, as numpy's argsort on < 16 items)."""
+    n = fsim.shape[0]
+    for i in range(1, n):
+        f = fsim[i]
+        row = sim[i].copy()
+        j = i - 1
+        while j >= 0 and fsim[j] > f:
+            fsim[j + 1] = fsim[j]
+            sim[j + 1] = sim[j]
+            j -= 1
+        fsim[j + 1] = f
+        sim[j + 1] = row
+
+
+@njit(cache=True, nogil=True)
+def _nelder_mead(x0, xatol, fatol, maxiter, ws):
+    """SciPy 1.17 ``_minimize_neldermead`` (adaptive, no bounds, maxfev unlimited) on
+    :func:`_amplitude`: returns (x, f)."""
+    N = x0.shape[0]
+    dim = float(N)
+    rho = 1.0
+    chi = 1.0 + 2.0 / dim
+    psi = 0.75 - 1.0 / (2.0 * dim)
+    sigma = 1.0 - 1.0 / dim
+    sim = np.empty((N + 1, N))
+    sim[0] = x0
+    for k in range(N):
+        y = x0.copy()
+        y[k] = (1.0 + 0.05) * y[k] if y[k] != 0 else 0.00025
+        sim[k + 1] = y
+    fsim = np.empty(N + 1)
+    for k in range(N + 1):
+        fsim[k] = _amplitude(sim[k], ws)
+    _sort_simplex(sim, fsim)
+    xbar = np.empty(N)
+    iterations = 1
+    while iterations < maxiter:
+        dx = 0.0
+        df = 0.0
+        for k in range(1, N + 1):
+            df = max(df, abs(fsim[0] - fsim[k]))
+            for j in range(N):
+                dx = max(dx, abs(sim[k, j] - sim[0, j]))
+        if dx <= xatol and df <= fatol:
+            break
+        for j in range(N):
+            acc = sim[0, j]
+            for k in range(1, N):
+                acc += sim[k, j]
+            xbar[j] = acc / N
+        xr = (1.0 + rho) * xbar - rho * sim[N]
+        fxr = _amplitude(xr, ws)
+        doshrink = False
+        if fxr < fsim[0]:
+            xe = (1.0 + rho * chi) * xbar - rho * chi * sim[N]
+            fxe = _amplitude(xe, ws)
+            if fxe < fxr:
+                sim[N] = xe
+                fsim[N] = fxe
+            else:
+                sim[N] = xr
+                fsim[N] = fxr
+        elif fxr < fsim[N - 1]:
+            sim[N] = xr
+            fsim[N] = fxr
+        elif fxr < fsim[N]:  # outside contraction
+            xc = (1.0 + psi * rho) * xbar - psi * rho * sim[N]
+            fxc = _amplitude(xc, ws)
+            if fxc <= fxr:
+                sim[N] = xc
+                fsim[N] = fxc
+            else:
+                doshrink = True
+        else:  # inside contraction
+            xcc = (1.0 - psi) * xbar + psi * sim[N]
+            fxcc = _amplitude(xcc, ws)
+            if fxcc < fsim[N]:
+                sim[N] = xcc
+                fsim[N] = fxcc
+            else:
+                doshrink = True
+        if doshrink:
+            for k in range(1, N + 1):
+                sim[k] = sim[0] + sigma * (sim[k] - sim[0])
+                fsim[k] = _amplitude(sim[k], ws)
+        iterations += 1
+        _sort_simplex(sim, fsim)
+    return sim[0].copy(), fsim.min()
+
+
+@njit(cache=True, nogil=True)
+def _polish_kernel(
+    starts, xatol, fatol, maxiter, base, pos, mags, gain, mag_idx, ang_idx, coeff, phase, fsign,
+    group, nh, M,
+):  # fmt: skip
+    """Nelder–Mead from each row of ``starts`` [rad], restarted once from its result (a minimax
+    can stall a simplex on a kink): (x per start, amplitude [mm] per start)."""
+    V = base.shape[0]
+    G = nh.shape[0]
+    c0, s0 = _phase_tables(phase)
+    ws = (
+        base, pos, np.empty(V), np.empty(V), np.empty(V), mags, gain, mag_idx, ang_idx, coeff,
+        c0, s0, fsign, group, nh, node_tables(nh, M), np.empty(M), np.empty(G), np.empty(G),
+        np.empty(G), np.empty(G),
+    )  # fmt: skip
+    P, N = starts.shape
+    xs = np.empty((P, N))
+    fs = np.empty(P)
+    for p in range(P):
+        x, f = _nelder_mead(starts[p], xatol, fatol, maxiter, ws)
+        x, f = _nelder_mead(x, xatol, fatol, maxiter, ws)
+        xs[p] = x
+        fs[p] = f
+    return xs, fs
+
+
+def _polish_scipy(amp, cand: list[np.ndarray], d: int) -> tuple[np.ndarray, np.ndarray]:
+    """Plain twin of :func:`_polish_kernel`: SciPy's Nelder–Mead on ``amp`` (angles [rad] →
+    amplitude [mm]) from each start in ``cand``, restarted once; (x per start, value per start)."""
+    from scipy.optimize import minimize
+
+    opts = {"xatol": 1e-10, "fatol": 1e-14, "maxiter": 4000 * d, "adaptive": True}
+    xs, fs = [], []
+    for x0 in cand:
+        res = minimize(lambda x: float(amp(x)[0]), x0, method="Nelder-Mead", options=opts)
+        res = minimize(lambda x: float(amp(x)[0]), res.x, method="Nelder-Mead", options=opts)
+        xs.append(res.x)
+        fs.append(float(res.fun))
+    return np.array(xs), np.array(fs)
+
+
 def optimal_assembly(
     terms: TermSet,
     magnitudes: Mapping[str, float],
@@ -206,6 +413,7 @@ def optimal_assembly(
     polish: int = 12,
     seed: int = 20130808,
     extra_starts: list[Mapping[str, float]] | None = None,
+    compiled: bool = True,
 ) -> AssemblyPlan:
     """Global minimum over all free angles of the exact coupled amplitude max_t |Σe(t)|.
 
@@ -217,23 +425,22 @@ def optimal_assembly(
     reference_value : float
         Value of the reference angle [rad] (0: angles are relative to the datum).
     starts : int
-        Quasi-random (scrambled Sobol) start points evaluated in one compiled batch (rounded up
-        to a power of 2).
+        Quasi-random start points (:func:`halton_starts`) evaluated in one compiled batch.
     polish : int
         Number of best starts refined by Nelder–Mead (xatol 1e-10 rad).
     seed : int
-        Seed of the Sobol scrambling (the result is deterministic).
+        Seed of the random shift of the start points (the result is deterministic).
     extra_starts : list of mappings, optional
         Further start points, angle name → angle [rad] (e.g. the paper's rule), always polished.
+    compiled : bool
+        Run the Nelder–Mead polish compiled (default) or with SciPy on the Python objective
+        (the plain twin: same steps, ~100× slower).
 
     Returns
     -------
     AssemblyPlan
         Angles of the relevant free angles (others 0) and the exact amplitude there.
     """
-    from scipy.optimize import minimize
-    from scipy.stats import qmc
-
     mags = dict(magnitudes)
     mvec = keyed_vector(terms.magnitudes, mags, "magnitudes", required=True)
     free = relevant_angles(terms, mags)
@@ -255,29 +462,38 @@ def optimal_assembly(
     if not free:
         return _plan(terms, mags, dict(zip(terms.angles, base, strict=True)), ())
     d = len(free)
-    m = int(np.ceil(np.log2(max(starts, 2))))  # Sobol balance needs a power of 2
-    sob = qmc.Sobol(d, scramble=True, seed=seed).random_base2(m) * 2 * np.pi
+    sob = halton_starts(starts, d, seed) * (2 * np.pi)
     vals = amp(sob)
     cand = [sob[i] for i in np.argsort(vals)[:polish]]
     for st in extra_starts or []:
         cand.append(np.array([float(st.get(a, 0.0)) for a in free]))
+    if compiled:
+        arr = _term_arrays(terms)
+        nh = arr["harmonics"]
+        xs, fs = _polish_kernel(
+            np.ascontiguousarray(np.array(cand, dtype=float).reshape(len(cand), d)),
+            1e-10,
+            1e-14,
+            4000 * d,
+            base.astype(float),
+            np.asarray(pos, dtype=np.int64),
+            np.ascontiguousarray(mvec.reshape(1, -1)),
+            arr["gain"],
+            arr["mag_idx"],
+            arr["ang_idx"],
+            arr["coeff"],
+            arr["phase"],
+            arr["fsign"],
+            arr["group"],
+            nh,
+            grid_points(nh) if nh.size else 16,
+        )
+    else:
+        xs, fs = _polish_scipy(amp, cand, d)
     best_x, best_v = None, np.inf
-    for x0 in cand:
-        res = minimize(
-            lambda x: float(amp(x)[0]),
-            x0,
-            method="Nelder-Mead",
-            options={"xatol": 1e-10, "fatol": 1e-14, "maxiter": 4000 * d, "adaptive": True},
-        )
-        # restart once from the result: Nelder-Mead on a minimax can stall on a kink
-        res = minimize(
-            lambda x: float(amp(x)[0]),
-            res.x,
-            method="Nelder-Mead",
-            options={"xatol": 1e-10, "fatol": 1e-14, "maxiter": 4000 * d, "adaptive": True},
-        )
-        if res.fun < best_v:
-            best_x, best_v = res.x, float(res.fun)
+    for x, f in zip(xs, fs, strict=True):
+        if f < best_v:
+            best_x, best_v = x, float(f)
     assert best_x is not None
     angles = dict(zip(terms.angles, full(best_x), strict=True))
     return _plan(terms, mags, angles, free)

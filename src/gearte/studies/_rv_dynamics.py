@@ -24,10 +24,10 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer, mass_properties
 from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult
+from gearte.units import N_per_mm_to_N_per_m, Nm_to_Nmm, rad_to_deg
 
 __all__ = [
     "ANALYSES",
@@ -60,8 +60,12 @@ class ContactOptions(StrictModel):
 
 
 class ModalOptions(StrictModel):
-    speed_min_rpm: float = Field(100.0, gt=0, le=2e4)
-    speed_max_rpm: float = Field(3000.0, gt=0, le=2e4)
+    speed_min_rpm: float = Field(
+        100.0, gt=0, le=2e4, description="Lowest input speed of the Campbell diagram [rpm]."
+    )
+    speed_max_rpm: float = Field(
+        3000.0, gt=0, le=2e4, description="Highest input speed of the Campbell diagram [rpm]."
+    )
     resonance_margin: float = Field(0.1, gt=0, lt=1, description="relative band around a mode")
 
     @model_validator(mode="after")
@@ -74,7 +78,9 @@ class ModalOptions(StrictModel):
 class DTEOptions(StrictModel):
     duration_s: float = Field(0.5, gt=0, le=60, description="simulated time after settling [s]")
     settle_s: float = Field(0.1, ge=0, le=10, description="settling time from static equilibrium")
-    method: Literal["rk4", "dopri5", "scipy"] = "rk4"
+    method: Literal["rk4", "dopri5", "scipy"] = Field(
+        "rk4", description="Integrator: fixed-step RK4, adaptive DOPRI5, or scipy's solve_ivp."
+    )
     step_fraction: float = Field(0.85, gt=0, le=1, description="RK4 step / stability limit")
     record_dt_s: float = Field(1e-4, gt=0, le=0.1, description="recording interval [s]")
 
@@ -82,11 +88,15 @@ class DTEOptions(StrictModel):
 class SpeedSweepOptions(StrictModel):
     """DTE peak-to-peak over a range of input speeds (resonances of the mesh excitation)."""
 
-    speed_min_rpm: float = Field(300.0, gt=0, le=2e4)
-    speed_max_rpm: float = Field(3000.0, gt=0, le=2e4)
-    count: int = Field(19, ge=2, le=500)
+    speed_min_rpm: float = Field(
+        300.0, gt=0, le=2e4, description="Lowest input speed of the sweep [rpm]."
+    )
+    speed_max_rpm: float = Field(
+        3000.0, gt=0, le=2e4, description="Highest input speed of the sweep [rpm]."
+    )
+    count: int = Field(19, ge=2, le=500, description="Input speeds in the sweep [-].")
     duration_s: float = Field(0.1, gt=0, le=10, description="simulated time per speed [s]")
-    settle_s: float = Field(0.1, ge=0, le=10)
+    settle_s: float = Field(0.1, ge=0, le=10, description="Settling time at each speed [s].")
 
     @model_validator(mode="after")
     def _order(self):
@@ -96,11 +106,17 @@ class SpeedSweepOptions(StrictModel):
 
 
 class BatchOptions(StrictModel):
-    samples: int = Field(16, ge=1, le=100000)
-    duration_s: float = Field(0.5, gt=0, le=60)
-    settle_s: float = Field(0.1, ge=0, le=10)
-    seed: int = Field(0, ge=0)
-    chunk_size: int = Field(4, ge=1, le=10000)
+    samples: int = Field(
+        16, ge=1, le=100000, description="Random error realisations simulated [-]."
+    )
+    duration_s: float = Field(
+        0.5, gt=0, le=60, description="Simulated time per realisation after settling [s]."
+    )
+    settle_s: float = Field(0.1, ge=0, le=10, description="Settling time before recording [s].")
+    seed: int = Field(0, ge=0, description="Seed of the random realisations.")
+    chunk_size: int = Field(
+        4, ge=1, le=10000, description="Realisations per chunk of the execution layer."
+    )
     tolerance_scale: float = Field(1.0, gt=0, le=10, description="× Table 3 amplitudes")
 
 
@@ -123,19 +139,18 @@ def build_dynamic_model(case, red: RVReducer):
     )
 
     d, op = case.reducer.dynamics, case.operation
-    _check_representable(red)
     mp = mass_properties(red, case.reducer.density, d.given("mass"), d.given("inertia"))
     kw: dict[str, Any] = {f"{b}_mass_kg": v for b, v in mp.mass_kg.items()}
     kw.update({f"{b}_inertia_kgm2": v for b, v in mp.inertia_kgm2.items()})
     kw.update(
         input_torsional_stiffness_Nm_per_rad=d.input_torsional_stiffness_Nm_per_rad,
         crank_torsional_stiffness_Nm_per_rad=d.crank_torsional_stiffness_Nm_per_rad,
-        crank_bending_stiffness_N_per_m=d.crank_bending_stiffness_N_per_mm * 1e3,
+        crank_bending_stiffness_N_per_m=N_per_mm_to_N_per_m(d.crank_bending_stiffness_N_per_mm),
         damping_ratio=d.damping_ratio,
         cycloid_stiffness=d.cycloid_stiffness,
         cycloid_mesh_stiffness_N_per_m=None
         if d.cycloid_mesh_stiffness_N_per_mm is None
-        else d.cycloid_mesh_stiffness_N_per_mm * 1e3,
+        else N_per_mm_to_N_per_m(d.cycloid_mesh_stiffness_N_per_mm),
         cycloid_pressure_angle_deg=d.cycloid_pressure_angle_deg,
         involute_harmonics=d.involute_harmonics,
         cycloid_harmonics=d.cycloid_harmonics,
@@ -156,6 +171,7 @@ def build_dynamic_model(case, red: RVReducer):
         sun_assembly=polar(e.sun_seat),
         output_assembly=polar(e.output_seat),
         output_bearing_clearance_mm=red.supports.main_bearing_clearance,
+        output_torque_Nm=op.output_torque_Nm,
     )
     return RVDynamicModel(params, errors), mp
 
@@ -185,29 +201,10 @@ def batch_tolerances(red: RVReducer, scale: float = 1.0):
     )
 
 
-def _check_representable(red: RVReducer) -> None:
-    """The disc profile errors the quasi-static model reads but the dynamics cannot hold."""
-    amp = red.error_set.amplitudes()
-    for part in ("disc_radial_runout", "disc_cumulative_pitch"):
-        if amp[part] > 0:
-            raise ParameterError(
-                "reducer.errors",
-                part,
-                "disc profile errors are read by the quasi-static analyses only: the dynamic "
-                "model has one equivalent cycloid–pin spring per disc and cannot hold them; "
-                "leave them out of a case that asks for dynamic analyses",
-            )
-    if np.any(red.error_set.disc_modification != 0):
-        raise ParameterError(
-            "reducer.discs.equidistant_modification_errors_um/shift_modification_errors_um",
-            red.error_set.disc_modification.tolist(),
-            "per-disc modification errors are read by the quasi-static analyses only (the "
-            "dynamic model's discs share one cycloid–pin pair)",
-        )
-
-
 def _has_errors(red: RVReducer) -> bool:
-    return any(v > 0 for v in red.error_set.amplitudes().values())
+    from gearte.models.rv_dynamics.excitation import has_pin_errors
+
+    return any(v > 0 for v in red.error_set.amplitudes().values()) or has_pin_errors(red)
 
 
 # --- analyses --------------------------------------------------------------------------------
@@ -220,40 +217,40 @@ def _contact(case, model) -> AnalysisResult:
     t_disc = case.operation.output_torque_Nm / case.reducer.discs.count
     sweep = []
     for tq in opts.load_sweep_Nm:
-        mp = mesh_period_contact(pair, tq * 1e3, min(opts.positions, 24))
+        mp = mesh_period_contact(pair, Nm_to_Nmm(tq), min(opts.positions, 24))
         sweep.append(
             {
                 "torque_per_disc [N·m]": tq,
-                "equivalent_pressure_angle_mean [deg]": float(np.degrees(mp.pressure_angle_mean)),
-                "equivalent_mesh_stiffness_mean [N/m]": mp.mesh_stiffness_mean * 1e3,
+                "equivalent_pressure_angle_mean [deg]": float(rad_to_deg(mp.pressure_angle_mean)),
+                "equivalent_mesh_stiffness_mean [N/m]": N_per_mm_to_N_per_m(mp.mesh_stiffness_mean),
                 "pins_in_contact_mean": float(np.mean(mp.pins_in_contact)),
             }
         )
     mean_k, a_k, b_k = model.cycloid_fourier
-    beta = np.degrees(c.pressure_angle)
+    beta = rad_to_deg(c.pressure_angle)
     values = {
-        "equivalent_pressure_angle_mean [deg]": float(np.degrees(c.pressure_angle_mean)),
+        "equivalent_pressure_angle_mean [deg]": float(rad_to_deg(c.pressure_angle_mean)),
         "equivalent_pressure_angle_min [deg]": float(beta.min()),
         "equivalent_pressure_angle_max [deg]": float(beta.max()),
-        "equivalent_mesh_stiffness_mean [N/m]": c.mesh_stiffness_mean * 1e3,
-        "equivalent_mesh_stiffness_min [N/m]": float(c.mesh_stiffness.min() * 1e3),
-        "equivalent_mesh_stiffness_max [N/m]": float(c.mesh_stiffness.max() * 1e3),
+        "equivalent_mesh_stiffness_mean [N/m]": N_per_mm_to_N_per_m(c.mesh_stiffness_mean),
+        "equivalent_mesh_stiffness_min [N/m]": float(N_per_mm_to_N_per_m(c.mesh_stiffness.min())),
+        "equivalent_mesh_stiffness_max [N/m]": float(N_per_mm_to_N_per_m(c.mesh_stiffness.max())),
         "pins_in_contact_min": int(c.pins_in_contact.min()),
         "pins_in_contact_max": int(c.pins_in_contact.max()),
         "max_pin_force [N]": float(c.max_force.max()),
         "max_contact_pressure [MPa]": c.max_contact_pressure,
         "contact_law": pair.contact_law,
         "torque_per_disc [N·m]": t_disc,
-        "mesh_position [deg]": np.degrees(c.mesh_position),
+        "mesh_position [deg]": rad_to_deg(c.mesh_position),
         "equivalent_pressure_angle [deg]": beta,
-        "equivalent_mesh_stiffness [N/m]": c.mesh_stiffness * 1e3,
+        "equivalent_mesh_stiffness [N/m]": N_per_mm_to_N_per_m(c.mesh_stiffness),
         "signed_resultant_pressure_angle_mean [deg]": float(
-            np.degrees(
+            rad_to_deg(
                 np.mean(np.arctan2(c.contact.radial_force_signed, c.contact.tangential_force))
             )
         ),
-        "stiffness_fourier_a [N/m]": a_k * 1e3,
-        "stiffness_fourier_b [N/m]": b_k * 1e3,
+        "stiffness_fourier_a [N/m]": N_per_mm_to_N_per_m(a_k),
+        "stiffness_fourier_b [N/m]": N_per_mm_to_N_per_m(b_k),
         "load_sweep": sweep,
     }
     notes = [
@@ -384,7 +381,10 @@ def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
     ]
     if _has_errors(red):
         notes.append(
-            "Errors: the case's [[reducer.errors]], the same the quasi-static model reads."
+            "Errors: the case's [[reducer.errors]] and per-pin errors, the same the "
+            "quasi-static model reads; pin, disc run-out, cumulative pitch and per-disc "
+            "modification errors act as each disc's loaded rotation shift computed from the "
+            "same pin clearances (gearte.models.rv_dynamics.excitation)."
         )
     if opts.duration_s * sources["output rotation"] < 0.99 and _has_errors(red):
         warnings.append(
@@ -502,7 +502,7 @@ def _batch(case, red, model, options) -> AnalysisResult:
         notes=[
             "Each part's error amplitude uniform in [0, tolerance] (the largest of the case's "
             f"errors of that part × {s:g}), phase uniform in [0, 2π), independently per crank "
-            f"and disc; seed {seed}.",
+            f"and disc; seed {seed}. Pin and disc-profile errors are not drawn.",
             "Peak-to-peak over the simulated span after settling, reduced inside the kernel.",
         ],
         data={"rows": res["rows"]},

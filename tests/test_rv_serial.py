@@ -1,0 +1,139 @@
+"""A serial's model from its measurement files (issue 16, ``rv_serial``): round trip through the
+metrology files, and the report's list of measured inputs."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from gearte.cases import case_path
+from gearte.geometry.measured import measurements_of
+from gearte.io import metrology as mt
+from gearte.io.case_file import load_case
+from gearte.studies import run_case
+from gearte.studies.rv_reducer import build_reducer
+
+ANALYSES = """
+[analyses.load_sharing]
+torque_Nm = 1078.0
+positions = 24
+compare_without_errors = false
+[analyses.transmission_error]
+torque_Nm = 1078.0
+positions = 24
+[analyses.catalogue]
+steps_per_segment = 4
+"""
+
+
+def _han_cases(tmp_path):
+    """The Han 2023 RV-110E with its Table 1-3 errors and pin errors (known design, known
+    errors), and the same design without errors. Table 4 (carrier bores) has no measurement
+    format here and is left out of both."""
+    text = case_path("han2023_rv110e").read_text(encoding="utf-8")
+    head = text[: text.index("[reducer.dynamics]")]
+    blocks = re.split(r"(?=\[\[reducer\.errors\]\])", head)
+    keep = [b for b in blocks[1:] if 'part = "carrier_crank_bore"' not in b]
+    pins = "radius_errors_um = [" + ", ".join(f"{3 * np.sin(k):.3f}" for k in range(40)) + "]\n"
+    base = blocks[0].replace("circle_radius_mm = 82.0\n", "circle_radius_mm = 82.0\n" + pins)
+    known = tmp_path / "known.toml"
+    known.write_text(base + "".join(keep) + ANALYSES, encoding="utf-8")
+    design = tmp_path / "design.toml"
+    nominal = blocks[0]
+    design.write_text(nominal + ANALYSES, encoding="utf-8")
+    return known, design
+
+
+def _export(reducer, folder):
+    """Measurement files of the known reducer's parts (the metrology a lab would write)."""
+    meas = measurements_of(reducer)
+    m, n = reducer.cranks.count, reducer.discs.count
+    mt.write_disc_bores(
+        folder / "bores.csv", {f"D{j + 1}": meas["disc_bores"][j] for j in range(n)}
+    )
+    mt.write_crank_eccentricity(
+        folder / "cranks.csv",
+        {
+            f"C{i + 1}": mt.CrankCams(meas["cam_eccentricity"][i], meas["cam_phase"][i])
+            for i in range(m)
+        },
+    )
+    mt.write_runout(
+        folder / "planets.csv",
+        {f"P{i + 1}": mt.Runout(*meas["planet_runout"][i]) for i in range(m)},
+    )
+    mt.write_pins(
+        folder / "pins.csv",
+        {"H1": mt.PinSet(meas["pin_diameters"], meas["slot_radial"], meas["slot_tangential"])},
+    )
+    (folder / "serial.toml").write_text(
+        """[case]
+kind = "rv_serial"
+title = "round trip"
+[reducer]
+case = "design.toml"
+[serial]
+name = "RV-1"
+discs = ["D1", "D2"]
+cranks = ["C1", "C2", "C3"]
+planets = ["P1", "P2", "P3"]
+pins = "H1"
+[serial.files]
+disc_bores = "bores.csv"
+crank_eccentricity = "cranks.csv"
+planet_runout = "planets.csv"
+pins = "pins.csv"
+"""
+        + ANALYSES,
+        encoding="utf-8",
+    )
+    return folder / "serial.toml"
+
+
+def test_round_trip_known_errors_through_measurement_files_same_results_1e9(tmp_path):
+    """Known design + known errors → measurement files → re-imported serial: every result to
+    1e-9 (relative, or 1e-9 of the largest value of an array)."""
+    known, design = _han_cases(tmp_path)
+    kcase = load_case(known)
+    serial = _export(build_reducer(kcase.reducer), tmp_path)
+    a = run_case(kcase)
+    b = run_case(load_case(serial))
+    assert b["measured_inputs"]["measured"]["cam eccentricity and phase"].startswith(str(tmp_path))
+    for name in ("load_sharing", "transmission_error", "catalogue"):
+        va, vb = a[name].values, b[name].values
+        for key, x in va.items():
+            if isinstance(x, str | dict):
+                continue
+            x, y = np.asarray(x, dtype=float), np.asarray(vb[key], dtype=float)
+            scale = max(float(np.max(np.abs(x))), 1e-12)
+            np.testing.assert_allclose(y, x, rtol=0, atol=1e-9 * scale, err_msg=f"{name}: {key}")
+
+
+def test_serial_names_a_part_missing_from_its_file(tmp_path):
+    known, _ = _han_cases(tmp_path)
+    serial = _export(build_reducer(load_case(known).reducer), tmp_path)
+    serial.write_text(serial.read_text().replace('"P3"]', '"P9"]'))
+    with pytest.raises(Exception, match="P9"):
+        run_case(load_case(serial))
+
+
+def test_validate_refuses_a_malformed_measurement_file_naming_file_line_column(tmp_path):
+    """``gearte validate`` reads the measurement files: a NaN in one of them is one line naming
+    the file, the line and the column, exit code 2, no traceback."""
+    from click.testing import CliRunner
+
+    from gearte.cli import main
+
+    known, _ = _han_cases(tmp_path)
+    serial = _export(build_reducer(load_case(known).reducer), tmp_path)
+    p = tmp_path / "cranks.csv"
+    lines = p.read_text().splitlines()
+    cells = lines[3].split(",")
+    lines[3] = ",".join([cells[0], cells[1], "nan", cells[3]])
+    p.write_text("\n".join(lines) + "\n")
+    r = CliRunner().invoke(main, ["validate", str(serial)])
+    assert r.exit_code == 2
+    assert f"{p}, line 4, column 3 'eccentricity [mm]'" in r.output
+    assert "Traceback" not in r.output
