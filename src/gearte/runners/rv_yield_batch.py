@@ -87,6 +87,7 @@ def plan(model, keys: Sequence[str]) -> RVBatchPlan:
     """
     from gearte.models.catalogue import ZERO_TORQUE_FRACTION
     from gearte.models.rv_load_sharing import assemble, contact_law, contact_phase, cycloid_stage
+
     RV_VECTOR_PARTS, MODIFICATION_FAMILIES = model.vector_parts, model.modification_families
     from gearte.solvers.rv_batch import problem_from_system
     from gearte.solvers.rv_equilibrium import _linear_parts

@@ -302,12 +302,11 @@ class RVReducerYield:
         """The assembled reducer of one sample (errors [µm], phases [rad])."""
         import dataclasses
 
-        from gearte.geometry.rv import ManufacturingErrors
-
         red = self.reducer
         e0 = red.errors
-        arr = {f.name: np.array(getattr(e0, f.name), dtype=float, copy=True)
-               for f in dataclasses.fields(ManufacturingErrors)}  # fmt: skip
+        names = ("planet", "disc_bore", "cam", "carrier_bore", "sun", "sun_seat", "output_seat",
+                 "disc_runout", "disc_pitch", "disc_modification")  # fmt: skip
+        arr = {n: np.array(getattr(e0, n), dtype=float, copy=True) for n in names}
 
         def vec(key: str) -> np.ndarray | None:
             if key not in errors:
@@ -341,7 +340,7 @@ class RVReducerYield:
             for col, fam in enumerate(MODIFICATION_FAMILIES):
                 if (key := f"{fam}.d{j + 1}") in errors:
                     arr["disc_modification"][j, col] = float(um_to_mm(errors[key]))
-        red = red.with_errors(ManufacturingErrors(**arr))
+        red = red.with_errors(dataclasses.replace(e0, **arr))
         pins = red.pins
         changed = {}
         for f in RV_PIN_FAMILIES:
