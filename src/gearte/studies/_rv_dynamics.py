@@ -101,7 +101,12 @@ class BatchOptions(StrictModel):
     duration_s: float = Field(0.5, gt=0, le=60)
     settle_s: float = Field(0.1, ge=0, le=10)
     seed: int = Field(0, ge=0)
-    chunk_size: int = Field(4, ge=1, le=10000)
+    chunk_size: int = Field(
+        1,
+        ge=1,
+        le=10000,
+        description="realisations per chunk (1: any batch of >= 2 uses every worker)",
+    )
     tolerance_scale: float = Field(1.0, gt=0, le=10, description="× Table 3 amplitudes")
 
 
