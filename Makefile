@@ -15,7 +15,7 @@ DEV_STAMP := $(VENV)/.installed-dev-$(HASH)
 PIP    := $(BIN)/python -m pip install --disable-pip-version-check -c $(CONSTRAINTS)
 DEMO_CASE ?= hu2020_rv80e_initial
 
-.PHONY: demo test test-slow test-latest lint typecheck bench lock clean fuzz
+.PHONY: demo test test-slow test-latest lint typecheck bench lock clean fuzz docs
 
 $(VENV)/bin/python:
 	@echo "==> creating $(VENV) with $(PYTHON)"
@@ -52,6 +52,13 @@ test: $(DEV_STAMP)
 	@echo "==> pytest"
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q
 
+# The docs site (mkdocs.yml) into site/, offline and strict (a broken link or reference fails);
+# the gallery runs the paper cases once per source tree (cached in .docs_cache/);
+# GEARTE_DOCS_GALLERY=0 leaves it out.
+docs: $(DEV_STAMP)
+	NO_MKDOCS_2_WARNING=1 NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/mkdocs build --strict
+	@echo "docs: site/index.html"
+
 # The long fuzzing job (issue 13): FUZZ_COUNT mutants of the bundled cases through validation.
 FUZZ_COUNT ?= 10000
 fuzz: $(DEV_STAMP)
@@ -87,4 +94,4 @@ bench: $(DEV_STAMP)
 	for b in benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) .venv-latest out .numba_cache_test .numba_cache_latest .pytest_cache
+	rm -rf $(VENV) .venv-latest out .numba_cache_test .numba_cache_latest .pytest_cache site .docs_cache

@@ -31,15 +31,16 @@ def _best(fn, repeat: int) -> float:
 
 def main() -> None:
     stage = CycloidStage(z_p=40, r_p=76.0, r_rp=3.0, a=1.5, b=11.0, dr_rp=-0.022, dr_p=-0.0437)
-    torque = 1011.5e3  # N·mm
+    torque = 1011.5e3  # N·mm (fitted to Hu et al.'s Tables 4-5, examples/hu2020_rv80e_initial.toml)
+    paper = dict(disc_share=0.55, E=2.06e5, mu=0.3)  # Hu et al. 2020 section 4
     theta = np.arange(N_POSITIONS) * (2 * np.pi / stage.z_p) / N_POSITIONS
 
     def fast():
-        return tooth_contact(stage, torque, mesh_angle=theta, contact_law="hu2020")
+        return tooth_contact(stage, torque, **paper, mesh_angle=theta, contact_law="hu2020")
 
     def plain():
         return tooth_contact(
-            stage, torque, mesh_angle=theta, implementation="plain", contact_law="hu2020"
+            stage, torque, **paper, mesh_angle=theta, implementation="plain", contact_law="hu2020"
         )
 
     t0 = time.perf_counter()

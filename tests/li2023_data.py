@@ -66,3 +66,10 @@ def table3_tolerances():
         carrier_hole=float(e.carrier_hole[:, 0].max()),
         output_assembly=e.output_assembly[0],
     )
+
+
+def li2023_pair(modified: bool = False):
+    """The cycloid–pin pair of Table 1 (``CycloidPinPair``) as the bundled cases build it:
+    unmodified (``li2023_rv_unmodified``) or with the section 4.1 modification Δr_rp = −0.01,
+    Δr_p = −0.05 mm (``li2023_rv``)."""
+    return li2023_parameters(modified).pair

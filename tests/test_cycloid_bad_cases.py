@@ -153,6 +153,9 @@ def physical_range_cases(draw):
             "geometric_te": {},
             "tooth_contact": {
                 "torque_Nm": draw(st.floats(min_value=1.0, max_value=5000.0)),
+                "disc_share": 0.5,
+                "youngs_modulus_MPa": 2.06e5,
+                "poisson_ratio": 0.3,
                 "mesh_positions": 3,
             },
             "compensation": {},

@@ -60,7 +60,11 @@ def test_results_json_has_the_required_names(written, name):
     assert html.count("<img") >= 5 or html.count("<svg") >= 5
 
 
-def test_hu2020_table3_case_reproduces_paper(results):
+def test_hu2020_table3_case_reproduces_paper_fitted_torque_face_width(results):
+    """``hu2020_rv80e_initial`` (Table 3) with the fitted T = 1011.5 N·m and b = 11 mm (the paper
+    prints neither). Table 4: F_max 1910.3 N, δ_max 0.0116 mm; gearte 1810.22 N / 0.0109782 mm,
+    documented deviation −5.24 % / −5.4 % (docs/validation/hu2020.md: the paper's index slip in
+    eq 44); tolerances as the model-level test (tests/test_hu2020_tooth_contact.py)."""
     r = results["hu2020_rv80e_initial"]
     assert round(r["geometry"]["K1"], 5) == 0.78993
     assert r["geometry"]["root_radius [mm]"] == pytest.approx(71.4783)
@@ -71,8 +75,8 @@ def test_hu2020_table3_case_reproduces_paper(results):
     assert tc["pins_in_mesh"] == 9  # paper: nine pins (3..11)
     assert tc["pins_in_mesh_index"] == list(range(3, 12))
     # documented deviation: paper 1910.3 N / 0.0116 mm (index slip in its eq 44), gearte exact
-    assert tc["max_contact_force [N]"] == pytest.approx(1910.3, rel=0.06)
-    assert tc["max_normal_deformation [mm]"] == pytest.approx(0.0116, rel=0.06)
+    assert tc["max_contact_force [N]"] == pytest.approx(1810.22, abs=0.01)
+    assert tc["max_normal_deformation [mm]"] == pytest.approx(0.0109782, abs=1e-7)
     # over one pitch: 1000 positions, 8 to 9 pins
     assert len(tc["max_contact_force_over_pitch [N]"]) == 1000
     assert {tc["pins_in_mesh_min"], tc["pins_in_mesh_max"]} <= {8, 9}
@@ -82,16 +86,19 @@ def test_hu2020_table3_case_reproduces_paper(results):
     )
 
 
-def test_hu2020_table6_case_improves_contact(results):
+def test_hu2020_table6_case_improves_contact_fitted_torque_face_width(results):
+    """``hu2020_rv80e_modified`` (Table 6) at the same fitted T and b. Table 7: 1435.9 N,
+    0.0088 mm, force −24.83 %; gearte 1409.39 N / 0.0086378 mm / −22.14 %, documented deviation
+    −1.85 % / −1.8 % / +2.7 points (docs/validation/hu2020.md)."""
     init = results["hu2020_rv80e_initial"]["tooth_contact"]
     mod = results["hu2020_rv80e_modified"]["tooth_contact"]
     assert round(results["hu2020_rv80e_modified"]["geometry"]["K1"], 4) == 0.7898
-    assert mod["max_contact_force [N]"] == pytest.approx(1435.9, rel=0.025)
-    assert mod["max_normal_deformation [mm]"] == pytest.approx(0.0088, rel=0.025)
+    assert mod["max_contact_force [N]"] == pytest.approx(1409.39, abs=0.01)
+    assert mod["max_normal_deformation [mm]"] == pytest.approx(0.0086378, abs=1e-7)
     assert mod["pins_in_mesh"] > init["pins_in_mesh"]
-    # paper: force -24.83 %, deformation -24 %
+    # paper: force -24.83 %, deformation -24 %; gearte -22.14 %
     assert 1 - mod["max_contact_force [N]"] / init["max_contact_force [N]"] == pytest.approx(
-        0.2483, abs=0.03
+        0.2214, abs=1e-4
     )
     # the modified nominal design is preloaded: gearte warns
     assert any("no backlash" in w for w in results["hu2020_rv80e_modified"].warnings)

@@ -57,12 +57,12 @@ def test_hu2020_table4_delta_max_from_force_eq38_fitted_face_width():
     Needs the face width b = 11 mm, fitted (the paper does not print it).
     """
     st = CycloidStage(**TABLE3)
-    d = float(max_normal_deformation(1910.3, st.rho0, st.r, 2.06e5, 0.3, 11.0))
+    d = float(max_normal_deformation(1910.3, st.rho0, st.r, 2.06e5, 0.3, 11.0, law="hu2020"))
     assert round(d, 4) == 0.0116
     st6 = CycloidStage(**TABLE6)
-    assert round(float(max_normal_deformation(1435.9, st6.rho0, st6.r, 2.06e5, 0.3, 11.0)), 4) == (
-        0.0088
-    )
+    assert round(
+        float(max_normal_deformation(1435.9, st6.rho0, st6.r, 2.06e5, 0.3, 11.0, law="hu2020")), 4
+    ) == (0.0088)
 
 
 def test_hu2020_table5_deformation_from_delta_max_fitted_face_width():
@@ -78,7 +78,7 @@ def test_hu2020_table5_deformation_from_delta_max_fitted_face_width():
     st = CycloidStage(**TABLE3)
     i = np.arange(3, 12)
     lr = _lr(st, 2 * np.pi * (i - 1) / st.z_p)
-    d_max = float(max_normal_deformation(1911.7, st.rho0, st.r, 2.06e5, 0.3, 11.0))
+    d_max = float(max_normal_deformation(1911.7, st.rho0, st.r, 2.06e5, 0.3, 11.0, law="hu2020"))
     np.testing.assert_array_equal(np.round(lr * d_max, 4), TABLE5)
     np.testing.assert_allclose(lr * 0.0116, TABLE5, atol=1e-4 + 1e-12)
 
@@ -104,7 +104,7 @@ def _paper_iteration_fixed_point(st: CycloidStage, slip: int) -> tuple[float, fl
     phi = st.pin_phases(0.0)
     lr = _lr(st, phi)
     clr = st.initial_clearance(phi)
-    A, B = compliance_constants(st.rho0, st.r, 2.06e5, 0.3, st.b)
+    A, B = compliance_constants(st.rho0, st.r, 2.06e5, 0.3, st.b, law="hu2020")
     T_c = 0.55 * TORQUE
 
     from scipy.optimize import brentq

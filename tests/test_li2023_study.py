@@ -65,18 +65,28 @@ def test_li2023_cases_exist():
         assert case_path(name).is_file()
 
 
-def test_li2023_rv_result_names_and_paper_values(modified, unmodified):
+def test_li2023_rv_result_names_and_paper_values_with_documented_deviations(modified, unmodified):
+    """The study reports the model's values (docs/validation/li2023.md, summary table):
+
+    * DTE p2p without errors (Fig 11a): paper 0.78″; gearte 0.2240″ (``li2023_rv``) and 0.2891″
+      (unmodified), documented deviation −71 % / −63 % (unprinted mesh stiffness and damping);
+      the shortened run here (0.1 s after 0.06 s settling) gives the same steady value; 1e-3
+      relative (RK4 at a fixed step, reproducible to far better).
+    * β unmodified (Fig 9): paper 31.9°; gearte 32.833°, deviation +0.93°; 1e-3°.
+    * k_cr modified / unmodified: paper 0.211; gearte 0.2322, deviation +10 %; 1e-4.
+    """
     for res in (modified, unmodified):
         v = _flat(res)
         for n in NAMES:
             assert n in v, n
         assert len(v["natural_frequencies [Hz]"]) == 30
         assert v["rigid_mode_ratio"] == pytest.approx(121.0, abs=1e-7)
-        assert 0.1 <= v["dte_peak_to_peak [arcsec]"] <= 2.0  # paper 0.78″
     vu, vm = _flat(unmodified), _flat(modified)
-    assert 31.5 <= vu["equivalent_pressure_angle_mean [deg]"] <= 33.5  # paper 31.9°
+    assert vm["dte_peak_to_peak [arcsec]"] == pytest.approx(0.2240, rel=1e-3)  # paper 0.78″
+    assert vu["dte_peak_to_peak [arcsec]"] == pytest.approx(0.2891, rel=1e-3)  # paper 0.78″
+    assert vu["equivalent_pressure_angle_mean [deg]"] == pytest.approx(32.833, abs=1e-3)  # 31.9°
     ratio = vm["equivalent_mesh_stiffness_mean [N/m]"] / vu["equivalent_mesh_stiffness_mean [N/m]"]
-    assert 0.15 <= ratio <= 0.35  # paper 2.62e8 / 1.24e9 = 0.21
+    assert ratio == pytest.approx(0.2322, abs=1e-4)  # paper 2.62e8 / 1.24e9 = 0.211
 
 
 def test_outputs_written_with_figures(modified, tmp_path):
@@ -106,7 +116,9 @@ def test_bad_case_names_fields():
 
 @pytest.mark.slow
 def test_li2023_rv_errors_cli(tmp_path):
-    """Full example through the CLI: one output revolution with the Table 3 errors (17.25″)."""
+    """Full example through the CLI: one output revolution with the Table 3 errors. Paper (Fig
+    11b) 17.25″; gearte 13.121″, documented deviation −24 % (docs/validation/li2023.md §2.6: the
+    placement of the errors is not printed); 1e-3 relative, as the model-level test."""
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[1] / "src"))
     subprocess.run(
         [sys.executable, "-m", "gearte", "run", "li2023_rv_errors", "--out", str(tmp_path)],
@@ -116,7 +128,7 @@ def test_li2023_rv_errors_cli(tmp_path):
     )
     d = json.loads((tmp_path / "results.json").read_text())
     v = d["analyses"]["dte"]["values"]
-    assert 5.0 <= v["dte_peak_to_peak [arcsec]"] <= 50.0
+    assert v["dte_peak_to_peak [arcsec]"] == pytest.approx(13.121, rel=1e-3)
     assert v["dominant_dte_source"] == "crank rotation"
 
 

@@ -82,14 +82,14 @@ def test_sweep_table_has_every_scalar_per_point():
     "vary, exc, field",
     [
         ({"demo.colour": "1,2"}, CaseFileError, "demo.colour"),
-        ({"demo.length_mm": "-1:1:3"}, CaseFileError, "demo.length_mm"),
+        ({"demo.length_mm": "-3:-1:3"}, CaseFileError, "demo.length_mm"),  # no valid point
         ({"demo.count": "1:2:3"}, CaseFileError, "demo.count"),  # 1.5 is not a count
         ({"demo.length_mm.x": "1,2"}, ParameterError, "demo.length_mm.x"),
         ({"case.kind": "x"}, ParameterError, "case.kind"),
         ({}, ParameterError, "vary"),
     ],
 )
-def test_bad_keys_and_values_are_clear_errors_before_anything_runs(vary, exc, field):
+def test_bad_keys_and_values_are_clear_errors_when_no_point_is_valid(vary, exc, field):
     with pytest.raises(exc) as err:
         run_sweep(DEMO, vary, progress=False)
     assert field in str(err.value)
@@ -197,3 +197,86 @@ def test_sweep_of_a_bundled_case_centre_distance_tolerance_widens_the_backlash()
         assert b == pytest.approx(a, rel=0.03)
     # the paper's case (±20 µm) sits in the middle of the sweep
     assert r.points[1]["pair.centre_distance_tol_um"] == 20
+
+
+def test_sweep_with_an_invalid_point_finishes_and_lists_it(tmp_path):
+    """Issue 15.5: a point that does not validate is skipped with its reason; the others run,
+    and the table, sweep.json and the index page list it."""
+    r = run_sweep(DEMO, {"demo.length_mm": "-1:1:3"}, progress=False)
+    assert r.statuses == ["invalid", "invalid", "ok"]
+    assert r.errors[0].startswith("invalid case: demo.length_mm")
+    assert r.values[0] == {} and r.values[2]["demo.total_length [mm]"] == pytest.approx(1.5)
+    paths = write_sweep(r, tmp_path / "sw", plots=False)
+    rows = list(csv.DictReader(paths["csv"].open()))
+    assert [row["status"] for row in rows] == ["invalid", "invalid", "ok"]
+    assert "demo.length_mm" in rows[0]["error"]
+    data = json.loads(paths["json"].read_text())
+    assert data["invalid_points"] == 2 and data["points"][0]["status"] == "invalid"
+    page = paths["index"].read_text()
+    assert "2 invalid" in page and "greater than 0" in page
+
+
+def test_index_page_links_every_figure_that_exists(tmp_path):
+    import html.parser
+
+    r = run_sweep(
+        DEMO, {"demo.length_mm": "-1:3:5", "demo.count": "2,3"}, progress=False
+    )  # two invalid rows (-1, 0) beside valid ones
+    paths = write_sweep(r, tmp_path / "sw")
+    assert paths["plots"]
+
+    class Links(html.parser.HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.refs: set[str] = set()
+
+        def handle_starttag(self, tag, attrs):
+            a = dict(attrs)
+            for k in ("href", "src"):
+                if a.get(k) and not a[k].startswith("#"):
+                    self.refs.add(a[k])
+
+    links = Links()
+    links.feed(paths["index"].read_text())
+    out = tmp_path / "sw"
+    on_disk = {str(p.relative_to(out)) for p in (out / "plots").glob("*.png")}
+    assert on_disk and on_disk <= links.refs
+    assert all((out / ref).is_file() for ref in links.refs)  # no dead link
+
+
+def test_coupled_keys_vary_together():
+    v = parse_vary("mc.sigma_mm,mc.offset_mm=1:0,2:0.5")
+    assert v.keys == ("mc.sigma_mm", "mc.offset_mm") and v.rows == ((1, 0), (2, 0.5))
+    r = run_sweep(MC, [v, parse_vary("mc.samples=1000,2000")], seed=3, workers=1, progress=False)
+    # the coupled pair is one axis: 2 x 2 points, not 2 x 2 x 2
+    assert [(p["mc.sigma_mm"], p["mc.offset_mm"], p["mc.samples"]) for p in r.points] == [
+        (1, 0, 1000),
+        (1, 0, 2000),
+        (2, 0.5, 1000),
+        (2, 0.5, 2000),
+    ]
+    assert r.coupled_with("mc.offset_mm") == ("mc.sigma_mm", "mc.offset_mm")
+    assert json.loads(r.to_json())["vary"]["mc.sigma_mm,mc.offset_mm"] == [[1, 0], [2, 0.5]]
+    with pytest.raises(ParameterError, match="2 values"):
+        parse_vary("a,b=1:2,3")
+
+
+def test_points_table_is_one_coupled_axis(tmp_path):
+    from gearte.cli import main
+
+    case = tmp_path / "demo.toml"
+    case.write_text('[case]\nkind = "foundation_test"\n[demo]\nlength_mm = 4.0\n')
+    table = tmp_path / "points.csv"
+    table.write_text("demo.length_mm,demo.count\n1.0,2\n2.0,4\n-1.0,2\n")
+    out = tmp_path / "out"
+    r = CliRunner().invoke(
+        main, ["sweep", str(case), "--points", str(table), "--out", str(out), "--no-progress"]
+    )
+    assert r.exit_code == 0, r.output
+    assert "1 point(s) did not validate" in r.output and "demo.length_mm=-1.0" in r.output
+    data = json.loads((out / "sweep.json").read_text())
+    assert [p["status"] for p in data["points"]] == ["ok", "ok", "invalid"]
+    assert data["points"][1]["values"]["demo.total_length [mm]"] == pytest.approx(4.0)
+    table.write_text("demo.length_mm,demo.count\n1.0\n")
+    r = CliRunner().invoke(main, ["sweep", str(case), "--points", str(table), "--out", str(out)])
+    assert r.exit_code == 2 and "line 2" in r.output

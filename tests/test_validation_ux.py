@@ -84,3 +84,95 @@ def test_rv_dynamics_overlapping_pins_are_refused_by_validate():
     data["reducer"]["pins"]["pin_radius_mm"] = 8.0
     (msg,) = _errors(data).values()
     assert "overlap" in msg
+
+
+def test_three_independent_errors_with_a_cross_section_check_in_one_pass(tmp_path):
+    """Issue 15.6: a field error, an unknown key and a contradiction between sections (the
+    tolerance-weighted compensation needs a tolerance for each factor) are all reported at once:
+    the case-level check runs although another section has field errors."""
+    data = _bundled("hu2020_rv80e_initial")
+    data["stage"]["face_width_mm"] = -1.0
+    data["case"]["titel"] = "typo"
+    data["analyses"]["compensation"]["rule"] = "tolerance_weighted"
+    data["errors"]["pin_radius_error"]["tolerance_um"] = 0.0
+    p = tmp_path / "three.toml"
+    from fuzzing import to_toml
+
+    p.write_text(to_toml(data))
+    r = CliRunner().invoke(main, ["validate", str(p)])
+    assert r.exit_code == EXIT_BAD_INPUT
+    assert "3 error(s)" in r.output, r.output
+    assert "stage.face_width_mm" in r.output
+    assert "case.titel: unknown key; did you mean 'title'?" in r.output
+    assert "'tolerance_weighted' needs tolerance_um > 0" in r.output
+
+
+def test_tooth_relation_negative_tolerance_and_unit_suffix_in_one_pass():
+    """The issue's own example: wrong tooth relation + negative tolerance + unknown key (a unit
+    suffix the schema does not use) in three sections."""
+    data = _bundled("hu2020_rv80e_initial")
+    data["stage"]["cycloid_teeth"] = 38
+    data["errors"]["pin_radius_error"]["tolerance_um"] = -3.0
+    tc = data["analyses"]["tooth_contact"]
+    tc["torque_Nmm"] = tc.pop("torque_Nm") * 1000
+    errors = _errors(data)
+    # the renamed key is both unknown and missing: four lines for the three mistakes
+    assert sorted(errors) == [
+        "analyses.tooth_contact.torque_Nm",
+        "analyses.tooth_contact.torque_Nmm",
+        "errors.pin_radius_error.tolerance_um",
+        "stage",
+    ]
+    assert "must equal z_p - 1 = 39" in errors["stage"]
+    assert "errors.pin_radius_error.tolerance_um" in errors
+    assert "did you mean 'torque_Nm'" in errors["analyses.tooth_contact.torque_Nmm"]
+
+
+def test_rv_check_between_sections_runs_beside_a_field_error():
+    """rv_reducer: an analysis that needs a section the case lacks is reported together with a
+    field error of another section (before: only the field error, then the rest on the next try).
+    """
+    data = _bundled("han2023_rv110e")
+    data["operation"]["input_speed_rpm"] = -5
+    del data["reducer"]["rated_torque_Nm"]
+    errors = _errors(data)
+    assert "operation.input_speed_rpm" in errors
+    assert "needs reducer.rated_torque_Nm" in errors["(case)"]
+
+
+def test_torque_in_Nmm_typed_as_Nm_is_refused_at_validation_with_the_value():
+    """A 500 N·m torque written as 500 000 (N·mm) in ``torque_Nm`` passes the schema range but
+    no steel carries it on the Hu 2020 stage: refused by validate, in the user's units."""
+    data = _bundled("hu2020_rv80e_initial")
+    data["analyses"]["tooth_contact"]["torque_Nm"] = 500_000.0
+    (msg,) = _errors(data).values()
+    assert "500000 N·m is implausible" in msg and "MPa" in msg
+    assert "500000 N·mm = 500 N·m" in msg
+    data["analyses"]["tooth_contact"]["torque_Nm"] = 2000.0  # 2x the paper's: plausible
+    load_case_dict(data)
+
+
+def test_rv_torque_in_Nmm_is_refused_for_each_key_that_holds_it():
+    data = _bundled("li2023_rv")
+    data["operation"]["output_torque_Nm"] *= 1000  # 450 000 "N·m" on an RV-40E-size reducer
+    errors = _errors(data)
+    assert list(errors) == ["operation.output_torque_Nm"]
+    assert "N·mm" in errors["operation.output_torque_Nm"]
+
+
+def test_plausibility_is_checked_beside_field_errors():
+    data = _bundled("li2023_rv")
+    data["operation"]["output_torque_Nm"] *= 1000
+    data["reducer"]["discs"]["face_width_mm"] = True  # a type error in another key
+    errors = _errors(data)
+    assert "reducer.discs.face_width_mm" in errors
+    # the torque check needs the discs (face width): it cannot be judged, so it is not reported
+    assert "operation.output_torque_Nm" not in errors
+
+
+def test_every_bundled_case_is_plausible():
+    from gearte.cases import list_cases
+    from gearte.io.case_file import load_case
+
+    for name in list_cases():
+        load_case(name)

@@ -5,9 +5,10 @@ so ``gearte --help`` answers fast.
 
 Exit codes (docs/errors.md): 0 ok · 1 the analysis failed (non-convergence, divergence) · 2 bad
 input · 3 internal error (a bug: please report it, ``--debug`` shows the traceback) · 4 the outputs
-cannot be written (read-only, disk full, file-size limit, a path under a file) · 130 / 143
-stopped by SIGINT (Ctrl-C) / SIGTERM: previous outputs kept; an interrupted sweep writes the points
-that finished, marked partial.
+cannot be written (read-only, disk full, file-size limit, a path under a file) · 5 the cluster
+was lost mid-run (finished chunks written, marked partial) · 130 / 143 stopped by SIGINT (Ctrl-C)
+/ SIGTERM: previous outputs kept; an interrupted sweep writes the points that finished, an
+interrupted Monte-Carlo its finished chunks, marked partial.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ EXIT_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
 EXIT_OUTPUT = 4
+EXIT_CLUSTER_LOST = 5
 EXIT_SIGINT = 130  # 128 + SIGINT
 EXIT_SIGTERM = 143  # 128 + SIGTERM
 
@@ -56,6 +58,7 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     """Run ``fn`` turning gearte's errors into clean messages and exit codes."""
     from gearte.errors import (
         CaseFileError,
+        ClusterLostError,
         ConvergenceError,
         DivergenceError,
         GearteError,
@@ -72,7 +75,15 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
 
         signum = int(getattr(exc, "signum", signal.SIGINT))
         name = signal.Signals(signum).name
-        _error("interrupted", f"stopped by {name}; nothing written, previous outputs kept")
+        written = getattr(exc, "written", None)
+        if written is not None:
+            _error(
+                "interrupted",
+                f"stopped by {name}: the finished chunks were written to {written}, marked "
+                'partial ("partial": true; its first warning says what was cut)',
+            )
+        else:
+            _error("interrupted", f"stopped by {name}; nothing written, previous outputs kept")
         sys.exit(128 + signum)
     except BrokenPipeError:  # output piped into `head` and closed: not an error of ours
         sys.stderr.close()
@@ -86,6 +97,15 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     except FileNotFoundError as exc:
         _error("not found", str(exc).strip("'\""))
         sys.exit(EXIT_BAD_INPUT)
+    except ClusterLostError as exc:
+        written = getattr(exc, "written", None)
+        kept = (
+            f"the finished chunks were written to {written}, marked partial"
+            if written is not None
+            else "nothing finished was kept; previous outputs kept"
+        )
+        _error("cluster lost", f"{exc}; {kept}")
+        sys.exit(EXIT_CLUSTER_LOST)
     except SchedulerError as exc:
         _error("scheduler", str(exc))
         sys.exit(EXIT_BAD_INPUT)
@@ -107,6 +127,19 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
             "traceback and report it.",
         )
         sys.exit(EXIT_INTERNAL)
+
+
+def _write_partial(exc: BaseException, target: Any) -> None:
+    """A run stopped mid-way (signal, lost cluster) with finished chunks: write them as the
+    output set, ``results.json`` only, marked ``"partial": true``; say so. The exception then
+    propagates to :func:`_guarded` for the exit code."""
+    partial = getattr(exc, "partial", None)
+    if partial is None:
+        return
+    from gearte.report.outputs import write_outputs
+
+    paths = write_outputs(partial, target, report=False)
+    exc.written = paths["results"]  # type: ignore[attr-defined]
 
 
 @contextlib.contextmanager
@@ -191,6 +224,7 @@ def run(
         import time
 
         t0 = time.perf_counter()
+        from gearte.errors import ClusterLostError
         from gearte.io.case_file import load_case
         from gearte.report.outputs import check_output_dir, safe_label, write_outputs
         from gearte.studies import RunOptions, run_case
@@ -208,7 +242,11 @@ def run(
                 scheduler=executor,
                 workers=workers,
             )
-            result = run_case(c, opts)
+            try:
+                result = run_case(c, opts)
+            except (KeyboardInterrupt, ClusterLostError) as exc:
+                _write_partial(exc, target)
+                raise
         result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
         paths = write_outputs(result, target, report=not no_report)
         for w in result.warnings:
@@ -231,10 +269,18 @@ def run(
     "--vary",
     "vary",
     multiple=True,
-    required=True,
     metavar="KEY=START:STOP:N",
     help="A case parameter to vary (dotted path, e.g. stage.eccentricity_mm=1.0:1.6:7, or "
-    "KEY=V1,V2,...). Repeat for a full-factorial grid.",
+    "KEY=V1,V2,...); coupled keys: K1,K2=A1:A2,B1:B2 (the points (A1, A2), (B1, B2)). Repeat "
+    "for a full-factorial grid.",
+)
+@click.option(
+    "--points",
+    "points_file",
+    default=None,
+    metavar="TABLE.csv",
+    help="Coupled points from a CSV table: a header of keys, one row per point (one axis of "
+    "the grid, combined with any --vary).",
 )
 @click.option(
     "--out",
@@ -250,6 +296,7 @@ def run(
 def sweep(
     case: str,
     vary: tuple[str, ...],
+    points_file: str | None,
     out_dir: str | None,
     seed: int | None,
     samples: int | None,
@@ -259,14 +306,20 @@ def sweep(
     no_progress: bool,
     debug: bool,
 ) -> None:
-    """Run CASE over a grid of parameter values; write sweep.csv, sweep.json and plots."""
+    """Run CASE over a grid of parameter values; write sweep.csv, sweep.json, index.html and
+    plots. Points that do not validate are skipped and listed with the reason."""
 
     def _sweep() -> None:
+        from gearte.errors import ParameterError
         from gearte.io.case_file import load_case
         from gearte.report.outputs import check_output_dir, safe_label
-        from gearte.sweep import parse_vary, run_sweep, write_sweep
+        from gearte.sweep import Coupled, Vary, parse_vary, read_points, run_sweep, write_sweep
 
-        varies = [parse_vary(v) for v in vary]
+        varies: list[Vary | Coupled] = [parse_vary(v) for v in vary]
+        if points_file is not None:
+            varies.append(read_points(points_file))
+        if not varies:
+            raise ParameterError("--vary", "", "give at least one --vary KEY=... or --points")
         c = load_case(case)
         default = os.path.join("out", f"sweep_{safe_label(c.case.name or c.case.kind)}")
         target = check_output_dir(out_dir if out_dir is not None else default)
@@ -297,13 +350,21 @@ def sweep(
                 sys.exit(128 + exc.signum)
             raise
         paths = write_sweep(result, target, plots=not no_plots)
-        failed = [e for e in result.errors if e]
         click.echo(
             f"{result.name}: {len(result.points)} points × {len(result.columns)} scalar results "
             f"in {result.elapsed_s:.2f} s ({result.backend})"
         )
-        if failed:
-            click.echo(f"warning: {len(failed)} point(s) failed; see the error column", err=True)
+        statuses = result.statuses
+        for what, label in (("invalid", "did not validate (skipped)"), ("failed", "failed")):
+            bad = [i for i, st in enumerate(statuses) if st == what]
+            if bad:
+                click.echo(f"warning: {len(bad)} point(s) {label}:", err=True)
+                for i in bad[:10]:
+                    where = ", ".join(f"{k}={v!r}" for k, v in result.points[i].items())
+                    click.echo(f"  #{i} {where}: {result.errors[i]}", err=True)
+                if len(bad) > 10:
+                    click.echo(f"  ... {len(bad) - 10} more in {paths['index']}", err=True)
+        click.echo(f"  wrote {paths['index']}")
         click.echo(f"  wrote {paths['csv']}")
         click.echo(f"  wrote {paths['json']}")
         if paths["plots"]:

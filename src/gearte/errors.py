@@ -15,6 +15,7 @@ __all__ = [
     "ConvergenceError",
     "DivergenceError",
     "SchedulerError",
+    "ClusterLostError",
     "BenchFileError",
     "MeasurementFileError",
     "OutputError",
@@ -74,6 +75,28 @@ class DivergenceError(GearteError, RuntimeError):
 
 class SchedulerError(GearteError, ConnectionError):
     """A distributed scheduler could not be reached or failed."""
+
+
+class ClusterLostError(SchedulerError):
+    """The cluster running the chunks was lost mid-run: the scheduler connection closed, or no
+    worker was left for longer than the no-worker timeout. Not bad input: the CLI writes the
+    chunks that finished as a partial result (``partial``) and exits with code 5.
+
+    Parameters
+    ----------
+    reason : str
+        What happened, as seen from this process.
+    partial : any, optional
+        What finished before the loss, marked partial (set by :func:`gearte.studies.run_case`).
+    """
+
+    def __init__(self, reason: str, partial: Any = None) -> None:
+        self.reason = reason
+        self.partial = partial
+        super().__init__(reason)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.reason, self.partial))
 
 
 class OutputError(GearteError):

@@ -12,6 +12,8 @@ budget                     default                  override
 memory of one analysis     4 GB                     ``GEARTE_MAX_MEMORY_GB``
 time of one analysis       3600 s (estimated)       ``GEARTE_MAX_SECONDS``
 points of a sweep          1000                     ``GEARTE_MAX_SWEEP_POINTS``
+Dask cluster with no       300 s, then the cluster  ``GEARTE_NO_WORKER_TIMEOUT_S`` (0: forever)
+worker                     counts as lost
 =========================  =======================  ===========================================
 """
 
@@ -29,10 +31,12 @@ __all__ = [
     "check_memory",
     "check_time",
     "check_sweep_points",
+    "no_worker_timeout_s",
 ]
 
 _DEFAULTS = {"GEARTE_MAX_MEMORY_GB": 4.0, "GEARTE_MAX_SECONDS": 3600.0}
 _DEFAULT_SWEEP_POINTS = 1000
+_DEFAULT_NO_WORKER_S = 300.0
 
 
 def _env_float(name: str, default: float) -> float:
@@ -63,8 +67,34 @@ def max_sweep_points() -> int:
     return int(_env_float("GEARTE_MAX_SWEEP_POINTS", _DEFAULT_SWEEP_POINTS))
 
 
+def no_worker_timeout_s() -> float:
+    """Seconds sampled work waits on a Dask cluster without any worker before the cluster counts
+    as lost [s] (``GEARTE_NO_WORKER_TIMEOUT_S``, default 300; ``0`` waits forever)."""
+    text = os.environ.get("GEARTE_NO_WORKER_TIMEOUT_S", "").strip()
+    if text in ("0", "0.0"):
+        return 0.0
+    return _env_float("GEARTE_NO_WORKER_TIMEOUT_S", _DEFAULT_NO_WORKER_S)
+
+
 def check_memory(field: str, value: Any, nbytes: float, what: str) -> None:
-    """Raise :class:`ParameterError` when ``nbytes`` exceeds the memory budget."""
+    """Raise :class:`ParameterError` when ``nbytes`` exceeds the memory budget.
+
+    Parameters
+    ----------
+    field : str
+        The input the budget check is about (named in the error).
+    value : Any
+        Its value (echoed in the error).
+    nbytes : float
+        Estimated memory need [bytes].
+    what : str
+        What needs it, for the message.
+
+    Raises
+    ------
+    ParameterError
+        Over the budget (``GEARTE_MAX_MEMORY_GB``).
+    """
     limit = max_memory_bytes()
     if nbytes > limit:
         raise ParameterError(
@@ -76,7 +106,24 @@ def check_memory(field: str, value: Any, nbytes: float, what: str) -> None:
 
 
 def check_time(field: str, value: Any, seconds: float, what: str) -> None:
-    """Raise :class:`ParameterError` when an estimated run time exceeds the time budget."""
+    """Raise :class:`ParameterError` when an estimated run time exceeds the time budget.
+
+    Parameters
+    ----------
+    field : str
+        The input the budget check is about (named in the error).
+    value : Any
+        Its value (echoed in the error).
+    seconds : float
+        Estimated run time [s].
+    what : str
+        What takes it, for the message.
+
+    Raises
+    ------
+    ParameterError
+        Over the budget (``GEARTE_MAX_SECONDS``).
+    """
     limit = max_seconds()
     if seconds > limit:
         raise ParameterError(
@@ -88,7 +135,18 @@ def check_time(field: str, value: Any, seconds: float, what: str) -> None:
 
 
 def check_sweep_points(n: int) -> None:
-    """Raise :class:`ParameterError` when a sweep grid has more points than allowed."""
+    """Raise :class:`ParameterError` when a sweep grid has more points than allowed.
+
+    Parameters
+    ----------
+    n : int
+        Number of grid points [-].
+
+    Raises
+    ------
+    ParameterError
+        Over ``GEARTE_MAX_SWEEP_POINTS``.
+    """
     limit = max_sweep_points()
     if n > limit:
         raise ParameterError(

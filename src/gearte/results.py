@@ -33,7 +33,18 @@ def _display() -> ModuleType:
 
 
 def to_jsonable(obj: Any) -> Any:
-    """Convert numpy scalars/arrays, tuples and nested mappings to plain JSON types."""
+    """Convert numpy scalars/arrays, tuples and nested mappings to plain JSON types.
+
+    Parameters
+    ----------
+    obj : Any
+        A result value: numbers, numpy scalars or arrays, sequences, mappings.
+
+    Returns
+    -------
+    Any
+        The same structure in plain JSON types (NaN/inf as ``None``).
+    """
     if isinstance(obj, dict):
         return {str(k): to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
@@ -179,6 +190,9 @@ class StudyResult:
     warnings: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
     timings: dict[str, float] = field(default_factory=dict)
+    #: True when the run was stopped and sampled analyses used only their finished chunks
+    #: (``"partial": true`` in ``results.json``; the first warning says what was cut).
+    partial: bool = False
 
     def __post_init__(self) -> None:
         self._link()
@@ -226,6 +240,7 @@ class StudyResult:
             },
             "references": {k: REFERENCES.get(k, k) for k in self.references},
             "warnings": list(self.warnings) + self._nonfinite_warnings(),
+            **({"partial": True} if self.partial else {}),
             "elapsed [s]": round(self.elapsed_s, 4),
             "timings [s]": {k: round(v, 4) for k, v in self.timings.items()},
             "analyses": {a.name: a.to_dict() for a in self.analyses},

@@ -8,10 +8,16 @@
 
 Each key is a dotted path into the case file (``section.field``; list items by index,
 ``pins.0.radius_mm``). The grid is the full factorial of the varied keys, the first key varying
-slowest. Every point is validated like a case file before anything runs, so a wrong key or an
-out-of-range value is reported at once with its field path. Every point runs with the same seed
-(common random numbers): differences between points come from the parameters, not from sampling
-noise.
+slowest. Keys that must change together (pins and teeth) are *coupled*: ``--vary a,b=1:2,3:4``
+gives the two points (a=1, b=2) and (a=3, b=4) as one axis of the grid, and ``--points
+table.csv`` reads such an axis from a table (one column per key, one row per point).
+
+Every point is validated like a case file before anything runs. A point that does not validate
+(an out-of-range value, a tooth relation that does not hold) is recorded with the validation
+message as its reason and skipped; the others run, and the table, ``sweep.json`` and the index
+page list the skipped points. Only when no point validates (a misspelt key) does the sweep stop
+with the error. Every point runs with the same seed (common random numbers): differences between
+points come from the parameters, not from sampling noise.
 
 Points run through :func:`gearte.execution.map_chunks`: in parallel (one point per worker, each
 point's own sampled work sequential) when there are at least as many points as workers, otherwise
@@ -36,7 +42,16 @@ from typing import Any
 
 from gearte.errors import CaseFileError, GearteError, ParameterError
 
-__all__ = ["Vary", "parse_vary", "grid_points", "SweepResult", "run_sweep", "write_sweep"]
+__all__ = [
+    "Vary",
+    "Coupled",
+    "parse_vary",
+    "read_points",
+    "grid_points",
+    "SweepResult",
+    "run_sweep",
+    "write_sweep",
+]
 
 _NUM_RE = re.compile(r"^[+-]?\d+$")
 
@@ -47,6 +62,32 @@ class Vary:
 
     key: str
     values: tuple[Any, ...]
+
+    @property
+    def keys(self) -> tuple[str, ...]:
+        return (self.key,)
+
+    @property
+    def rows(self) -> tuple[tuple[Any, ...], ...]:
+        return tuple((v,) for v in self.values)
+
+
+@dataclass(frozen=True)
+class Coupled:
+    """Keys varied together: one axis of the grid whose points are the ``rows`` (one value per
+    key, in the order of ``keys``)."""
+
+    keys: tuple[str, ...]
+    rows: tuple[tuple[Any, ...], ...]
+
+    @property
+    def key(self) -> str:
+        """The keys joined by commas (as written after ``--vary``)."""
+        return ",".join(self.keys)
+
+    @property
+    def values(self) -> tuple[tuple[Any, ...], ...]:
+        return self.rows
 
 
 def _parse_scalar(text: str) -> Any:
@@ -97,9 +138,10 @@ def _range_values(key: str, spec: str) -> tuple[Any, ...]:
     return tuple(values)
 
 
-def parse_vary(spec: str) -> Vary:
+def parse_vary(spec: str) -> Vary | Coupled:
     """Parse ``KEY=START:STOP:N`` (``N`` evenly spaced values, ends included) or
-    ``KEY=V1,V2,...`` (explicit values) or ``KEY=VALUE``.
+    ``KEY=V1,V2,...`` (explicit values) or ``KEY=VALUE``; or coupled keys
+    ``K1,K2=A1:A2,B1:B2,...`` (the points (K1=A1, K2=A2), (K1=B1, K2=B2), ...).
 
     Integer ``START``/``STOP`` with integral steps give integers (for counts).
 
@@ -107,6 +149,18 @@ def parse_vary(spec: str) -> Vary:
     (1.0, 1.1, 1.2, 1.3, 1.4, 1.5)
     >>> parse_vary("stage.pins=38,40").values
     (38, 40)
+    >>> parse_vary("stage.pins,stage.cycloid_teeth=38:37,40:39").rows
+    ((38, 37), (40, 39))
+
+    Parameters
+    ----------
+    spec : str
+        The ``--vary`` text.
+
+    Returns
+    -------
+    Vary or Coupled
+        The key (or coupled keys) and its values.
     """
     key, sep, rhs = spec.partition("=")
     key, rhs = key.strip(), rhs.strip()
@@ -114,6 +168,8 @@ def parse_vary(spec: str) -> Vary:
         raise ParameterError(
             "--vary", spec, "expected KEY=START:STOP:N or KEY=V1,V2,... (e.g. demo.x_mm=1:2:5)"
         )
+    if "," in key:
+        return _coupled(key, rhs)
     if ":" in rhs:
         return Vary(key, _range_values(key, rhs))
     values = tuple(_parse_scalar(v) for v in rhs.split(",") if v.strip())
@@ -122,11 +178,83 @@ def parse_vary(spec: str) -> Vary:
     return Vary(key, values)
 
 
-def _as_vary(key: str, spec: Any) -> Vary:
-    if isinstance(spec, Vary):
+def _coupled(key: str, rhs: str) -> Coupled:
+    keys = tuple(k.strip() for k in key.split(","))
+    if any(not k for k in keys):
+        raise ParameterError("--vary", key, "empty key in the coupled keys K1,K2,...")
+    rows = []
+    for item in (i for i in rhs.split(",") if i.strip()):
+        parts = item.split(":")
+        if len(parts) != len(keys):
+            raise ParameterError(
+                f"--vary {key}",
+                item,
+                f"a point of {len(keys)} coupled keys needs {len(keys)} values separated by ':' "
+                f"(e.g. {key}={':'.join(['1'] * len(keys))},{':'.join(['2'] * len(keys))})",
+            )
+        rows.append(tuple(_parse_scalar(p) for p in parts))
+    if not rows:
+        raise ParameterError(f"--vary {key}", rhs, "no points given")
+    return Coupled(keys, tuple(rows))
+
+
+def read_points(path: str | os.PathLike[str]) -> Coupled:
+    """Read coupled points from a CSV table (``--points``): a header of keys, one row per point,
+    e.g.::
+
+        stage.pins,stage.cycloid_teeth
+        38,37
+        40,39
+
+    Values are read as in ``--vary`` (integers, floats, ``true``/``false``, text).
+
+    Parameters
+    ----------
+    path : path
+        The CSV file.
+
+    Raises
+    ------
+    ParameterError
+        The file cannot be read, has no row, an empty key, or a row with a wrong number of
+        values (its line is named).
+    """
+    from gearte.limits import check_sweep_points
+
+    where = f"--points {os.fspath(path)}"
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParameterError("--points", os.fspath(path), f"cannot read: {exc}") from None
+    lines = [row for row in csv.reader(io.StringIO(text)) if any(c.strip() for c in row)]
+    if len(lines) < 2:
+        raise ParameterError(where, len(lines), "needs a header of keys and at least one row")
+    keys = tuple(k.strip() for k in lines[0])
+    if any(not k for k in keys):
+        raise ParameterError(where, lines[0], "empty key in the header")
+    check_sweep_points(len(lines) - 1)
+    rows = []
+    for n, row in enumerate(lines[1:], start=2):
+        if len(row) != len(keys):
+            raise ParameterError(
+                f"{where} line {n}", row, f"has {len(row)} values for {len(keys)} keys"
+            )
+        rows.append(tuple(_parse_scalar(c) for c in row))
+    return Coupled(keys, tuple(rows))
+
+
+def _as_vary(key: str, spec: Any) -> Vary | Coupled:
+    if isinstance(spec, Vary | Coupled):
         return spec
     if isinstance(spec, str):
         return parse_vary(f"{key}={spec}")
+    if "," in key:
+        keys = tuple(k.strip() for k in key.split(","))
+        rows = tuple(tuple(r) for r in spec)
+        bad = [r for r in rows if len(r) != len(keys)]
+        if bad or not rows:
+            raise ParameterError(f"vary[{key!r}]", spec, f"give rows of {len(keys)} values")
+        return Coupled(keys, rows)
     try:
         values = tuple(v.item() if hasattr(v, "item") else v for v in spec)
     except TypeError:
@@ -136,13 +264,22 @@ def _as_vary(key: str, spec: Any) -> Vary:
     return Vary(key, values)
 
 
-def grid_points(vary: Sequence[Vary]) -> list[dict[str, Any]]:
-    """Full-factorial grid, first key varying slowest: ``[{key: value, ...}, ...]``."""
-    keys = [v.key for v in vary]
-    return [
-        dict(zip(keys, combo, strict=True))
-        for combo in itertools.product(*[v.values for v in vary])
-    ]
+def grid_points(vary: Sequence[Vary | Coupled]) -> list[dict[str, Any]]:
+    """Full-factorial grid, first key varying slowest: ``[{key: value, ...}, ...]``; coupled
+    keys form one axis (their rows).
+
+    Parameters
+    ----------
+    vary : sequence of Vary or Coupled
+        The varied keys with their values (:func:`parse_vary`).
+
+    Returns
+    -------
+    list of dict
+        One ``{key: value}`` per grid point.
+    """
+    axes = [[dict(zip(v.keys, row, strict=True)) for row in v.rows] for v in vary]
+    return [{k: x for d in combo for k, x in d.items()} for combo in itertools.product(*axes)]
 
 
 def _set_path(data: dict[str, Any], key: str, value: Any) -> None:
@@ -282,14 +419,17 @@ class SweepResult:
     values : list of dict
         Scalar results of each point (``"analysis.value [unit]"`` → number).
     errors : list of str or None
-        Why a point failed (non-convergence, ...), ``None`` where it ran.
+        Why a point failed (non-convergence, ...) or was skipped (``"invalid case: ..."``, the
+        validation messages), ``None`` where it ran.
+    skipped : list of bool
+        Points that did not validate and were not run.
     """
 
     name: str
     kind: str
     title: str
     source: str
-    vary: list[Vary]
+    vary: list[Vary | Coupled]
     points: list[dict[str, Any]]
     values: list[dict[str, Any]]
     errors: list[str | None]
@@ -301,10 +441,31 @@ class SweepResult:
     #: True when the sweep was interrupted: only the points that finished are here.
     partial: bool = False
     backend: str = ""
+    skipped: list[bool] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if not self.skipped:
+            self.skipped = [False] * len(self.points)
 
     @property
     def keys(self) -> list[str]:
-        return [v.key for v in self.vary]
+        return [k for v in self.vary for k in v.keys]
+
+    def coupled_with(self, key: str) -> tuple[str, ...]:
+        """The keys varied together with ``key`` (itself included)."""
+        for v in self.vary:
+            if key in v.keys:
+                return v.keys
+        return (key,)
+
+    @property
+    def statuses(self) -> list[str]:
+        """``"ok"``, ``"failed"`` (the run stopped: the error says why) or ``"invalid"`` (did not
+        validate, not run) for each point."""
+        return [
+            "invalid" if s else ("failed" if e else "ok")
+            for s, e in zip(self.skipped, self.errors, strict=True)
+        ]
 
     @property
     def columns(self) -> list[str]:
@@ -326,14 +487,16 @@ class SweepResult:
         """The table: varied keys, every scalar result, ``error``."""
         cols = self.columns
         return [
-            {**p, **{c: v.get(c) for c in cols}, "error": e or ""}
-            for p, v, e in zip(self.points, self.values, self.errors, strict=True)
+            {**p, **{c: v.get(c) for c in cols}, "status": st, "error": e or ""}
+            for p, v, e, st in zip(
+                self.points, self.values, self.errors, self.statuses, strict=True
+            )
         ]
 
     def to_csv(self) -> str:
         buf = io.StringIO()
         w = csv.DictWriter(
-            buf, fieldnames=[*self.keys, *self.columns, "error"], lineterminator="\n"
+            buf, fieldnames=[*self.keys, *self.columns, "status", "error"], lineterminator="\n"
         )
         w.writeheader()
         for row in self.rows():
@@ -357,7 +520,10 @@ class SweepResult:
                 "title": self.title,
                 "source": self.source,
             },
-            "vary": {v.key: list(v.values) for v in self.vary},
+            "vary": {
+                v.key: [list(r) for r in v.rows] if isinstance(v, Coupled) else list(v.values)
+                for v in self.vary
+            },
             "partial": self.partial,
             "seed": self.seed,
             "samples": self.samples,
@@ -367,20 +533,24 @@ class SweepResult:
             "constant_columns": [
                 c for c in self.columns if len({repr(v) for v in self.column(c)}) == 1
             ],
+            "invalid_points": sum(self.skipped),
+            "failed_points": sum(1 for s in self.statuses if s == "failed"),
             "points": [
                 {
                     "params": p,
                     "values": to_jsonable(v),
+                    "status": st,
                     "error": e,
                     "warnings": w,
                     "elapsed [s]": round(t, 4),
                 }
-                for p, v, e, w, t in zip(
+                for p, v, e, w, t, st in zip(
                     self.points,
                     self.values,
                     self.errors,
                     self.warnings,
                     self.point_elapsed_s,
+                    self.statuses,
                     strict=True,
                 )
             ],
@@ -394,7 +564,7 @@ class SweepResult:
 
 def run_sweep(
     case: Any,
-    vary: Mapping[str, Any] | Sequence[Vary | str],
+    vary: Mapping[str, Any] | Sequence[Vary | Coupled | str],
     *,
     seed: int | None = None,
     samples: int | None = None,
@@ -410,7 +580,9 @@ def run_sweep(
         The base case.
     vary : mapping or sequence
         ``{"section.field": spec}`` where ``spec`` is ``"START:STOP:N"``, ``"V1,V2,..."`` or a
-        sequence of values; or a sequence of ``"KEY=..."`` strings / :class:`Vary`.
+        sequence of values, or ``{"k1,k2": [(a1, a2), (b1, b2)]}`` / ``{"k1,k2": "a1:a2,b1:b2"}``
+        for coupled keys; or a sequence of ``"KEY=..."`` strings / :class:`Vary` /
+        :class:`Coupled` (:func:`read_points`).
     seed, samples : int, optional
         Override the case's seed and Monte-Carlo sample counts (the same for every point).
     scheduler, workers :
@@ -424,19 +596,21 @@ def run_sweep(
     ParameterError
         A malformed ``vary`` entry, or a key that cannot be set.
     CaseFileError
-        A point does not validate: the message names the field, the value and the point.
+        No point validates: the message names the field, the value and the first point. (Points
+        that do not validate beside others that do are recorded and skipped.)
     """
     from gearte.execution import executor_scope, map_chunks
     from gearte.io.case_file import load_case_dict
     from gearte.studies import get_kind
 
+    varies: list[Vary | Coupled]
     if isinstance(vary, Mapping):
         varies = [_as_vary(k, s) for k, s in vary.items()]
     else:
-        varies = [v if isinstance(v, Vary) else parse_vary(v) for v in vary]
+        varies = [v if isinstance(v, Vary | Coupled) else parse_vary(v) for v in vary]
     if not varies:
         raise ParameterError("vary", vary, "give at least one key to vary")
-    dup = [k for k, n in _count([v.key for v in varies]).items() if n > 1]
+    dup = [k for k, n in _count([k for v in varies for k in v.keys]).items() if n > 1]
     if dup:
         raise ParameterError("vary", dup[0], "key given more than once")
 
@@ -445,16 +619,22 @@ def run_sweep(
     check_sweep_points(math.prod(len(v.values) for v in varies))
     base, source, name = _base_case(case)
     points = grid_points(varies)
-    cases: list[dict[str, Any]] = []
+    cases: dict[int, dict[str, Any]] = {}
+    invalid: dict[int, CaseFileError] = {}
     validated = None
-    for p in points:
+    for i, p in enumerate(points):
         data = _deep_copy(base)
         for k, v in p.items():
             _set_path(data, k, v)
         where = ", ".join(f"{k}={v!r}" for k, v in p.items())
-        validated = load_case_dict(data, source=f"{source} at {where}")
-        cases.append(data)
-    assert validated is not None
+        try:
+            validated = load_case_dict(data, source=f"{source} at {where}")
+        except CaseFileError as exc:  # recorded and skipped (issue 15.5)
+            invalid[i] = exc
+            continue
+        cases[i] = data
+    if validated is None:  # nothing to run: a wrong key, or every value out of range
+        raise invalid[0]
     from gearte.studies import check_samples_override
 
     check_samples_override(validated, samples)
@@ -469,11 +649,11 @@ def run_sweep(
     try:
         with executor_scope(scheduler, workers) as ex:
             backend = ex.name
-            by_points = len(points) >= ex.workers or ex.workers == 1
+            by_points = len(cases) >= ex.workers or ex.workers == 1
             inner: dict[str, Any] = {"progress": False, "seed": seed, "samples": samples}
             if by_points:
                 inner |= {"scheduler": None, "workers": 1}
-                tasks = [(i, c, kind, kind_module, inner) for i, c in enumerate(cases)]
+                tasks = [(i, c, kind, kind_module, inner) for i, c in cases.items()]
                 map_chunks(
                     _run_point,
                     tasks,
@@ -484,10 +664,19 @@ def run_sweep(
                 )
             else:  # few points: one after another, each spreading its samples over the workers
                 inner |= {"scheduler": ex, "workers": workers}
-                for i, c in enumerate(cases):
+                for i, c in cases.items():
                     done[i] = _run_point((i, c, kind, kind_module, inner))
     except KeyboardInterrupt as exc:  # keep what finished, marked partial
         interrupted = exc
+    for i, bad in invalid.items():
+        reason = "; ".join(f"{f}: {m}" for f, m in bad.errors)
+        done[i] = {
+            "index": i,
+            "values": {},
+            "error": f"invalid case: {reason}",
+            "warnings": [],
+            "elapsed": 0.0,
+        }
     order = sorted(done)
     out = [done[i] for i in order]
     result = SweepResult(
@@ -506,6 +695,7 @@ def run_sweep(
         point_elapsed_s=[o["elapsed"] for o in out],
         backend=f"{backend} ({'points' if by_points else 'samples'} in parallel)",
         partial=interrupted is not None,
+        skipped=[i in invalid for i in order],
     )
     if interrupted is not None:
         from gearte.errors import Interrupted
@@ -525,29 +715,54 @@ def _count(items: Sequence[str]) -> dict[str, int]:
 def write_sweep(
     result: SweepResult, out_dir: str | os.PathLike[str], *, plots: bool = True
 ) -> dict[str, Any]:
-    """Write ``sweep.csv``, ``sweep.json`` and (unless ``plots=False``) under ``plots/`` one PNG
-    per scalar result that varies over the sweep, with one panel per varied key. Figures are
-    rendered before any file is written.
+    """Write ``sweep.csv``, ``sweep.json``, ``index.html`` and (unless ``plots=False``) under
+    ``plots/`` one PNG per scalar result that varies over the sweep, with one panel per varied
+    key. The index page links every figure and lists the points that were skipped as invalid or
+    failed, with their reasons. Figures are rendered before any file is written.
+
+    Parameters
+    ----------
+    result : SweepResult
+        The sweep.
+    out_dir : str or os.PathLike
+        Output folder (created).
+    plots : bool
+        Also write the PNG figures.
 
     Returns
     -------
     dict
-        ``{"csv": path, "json": path, "plots": [paths]}``.
+        ``{"csv": path, "json": path, "index": path, "plots": [paths]}``.
     """
+    from gearte.plotting.sweep import varying_columns
+    from gearte.report.sweep_page import sweep_index_html
+
     rendered: dict[str, bytes] = {}
+    listed: list[tuple[str, str, str]] = []
     if plots:
         from gearte.plotting.sweep import figures
 
         for stem, fig in figures(result):
+            name, n = f"plots/{stem}.png", 1
+            while name in rendered:  # two results with the same safe file name
+                n += 1
+                name = f"plots/{stem}_{n}.png"
             buf = io.BytesIO()
             fig.fig.savefig(buf, format="png", dpi=100)
-            rendered[f"plots/{stem}.png"] = buf.getvalue()
+            rendered[name] = buf.getvalue()
+            listed.append((name, fig.title, fig.caption))
     from gearte.report.outputs import write_file_set
 
-    files = {"sweep.csv": result.to_csv().encode(), "sweep.json": result.to_json().encode()}
+    page = sweep_index_html(result, listed, varying=varying_columns(result), plots=plots)
+    files = {
+        "sweep.csv": result.to_csv().encode(),
+        "sweep.json": result.to_json().encode(),
+        "index.html": page.encode(),
+    }
     written = write_file_set(out_dir, {**files, **rendered})
     return {
         "csv": written["sweep.csv"],
         "json": written["sweep.json"],
+        "index": written["index.html"],
         "plots": [written[k] for k in rendered],
     }

@@ -90,7 +90,21 @@ def joint_transmission_error(
     """Transmission error of stages in series at the chain's output [rad].
 
     ``Σ_k f_k TE_k(θ / f_k)`` over the stages with a TE model (:func:`joint_te_contributions`);
-    the others count as exact. Parameters as there.
+    the others count as exact.
+
+    Parameters
+    ----------
+    drives : sequence of Drive or None
+        Motor side first; ``None`` for a stage that is not a drive.
+    ratios : sequence of float
+        Each stage's reduction i = ω_in / ω_out [-] (> 0).
+    joint_angle : array_like
+        Output angles of the last stage [rad].
+
+    Returns
+    -------
+    numpy.ndarray
+        Sum of the stages' TE at the output [rad], shaped like ``joint_angle``.
     """
     th = np.asarray(joint_angle, dtype=float)
     total = np.zeros_like(th)

@@ -23,7 +23,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 from urllib.parse import urlsplit
 
-from gearte.errors import ParameterError, SchedulerError
+from gearte.errors import ClusterLostError, ParameterError, SchedulerError
 from gearte.execution.streams import default_workers
 
 __all__ = [
@@ -107,6 +107,11 @@ class Batch:
         """Cancel unfinished chunks (after a failure or an interrupt)."""
         self.pending.clear()
 
+    def finished(self) -> list[tuple[int, Any]]:
+        """Chunks already finished but not handed back yet, without waiting (after a stop, to
+        keep what is done); ``[]`` where that cannot be known without waiting."""
+        return []
+
 
 class _SequentialBatch(Batch):
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
@@ -172,6 +177,14 @@ class _PoolBatch(Batch):
         self._jobs.clear()
         super().cancel()
 
+    def finished(self) -> list[tuple[int, Any]]:
+        out = []
+        for f, index in list(self.pending.items()):
+            if f.done() and not f.cancelled() and f.exception() is None:
+                out.append((index, f.result()))
+                del self.pending[f]
+        return out
+
 
 class PoolExecutor(ChunkExecutor):
     """A local pool of threads (``kind="threads"``) or processes (``kind="processes"``).
@@ -206,7 +219,7 @@ class PoolExecutor(ChunkExecutor):
             return cf.ThreadPoolExecutor(self.workers, thread_name_prefix="gearte")
         methods = multiprocessing.get_all_start_methods()
         ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
-        return cf.ProcessPoolExecutor(self.workers, mp_context=ctx)
+        return cf.ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_worker_init)
 
     def _restart(self, generation: int) -> None:
         """Replace the broken pool of ``generation`` (once, whichever batch notices first)."""
@@ -228,6 +241,15 @@ class PoolExecutor(ChunkExecutor):
 
     def close(self) -> None:
         _shutdown_pool(self._pool, self.shutdown_timeout_s)
+
+
+def _worker_init() -> None:
+    """Runs first in every local worker process: ignore SIGINT. Ctrl-C in a terminal reaches the
+    whole process group; the main process stops the work and shuts the pool down, and workers
+    must not print a ``KeyboardInterrupt`` traceback each."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _shutdown_pool(pool: cf.Executor, timeout_s: float) -> None:
@@ -358,6 +380,11 @@ class DaskExecutor(ChunkExecutor):
         scheduler regardless (up to ``distributed.scheduler.allowed-failures`` times).
     connect_timeout_s : float
         How long to wait for the scheduler.
+    no_worker_timeout_s : float, optional
+        Seconds chunks may wait on a cluster without any worker before the cluster counts as
+        lost (:class:`~gearte.errors.ClusterLostError`; finished chunks are kept inside
+        :func:`gearte.studies.run_case`); ``0`` waits forever. Default: the environment
+        variable ``GEARTE_NO_WORKER_TIMEOUT_S`` or 300 s (queued HPC workers may need more).
     check_versions : bool
         Check that every worker imports the same gearte version as this process.
 
@@ -378,8 +405,14 @@ class DaskExecutor(ChunkExecutor):
         *,
         retries: int = 0,
         connect_timeout_s: float = CONNECT_TIMEOUT_S,
+        no_worker_timeout_s: float | None = None,
         check_versions: bool = True,
     ) -> None:
+        if no_worker_timeout_s is None:
+            from gearte.limits import no_worker_timeout_s as _default
+
+            no_worker_timeout_s = _default()
+        self.no_worker_timeout_s = float(no_worker_timeout_s)
         distributed = _import_distributed()
         self._owned: list[Any] = []
         self._workers, self._workers_at = 1, -math.inf
@@ -402,6 +435,11 @@ class DaskExecutor(ChunkExecutor):
                 self._owned.append(cluster)
                 self.client = distributed.Client(cluster, set_as_default=False)
                 self._owned.insert(0, self.client)
+                # Ctrl-C in a terminal reaches the local workers too: they ignore it (also
+                # workers the nannies restart), this process stops the work and the cluster.
+                from gearte.execution._dask_plugins import IgnoreSigint
+
+                self.client.register_plugin(IgnoreSigint(), name="gearte-ignore-sigint")
             elif isinstance(scheduler, str):
                 _probe_tcp(scheduler, connect_timeout_s)
                 self.client = _connect(distributed, scheduler, connect_timeout_s)
@@ -484,11 +522,39 @@ class _DaskBatch(Batch):
         else:
             self._ac.add(fut)
 
+    def _wait_ready(self) -> None:
+        """Wait for a finished chunk, watching the cluster: no worker for longer than
+        ``no_worker_timeout_s`` (or no scheduler) is a lost cluster, not an endless wait."""
+        ex, ac = self._ex, self._ac
+        checked, alone_since = time.monotonic(), None
+        cond = getattr(ac, "thread_condition", None)
+        while not ac.has_ready() and not ac.is_empty():
+            if cond is not None:
+                with cond:
+                    cond.wait(timeout=0.1)
+            else:  # pragma: no cover - other distributed versions
+                time.sleep(0.1)
+            now = time.monotonic()
+            if ex.no_worker_timeout_s <= 0 or now - checked < 1.0:
+                continue
+            checked = now
+            if ex.client.nthreads():
+                alone_since = None
+                continue
+            alone_since = now if alone_since is None else alone_since
+            if now - alone_since > ex.no_worker_timeout_s:
+                raise ClusterLostError(
+                    f"the Dask cluster has had no worker for {ex.no_worker_timeout_s:g} s "
+                    f"with {len(self.pending)} chunk(s) waiting (workers killed or gone; "
+                    "GEARTE_NO_WORKER_TIMEOUT_S sets the wait, 0 waits forever)"
+                )
+
     def next_done(self) -> list[tuple[int, Any]]:
         distributed = _import_distributed()
         from distributed.comm import CommClosedError
 
         try:
+            self._wait_ready()
             batch = self._ac.next_batch(block=True)
             results = self._ex.client.gather(batch)
         except distributed.KilledWorker as exc:
@@ -496,13 +562,22 @@ class _DaskBatch(Batch):
                 f"a chunk killed its Dask workers repeatedly ({exc}); it likely runs out of "
                 "memory or crashes the interpreter — try a smaller chunk size"
             ) from None
-        except CommClosedError as exc:
-            raise SchedulerError(f"lost the connection to the Dask scheduler ({exc})") from None
+        except (CommClosedError, OSError) as exc:
+            raise ClusterLostError(f"lost the connection to the Dask scheduler ({exc})") from None
         except distributed.client.FutureCancelledError as exc:
             raise SchedulerError(f"the Dask scheduler cancelled a chunk ({exc})") from None
         out = [(self.pending.pop(f), r) for f, r in zip(batch, results, strict=True)]
         for fut in batch:
             fut.release()
+        return out
+
+    def finished(self) -> list[tuple[int, Any]]:
+        out = []
+        for f, index in list(self.pending.items()):
+            if f.status == "finished":
+                with contextlib.suppress(Exception):  # a lost cluster: keep what can be had
+                    out.append((index, f.result(timeout=2.0)))
+                    del self.pending[f]
         return out
 
     def cancel(self) -> None:
@@ -536,7 +611,7 @@ def open_executor(
     retries : int
         Dask only: extra attempts of a chunk that raised.
     connect_timeout_s : float
-        Dask only: seconds to wait for the scheduler before :class:`SchedulerError`.
+        Dask only: time to wait for the scheduler before :class:`SchedulerError` [s].
 
     Raises
     ------

@@ -6,9 +6,10 @@ import re
 from collections.abc import Callable, Iterable
 from typing import Any, TypeVar
 
-from gearte.errors import ParameterError
-from gearte.execution.backends import ChunkExecutor, open_executor
+from gearte.errors import ClusterLostError, ParameterError
+from gearte.execution.backends import ChunkExecutor, SequentialExecutor, open_executor
 from gearte.execution.progress import ChunkProgress
+from gearte.execution.stop import current_stop_scope
 
 __all__ = ["map_chunks"]
 
@@ -89,6 +90,12 @@ def map_chunks(
     Results are combined in task order whatever the order chunks finish in, so floating-point
     reductions give the same bits on every backend and worker count. A failing chunk cancels the
     others and its exception propagates unchanged.
+
+    Inside :func:`gearte.execution.stop.keep_finished_chunks` (every
+    :func:`gearte.studies.run_case`), a stop — SIGINT/SIGTERM or
+    :class:`~gearte.errors.ClusterLostError` — after at least one chunk finished returns the
+    result of the finished prefix of chunks instead of raising, and later calls run their first
+    chunk only, in this thread; the scope records both (:mod:`gearte.execution.stop`).
     """
     if options is not None:
         workers = getattr(options, "workers", None) if workers is None else workers
@@ -101,6 +108,11 @@ def map_chunks(
     total = len(tasks) if hasattr(tasks, "__len__") else None  # type: ignore[arg-type]
     keep = reduce is None and on_result is None
     label = re.sub(r"[^A-Za-z0-9_.]+", "_", description).strip("_") or "chunk"
+    scope = current_stop_scope()
+    if scope is not None and scope.stopped:  # the run was stopped: first chunk only, here
+        tasks = list(_first(tasks))
+        scheduler, progress = SequentialExecutor(), False
+        scope.cut.append(f"{description}: first chunk only, of {total or '?'} (after the stop)")
 
     owned = not isinstance(scheduler, ChunkExecutor)
     executor = open_executor(scheduler, workers, retries=retries)
@@ -122,6 +134,23 @@ def map_chunks(
         buffer: dict[int, Any] = {}
         frontier = 0  # index of the next result to hand back
         submitted = 0
+        reducing = False  # an interrupt inside reduce/on_result may leave `acc` half-updated
+
+        def hand_back() -> None:
+            """Reduce / keep / report the results that are next in task order."""
+            nonlocal frontier, acc, reducing
+            while frontier in buffer:
+                reducing = True
+                result = buffer.pop(frontier)
+                if keep:
+                    results.append(result)
+                if reduce is not None:
+                    acc = result if acc is _NOTHING else reduce(acc, result)
+                if on_result is not None:
+                    on_result(frontier, result)
+                frontier += 1
+                reducing = False
+
         it = iter(tasks)
         exhausted = False
         with ChunkProgress(total, description, bool(progress)) as bar:
@@ -141,18 +170,22 @@ def map_chunks(
                     for index, result in batch.next_done():
                         buffer[index] = result
                         bar.advance()
-                    while frontier in buffer:
-                        result = buffer.pop(frontier)
-                        if keep:
-                            results.append(result)
-                        if reduce is not None:
-                            acc = result if acc is _NOTHING else reduce(acc, result)
-                        if on_result is not None:
-                            on_result(frontier, result)
-                        frontier += 1
-            except BaseException:
+                    hand_back()
+            except BaseException as exc:
+                stop = isinstance(exc, KeyboardInterrupt | ClusterLostError)
+                if not (stop and scope is not None and not scope.stopped) or reducing:
+                    batch.cancel()  # (an interrupt inside reduce: `acc` may be half-updated)
+                    raise
+                for index, result in batch.finished():  # keep what is done, not waited for
+                    buffer[index] = result
                 batch.cancel()
-                raise
+                hand_back()
+                if frontier == 0:  # nothing finished: nothing to keep
+                    raise
+                scope.cause = exc
+                scope.cut.append(
+                    f"{description}: {frontier} of {total or '?'} chunks finished and kept"
+                )
     finally:
         if owned:
             executor.close()
@@ -161,3 +194,9 @@ def map_chunks(
     if reduce is not None:
         return None if acc is _NOTHING else acc
     return None
+
+
+def _first(tasks: Iterable[T]) -> Iterable[T]:
+    for task in tasks:
+        yield task
+        return

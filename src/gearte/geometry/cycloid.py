@@ -80,6 +80,10 @@ def short_width_coefficient(z_p: int, r_p: float, a: float, dr_p: float = 0.0) -
     --------
     >>> round(short_width_coefficient(40, 76.0, 1.5, -0.0437), 5)
     0.78993
+
+    References
+    ----------
+    Hu et al. (2020) eq 3, doi:10.3390/app10020481.
     """
     return a * z_p / (r_p + dr_p)
 
@@ -162,6 +166,15 @@ def theoretical_profile_xy(
         Pin-centre-circle radius used [mm].
     a : float
         Eccentricity [mm].
+
+    Returns
+    -------
+    x, y : numpy.ndarray
+        Pin-centre path [mm] in the disc frame.
+
+    References
+    ----------
+    Hu et al. (2020) eq 1–2, doi:10.3390/app10020481.
     """
     phi = np.asarray(phi, dtype=float)
     i_h = z_p / (z_p - 1)
@@ -225,6 +238,10 @@ def profile_xy(
     >>> x, y = profile_xy(0.0, z_p=40, r_p=76.0, r_rp=3.0, a=1.5, dr_rp=-0.022, dr_p=-0.0437)
     >>> round(float(np.hypot(x, y)), 4)
     71.4783
+
+    References
+    ----------
+    Hu et al. (2020) eq 1–3, doi:10.3390/app10020481.
     """
     phi = np.asarray(phi, dtype=float)
     R = r_p + dr_p
@@ -247,12 +264,54 @@ def profile_xy(
 
 
 def root_radius(r_p: float, r_rp: float, a: float, dr_rp: float = 0.0, dr_p: float = 0.0) -> float:
-    """Root radius of the modified disc, R − a − r [mm] (eq 1–2 at φ = 0)."""
+    """Root radius of the modified disc, R − a − r [mm] (eq 1–2 at φ = 0).
+
+    Parameters
+    ----------
+    r_p : float
+        Pin-centre-circle radius r_p [mm].
+    r_rp : float
+        Pin radius r_rp [mm].
+    a : float
+        Eccentricity a [mm].
+    dr_rp, dr_p : float
+        Equidistant Δr_rp and shifted Δr_p modifications [mm].
+
+    Returns
+    -------
+    float
+        R − a − r [mm] with R = r_p + Δr_p, r = r_rp + Δr_rp.
+
+    References
+    ----------
+    Hu et al. (2020) eq 1–2, doi:10.3390/app10020481.
+    """
     return (r_p + dr_p) - a - (r_rp + dr_rp)
 
 
 def tip_radius(r_p: float, r_rp: float, a: float, dr_rp: float = 0.0, dr_p: float = 0.0) -> float:
-    """Tip radius of the modified disc, R + a − r [mm] (eq 1–2 at φ = π)."""
+    """Tip radius of the modified disc, R + a − r [mm] (eq 1–2 at φ = π).
+
+    Parameters
+    ----------
+    r_p : float
+        Pin-centre-circle radius r_p [mm].
+    r_rp : float
+        Pin radius r_rp [mm].
+    a : float
+        Eccentricity a [mm].
+    dr_rp, dr_p : float
+        Equidistant Δr_rp and shifted Δr_p modifications [mm].
+
+    Returns
+    -------
+    float
+        R + a − r [mm] with R = r_p + Δr_p, r = r_rp + Δr_rp.
+
+    References
+    ----------
+    Hu et al. (2020) eq 1–2, doi:10.3390/app10020481.
+    """
     return (r_p + dr_p) + a - (r_rp + dr_rp)
 
 
@@ -290,6 +349,10 @@ def curvature_radius(
     r = r_rp + Δr_rp: gearte evaluates the curvature of the profile actually ground (the paper
     prints r_p, r_rp; the difference is ≈ 0.03 mm on 43.6 mm for Table 3). At φ0 = arccos K1 it
     reduces to ``ρ(φ0) = −R (1 − K1²)^½ + r``.
+
+    References
+    ----------
+    Hu et al. (2020) eq 40, doi:10.3390/app10020481.
     """
     phi = np.asarray(phi, dtype=float)
     R, r = geometry_radii(r_p, r_rp, dr_rp, dr_p, k1_definition)
@@ -304,6 +367,20 @@ def min_convex_curvature_radius(z_p: int, R: float, a: float) -> float:
 
     The disc is free of undercut (no loop or cusp) when the grinding pin radius r is smaller than
     this value (first-order undercut condition of cycloid gearing).
+
+    Parameters
+    ----------
+    z_p : int
+        Number of pins [-].
+    R : float
+        Pin-centre-circle radius of the path, r_p + Δr_p [mm].
+    a : float
+        Eccentricity [mm].
+
+    Returns
+    -------
+    float
+        min |ρ| over the convex part of the path [mm] (``inf`` if it has none).
     """
     K1 = a * z_p / R
     phi = np.linspace(0.0, np.pi, 4001)
@@ -319,6 +396,26 @@ def normal_arm(phi: ArrayLike, *, z_p: int, a: float, K1: float) -> np.ndarray:
     """Arm of the contact normal about the disc centre, l = r_c sin φ / S [mm] (eq 36).
 
     r_c = a z_c is the cycloid pitch radius; l is largest, = r_c, at φ0 = arccos K1.
+
+    Parameters
+    ----------
+    phi : array_like
+        Meshing phase φ [rad].
+    z_p : int
+        Number of pins [-] (z_c = z_p − 1).
+    a : float
+        Eccentricity [mm].
+    K1 : float
+        Short-width coefficient [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        l(φ) [mm], signed like sin φ.
+
+    References
+    ----------
+    Hu et al. (2020) eq 36, doi:10.3390/app10020481.
     """
     phi = np.asarray(phi, dtype=float)
     return a * (z_p - 1) * np.sin(phi) / _S(K1, phi)
@@ -339,8 +436,33 @@ def normal_clearance_unclosed(
 
     ``Δ_n(φ) = Δr_rp − Δr_p (1 − K1 cos φ)/S + l(φ) δ_rot`` — the normal distance between the
     modified profile and a nominal pin (radius r_rp on radius r_p) at the disc's nominal position,
-    the same on both flanks (the profile is symmetric about φ = 0). ``k1_definition`` as in
-    :func:`geometry_radii`.
+    the same on both flanks (the profile is symmetric about φ = 0).
+
+    Parameters
+    ----------
+    phi : array_like
+        Meshing phase φ [rad].
+    z_p : int
+        Number of pins [-].
+    r_p : float
+        Pin-centre-circle radius [mm].
+    a : float
+        Eccentricity [mm].
+    dr_rp, dr_p : float
+        Equidistant Δr_rp and shifted Δr_p modifications [mm].
+    rotation : float
+        Rotation modification δ_rot [rad].
+    k1_definition : {"ground", "nominal"}
+        K1 from the ground or the nominal pin circle, as in :func:`geometry_radii`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Δ_n(φ) [mm].
+
+    References
+    ----------
+    Hu et al. (2020) eq 32 (its unclosed part), doi:10.3390/app10020481.
     """
     phi = np.asarray(phi, dtype=float)
     K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
@@ -363,13 +485,52 @@ def closing_rotation(
 
     β0 = Δ_n(φ0) / r_c = (Δr_rp − Δr_p (1 − K1²)^½)/(a z_c) + δ_rot. Negative when the nominal
     modification leaves no backlash (the disc is then preloaded on both flanks).
+
+    Parameters
+    ----------
+    z_p : int
+        Number of pins [-].
+    r_p : float
+        Pin-centre-circle radius [mm].
+    a : float
+        Eccentricity [mm].
+    dr_rp, dr_p : float
+        Equidistant Δr_rp and shifted Δr_p modifications [mm].
+    rotation : float
+        Rotation modification δ_rot [rad].
+    k1_definition : {"ground", "nominal"}
+        K1 from the ground or the nominal pin circle, as in :func:`geometry_radii`.
+
+    Returns
+    -------
+    float
+        β0 [rad].
+
+    References
+    ----------
+    Hu et al. (2020) eq 32–34, doi:10.3390/app10020481.
     """
     K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
     return (dr_rp - dr_p * math.sqrt(1.0 - K1 * K1)) / (a * (z_p - 1)) + rotation
 
 
 def first_contact_phase(K1: float) -> float:
-    """φ0 = arccos K1 [rad]: where the initial clearance is zero and the arm is r_c (eq 33–34)."""
+    """φ0 = arccos K1 [rad]: where the initial clearance is zero and the arm is r_c (eq 33–34).
+
+    Parameters
+    ----------
+    K1 : float
+        Short-width coefficient [-], 0 < K1 < 1.
+
+    Returns
+    -------
+    float
+        φ0 [rad].
+
+    References
+    ----------
+    Hu et al. (2020) eq 33–34, doi:10.3390/app10020481.
+    """
     return math.acos(K1)
 
 
@@ -415,6 +576,10 @@ def initial_clearance(
     It equals Δ_n(φ) − (l(φ)/r_c) Δ_n(φ0): the unclosed normal clearance minus what the closing
     rotation β0 = Δ_n(φ0)/r_c takes up. A rotation modification adds l(φ) δ_rot to Δ_n and the
     same to the closing rotation, so it cancels here. Δ(φ0) = 0 at φ0 = arccos K1 (eq 33–34).
+
+    References
+    ----------
+    Hu et al. (2020) eq 32–34, doi:10.3390/app10020481.
     """
     phi = np.asarray(phi, dtype=float)
     K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
@@ -457,6 +622,10 @@ def envelope_gaps(
     -------
     numpy.ndarray, shape (n, z_p) or (n, m)
         Gap [mm] (negative: overlap).
+
+    References
+    ----------
+    Hu et al. (2020) eq 1–3 (the profile whose gaps are measured), doi:10.3390/app10020481.
     """
     theta = np.atleast_1d(np.asarray(mesh_angle, dtype=float))
     beta = np.broadcast_to(np.asarray(beta, dtype=float), theta.shape)
@@ -510,6 +679,10 @@ def envelope_clearance(stage: CycloidStage, mesh_angle: ArrayLike = 0.0) -> np.n
     -------
     numpy.ndarray, shape (n, z_p)
         Clearance [mm].
+
+    References
+    ----------
+    Hu et al. (2020) eq 32–34 (the closing convention), doi:10.3390/app10020481.
     """
     theta = np.atleast_1d(np.asarray(mesh_angle, dtype=float))
     phi0 = np.full((theta.shape[0], 1), stage.phi0)

@@ -131,6 +131,22 @@ def iso6336_mesh_stiffness(face_width: float, c_gamma: float = 20.0) -> float:
     """Mean involute mesh stiffness [N/mm] = ``c_gamma`` [N/(mm·µm)] × face width [mm] × 1000.
 
     ISO 6336-1:2019, 9.3 gives ``c_gamma ≈ 20 N/(mm·µm)`` for solid steel spur gears.
+
+    Parameters
+    ----------
+    face_width : float
+        Face width of the mesh [mm].
+    c_gamma : float
+        Mesh stiffness per face width [N/(mm·µm)].
+
+    Returns
+    -------
+    float
+        Mean mesh stiffness [N/mm].
+
+    References
+    ----------
+    ISO 6336-1:2019, clause 9.3.
     """
     if face_width <= 0:
         raise ParameterError("face_width", face_width, "must be > 0 mm")

@@ -492,6 +492,18 @@ def _check_positions(t: _Table, j: int, pos: np.ndarray) -> None:
 def read_te_folder(path: str | os.PathLike, pattern: str = "*.csv") -> list[TETrace]:
     """Read every TE trace of a folder (one file per operating point), sorted by file name.
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The folder.
+    pattern : str
+        Glob of the trace files in it.
+
+    Returns
+    -------
+    list of TETrace
+        One trace per file, sorted by file name.
+
     Raises
     ------
     BenchFileError
@@ -513,6 +525,11 @@ _BRANCH_WORDS = {"ascending": 1, "descending": -1, "loading": 2, "unloading": -2
 
 def read_hysteresis(path: str | os.PathLike) -> HysteresisCurve:
     """Read a hysteresis curve (output torque against output torsion angle, input locked).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file.
 
     Returns
     -------
@@ -609,7 +626,19 @@ def _fmt(a: np.ndarray) -> np.ndarray:
 def write_te_trace(
     path: str | os.PathLike, trace: TETrace, *, unit_position: str = "deg", unit_te: str = "arcsec"
 ) -> None:
-    """Write a :class:`TETrace` in the layout :func:`read_te_trace` reads (round-trip exact)."""
+    """Write a :class:`TETrace` in the layout :func:`read_te_trace` reads (round-trip exact).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file to write.
+    trace : TETrace
+        Positions [rad] and TE [rad] (written in the units below).
+    unit_position : str
+        Unit of the position column (e.g. ``"deg"``).
+    unit_te : str
+        Unit of the TE column (e.g. ``"arcsec"``).
+    """
     fp, ft = _ANGLE_UNITS[unit_position], _ANGLE_UNITS[unit_te]
     head = []
     if trace.serial:
@@ -639,7 +668,19 @@ def write_hysteresis(
     with_branch: bool = True,
 ) -> None:
     """Write a :class:`HysteresisCurve` (torque in N·m) in the layout :func:`read_hysteresis`
-    reads."""
+    reads.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file to write.
+    curve : HysteresisCurve
+        Torque [N·mm] and angle [rad] (written as N·m and ``unit_angle``).
+    unit_angle : str
+        Unit of the angle column (a unit :func:`read_hysteresis` reads, e.g. ``"arcmin"``).
+    with_branch : bool
+        Write the ``branch`` column (+1 / −1) when the curve has one.
+    """
     fa = _ANGLE_UNITS[unit_angle]
     names = ["torque [N·m]", f"angle [{unit_angle}]"]
     cols = [_fmt(curve.torque / float(Nm_to_Nmm(1.0))), _fmt(curve.angle / fa)]

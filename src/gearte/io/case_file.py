@@ -154,7 +154,20 @@ def did_you_mean(key: str, known: set[str]) -> str:
 
 def format_validation_errors(exc: Any, root: Any = None) -> list[tuple[str, str]]:
     """Turn a pydantic ``ValidationError`` into ``(field, message)`` pairs, one per problem;
-    with ``root`` (the ``Case`` class), unknown keys get a "did you mean" hint."""
+    with ``root`` (the ``Case`` class), unknown keys get a "did you mean" hint.
+
+    Parameters
+    ----------
+    exc : pydantic.ValidationError
+        The validation error.
+    root : type, optional
+        The ``Case`` class the input was validated against (for "did you mean" hints).
+
+    Returns
+    -------
+    list of (str, str)
+        ``(dotted field, message)`` pairs.
+    """
     out: list[tuple[str, str]] = []
     for err in exc.errors(include_url=False):
         loc = ".".join(str(p) for p in _user_loc(root, tuple(err.get("loc", ())))) or "(case)"
@@ -231,10 +244,86 @@ def load_case_dict(
     module = get_kind(kind)
     if name is not None and "name" not in meta:
         data = {**data, "case": {**meta, "name": name}}
+    context = {"case_dir": base_dir}
     try:
-        return module.Case.model_validate(data, context={"case_dir": base_dir})
+        case = module.Case.model_validate(data, context=context)
     except ValidationError as exc:
-        raise CaseFileError(source, format_validation_errors(exc, module.Case)) from None
+        errors = format_validation_errors(exc, module.Case)
+        errors += _checks_beside_errors(module.Case, kind, data, context, exc)
+        raise CaseFileError(source, errors) from None
+    from gearte.io.plausibility import plausibility_problems
+
+    problems = plausibility_problems(kind, case)
+    if problems:
+        raise CaseFileError(source, problems)
+    return case
+
+
+class _NotValidated(Exception):
+    """A cross-field check used a section that did not validate (the check is skipped)."""
+
+
+class _Placeholder:
+    """Stands for a section that did not validate: any use of it stops the check using it."""
+
+    __slots__ = ("_key",)
+
+    def __init__(self, key: str) -> None:
+        object.__setattr__(self, "_key", key)
+
+    def __getattr__(self, name: str) -> Any:
+        raise _NotValidated(object.__getattribute__(self, "_key"))
+
+
+def _checks_beside_errors(
+    root: Any, kind: str, data: dict[str, Any], context: dict[str, Any], exc: Any
+) -> list[tuple[str, str]]:
+    """The case-level cross-field checks (``root``'s "after" model validators) and the
+    plausibility checks, run on the sections that did validate when others did not.
+
+    pydantic runs a model's after-validators only when all its fields are valid, so a
+    contradiction between sections (a rule that needs tolerances, an analysis that needs a
+    section) would be reported only after the field errors are fixed. Here each top-level section
+    is validated on its own; the sections with errors become placeholders, and a check that
+    touches a placeholder is skipped (it cannot be judged), every other check runs.
+    """
+    from pydantic import TypeAdapter, ValidationError
+
+    errs = exc.errors(include_url=False)
+    if any(not e.get("loc") for e in errs):  # the case-level checks ran (and failed)
+        return []
+    failed = {str(e["loc"][0]) for e in errs}
+    values: dict[str, Any] = {}
+    for name, info in root.model_fields.items():
+        key = info.alias or name
+        if key in failed or (key not in data and info.is_required()):
+            values[name] = _Placeholder(key)
+        elif key not in data:
+            values[name] = info.get_default(call_default_factory=True)
+        else:
+            try:
+                adapter: TypeAdapter[Any] = TypeAdapter(info.annotation)
+                values[name] = adapter.validate_python(data[key], context=context)
+            except (ValidationError, TypeError):
+                values[name] = _Placeholder(key)
+    case = root.model_construct(**values)
+    out: list[tuple[str, str]] = []
+    for dec in root.__pydantic_decorators__.model_validators.values():
+        if dec.info.mode != "after":
+            continue
+        try:
+            dec.func(case)
+        except (_NotValidated, TypeError, AttributeError):
+            continue
+        except (ValueError, AssertionError) as err:
+            out.append(("(case)", str(err)))
+    from gearte.io.plausibility import plausibility_problems
+
+    try:
+        out += plausibility_problems(kind, case)
+    except (_NotValidated, TypeError, AttributeError):
+        pass
+    return out
 
 
 def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:

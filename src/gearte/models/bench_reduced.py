@@ -102,7 +102,18 @@ class ReducedRV:
 
 
 def parameter_names(model: ReducedRV) -> tuple[str, ...]:
-    """All parameter names: hysteresis, TE common, then (cos, sin) per family and the encoder."""
+    """All parameter names: hysteresis, TE common, then (cos, sin) per family and the encoder.
+
+    Parameters
+    ----------
+    model : ReducedRV
+        Constants of the reducer type.
+
+    Returns
+    -------
+    tuple of str
+        The names, in the order of the fit's parameter vector.
+    """
     return (*HYSTERESIS_PARAMETERS, *TE_COMMON, *model.family_parameters())
 
 
@@ -114,7 +125,25 @@ def _play(p: dict, model: ReducedRV) -> float:
 def hysteresis_angle(
     model: ReducedRV, params: dict, torque: ArrayLike, direction: ArrayLike
 ) -> np.ndarray:
-    """Output torsion angle [rad] at the measured torques [N·mm] and branches (±1)."""
+    """Output torsion angle [rad] at the measured torques [N·mm] and branches (±1).
+
+    Parameters
+    ----------
+    model : ReducedRV
+        Constants of the reducer type.
+    params : dict
+        Parameter name (:func:`parameter_names`) → value, in the units listed with
+        :data:`HYSTERESIS_PARAMETERS` ([mm], [N·mm], [-], [rad/(N·mm)], [rad]).
+    torque : array_like, shape (K,)
+        Measured output torque T [N·mm].
+    direction : array_like, shape (K,)
+        Branch s of each sample [-]: +1 rising, −1 falling torque.
+
+    Returns
+    -------
+    numpy.ndarray
+        θ(T, s) [rad] (module docstring).
+    """
     t = np.asarray(torque, dtype=float)
     s = np.asarray(direction, dtype=float)
     tr = model.rated_torque
@@ -136,6 +165,23 @@ def hysteresis_jacobian(
 
     At exactly ``u = T − s T_fr = 0`` the elastic law's slope ``|u|^(p−1)`` is infinite; it is
     evaluated at ``|u/T_r| = 1e-12`` there.
+
+    Parameters
+    ----------
+    model : ReducedRV
+        Constants of the reducer type.
+    params : dict
+        Parameter name (:func:`parameter_names`) → value, in the units listed with
+        :data:`HYSTERESIS_PARAMETERS` ([mm], [N·mm], [-], [rad/(N·mm)], [rad]).
+    torque : array_like, shape (K,)
+        Measured output torque T [N·mm].
+    direction : array_like, shape (K,)
+        Branch s of each sample [-]: +1 rising, −1 falling torque.
+
+    Returns
+    -------
+    dict
+        Parameter name → ∂θ/∂parameter, shape (K,).
     """
     t = np.asarray(torque, dtype=float)
     s = np.asarray(direction, dtype=float)
@@ -175,7 +221,20 @@ def te_orders(model: ReducedRV) -> list[int]:
 
 def te_basis(model: ReducedRV, position: ArrayLike) -> np.ndarray:
     """``(K, 1 + 2 U)`` columns ``1, cos(n φ), sin(n φ)`` for the ``U`` distinct orders of
-    :func:`te_orders` (families sharing an order share its columns)."""
+    :func:`te_orders` (families sharing an order share its columns).
+
+    Parameters
+    ----------
+    model : ReducedRV
+        Constants of the reducer type.
+    position : array_like, shape (K,)
+        Output position φ [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (K, 1 + 2 U)
+        The basis [-].
+    """
     phi = np.asarray(position, dtype=float)
     cols = [np.ones_like(phi)]
     for n in te_orders(model):
@@ -185,7 +244,23 @@ def te_basis(model: ReducedRV, position: ArrayLike) -> np.ndarray:
 
 def te_coefficients(model: ReducedRV, params: dict, direction: int) -> np.ndarray:
     """Coefficients of :func:`te_basis` [rad]: the offset of the direction, then per order the
-    sums of the cos and sin amplitudes of the families at that order."""
+    sums of the cos and sin amplitudes of the families at that order.
+
+    Parameters
+    ----------
+    model : ReducedRV
+        Constants of the reducer type.
+    params : dict
+        Parameter name (:func:`parameter_names`) → value, in the units listed with
+        :data:`HYSTERESIS_PARAMETERS` ([mm], [N·mm], [-], [rad/(N·mm)], [rad]).
+    direction : int
+        +1 forward, −1 backward [-].
+
+    Returns
+    -------
+    numpy.ndarray, shape (1 + 2 U,)
+        Coefficients [rad].
+    """
     orders = te_orders(model)
     c = np.zeros(1 + 2 * len(orders))
     c[0] = params["te_offset"] + 0.5 * direction * (_play(params, model) + params["running_windup"])
@@ -206,7 +281,24 @@ def te_trace(
 ) -> np.ndarray:
     """Angular TE [rad] of one direction (+1 forward, −1 backward) at output positions [rad].
 
-    ``basis`` may hold :func:`te_basis` of the positions, computed once for repeated calls.
+    Parameters
+    ----------
+    model : ReducedRV
+        Constants of the reducer type.
+    params : dict
+        Parameter name (:func:`parameter_names`) → value, in the units listed with
+        :data:`HYSTERESIS_PARAMETERS` ([mm], [N·mm], [-], [rad/(N·mm)], [rad]).
+    position : array_like, shape (K,)
+        Output position φ [rad].
+    direction : int
+        +1 forward, −1 backward [-].
+    basis : numpy.ndarray, optional
+        :func:`te_basis` of ``position`` [-], computed once for repeated calls.
+
+    Returns
+    -------
+    numpy.ndarray, shape (K,)
+        TE_d(φ) [rad].
     """
     b = te_basis(model, position) if basis is None else basis
     return b @ te_coefficients(model, params, direction)

@@ -89,6 +89,18 @@ def branch_directions(torque: ArrayLike, threshold: float = 0.02) -> np.ndarray:
     A turning point is declared when the torque retreats from its running extreme by more than
     ``threshold`` × the sweep's range (so noise on the torque reading does not split a branch);
     samples up to the extreme belong to the branch that reached it.
+
+    Parameters
+    ----------
+    torque : array_like, shape (K,)
+        Torque in recording order [N·mm] (any consistent unit).
+    threshold : float
+        Retreat that marks a turning point, as a fraction of the sweep's range [-].
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (K,)
+        +1 / −1 per sample [-].
     """
     t = np.asarray(torque, dtype=float)
     n = t.size
@@ -139,7 +151,7 @@ def split_branches(
     rated_torque : float
         ``T_r`` [N·mm].
     direction : (K,) ints, optional
-        +1 rising / −1 falling torque per sample (a marked branch); inferred by
+        +1 rising / −1 falling torque per sample [-] (a marked branch); inferred by
         :func:`branch_directions` when omitted.
     reach : float
         Each branch must span ``[−reach T_r, +reach T_r]``.
@@ -195,6 +207,18 @@ def torsional_rigidity(branches: Branches, rated_torque: float) -> float:
     A measured sweep whose peak torque falls short of ``T_r`` (within the ``reach`` that
     :func:`split_branches` accepts) is read at its own peak ``T_hi``:
     ``(T_hi − T_r/2)/(θ_mid(T_hi) − θ_mid(T_r/2))`` — nothing is extrapolated.
+
+    Parameters
+    ----------
+    branches : Branches
+        Ascending and descending branches of the sweep (:func:`split_branches`).
+    rated_torque : float
+        Rated torque T_r [N·mm].
+
+    Returns
+    -------
+    float
+        b/a [N·mm/rad].
     """
     tr = rated_torque
     hi = min(tr, branches.asc_torque[-1], branches.desc_torque[-1])
@@ -206,7 +230,22 @@ def torsional_rigidity(branches: Branches, rated_torque: float) -> float:
 
 
 def lost_motion(branches: Branches, rated_torque: float, fraction: float = 0.03) -> float:
-    """Lost motion ``θ_mid(+f T_r) − θ_mid(−f T_r)`` [rad], ``f`` = ``fraction`` (0.03 or 0.05)."""
+    """Lost motion ``θ_mid(+f T_r) − θ_mid(−f T_r)`` [rad], ``f`` = ``fraction`` (0.03 or 0.05).
+
+    Parameters
+    ----------
+    branches : Branches
+        Ascending and descending branches of the sweep (:func:`split_branches`).
+    rated_torque : float
+        Rated torque T_r [N·mm].
+    fraction : float
+        f [-], in (0, 0.5).
+
+    Returns
+    -------
+    float
+        Lost motion [rad].
+    """
     if not 0 < fraction < 0.5:
         raise ParameterError("lost_motion_fraction", fraction, "must be in (0, 0.5)")
     th = branches.mid(np.array([-fraction, fraction]) * rated_torque)
@@ -219,6 +258,18 @@ def backlash_at_zero(branches: Branches, rated_torque: float) -> float:
     ``(θ_desc(0) − θ_asc(0)) − w_f`` with the friction width ``w_f`` the mean loop width at
     ``±T_r/2``, where the reducer is closed and only friction separates the branches. The free
     play without friction; equal to the hysteresis loss for a frictionless (virtual) curve.
+
+    Parameters
+    ----------
+    branches : Branches
+        Ascending and descending branches of the sweep (:func:`split_branches`).
+    rated_torque : float
+        Rated torque T_r [N·mm].
+
+    Returns
+    -------
+    float
+        Backlash [rad].
     """
     half = np.array([-0.5, 0.5]) * rated_torque
     w_f = float(np.mean(branches.descending(half) - branches.ascending(half)))
@@ -226,7 +277,18 @@ def backlash_at_zero(branches: Branches, rated_torque: float) -> float:
 
 
 def hysteresis_loss(branches: Branches) -> float:
-    """Hysteresis loss ``θ_desc(0) − θ_asc(0)`` [rad]: loop width at zero torque."""
+    """Hysteresis loss ``θ_desc(0) − θ_asc(0)`` [rad]: loop width at zero torque.
+
+    Parameters
+    ----------
+    branches : Branches
+        Ascending and descending branches of the sweep (:func:`split_branches`).
+
+    Returns
+    -------
+    float
+        Hysteresis loss [rad].
+    """
     return float(branches.descending(0.0) - branches.ascending(0.0))
 
 
@@ -249,7 +311,27 @@ def hysteresis_values(
     direction: ArrayLike | None = None,
     lost_motion_fraction: float = 0.03,
 ) -> HysteresisValues:
-    """All hysteresis catalogue quantities of a sweep (see the module docstring)."""
+    """All hysteresis catalogue quantities of a sweep (see the module docstring).
+
+    Parameters
+    ----------
+    torque : array_like, shape (K,)
+        Output torque in recording order [N·mm].
+    angle : array_like, shape (K,)
+        Output torsion angle [rad].
+    rated_torque : float
+        Rated torque T_r [N·mm].
+    direction : array_like, optional
+        +1 rising / −1 falling torque per sample [-]; inferred when omitted
+        (:func:`split_branches`).
+    lost_motion_fraction : float
+        f of :func:`lost_motion` [-].
+
+    Returns
+    -------
+    HysteresisValues
+        Rigidity [N·mm/rad], lost motion, backlash and hysteresis loss [rad].
+    """
     br = split_branches(torque, angle, rated_torque, direction)
     return HysteresisValues(
         torsional_rigidity=torsional_rigidity(br, rated_torque),
@@ -276,6 +358,22 @@ def forward_backward_difference(
 
     The backward trace is interpolated linearly and periodically (period 2π) onto the forward
     positions; either trace may run in either sense.
+
+    Parameters
+    ----------
+    forward_position : array_like
+        Positions φ of the forward trace [rad].
+    forward_te : array_like
+        Forward TE [rad].
+    backward_position : array_like
+        Positions of the backward trace [rad].
+    backward_te : array_like
+        Backward TE [rad].
+
+    Returns
+    -------
+    numpy.ndarray
+        TE_fwd − TE_bwd at ``forward_position`` [rad].
     """
     bp = np.asarray(backward_position, dtype=float)
     bt = np.asarray(backward_te, dtype=float)

@@ -351,8 +351,27 @@ def secant_stiffness(
 
     Parameters
     ----------
-    F, law, rho, r, E, nu, b, rho_cap
-        As in :func:`approach`.
+    F : array_like
+        Contact force [N], > 0.
+    law : {"line_contact", "hu2020"}
+        The contact law (:data:`LAWS`).
+    rho : array_like
+        Curvature radius of the flank at the contact [mm] (ρ < 0 convex).
+    r : float
+        Pin radius [mm].
+    E : float
+        Young's modulus of pin and disc [MPa].
+    nu : float
+        Poisson's ratio [-].
+    b : float
+        Face width [mm].
+    rho_cap : float, optional
+        Cap on |ρ| in the logarithm [mm] (as in :func:`log_law_coefficients`).
+
+    Returns
+    -------
+    numpy.ndarray
+        k [N/mm].
 
     References
     ----------
@@ -378,8 +397,27 @@ def tangent_stiffness(
 
     Parameters
     ----------
-    F, law, rho, r, E, nu, b, rho_cap
-        As in :func:`approach`.
+    F : array_like
+        Contact force [N], > 0.
+    law : {"line_contact", "hu2020"}
+        The contact law (:data:`LAWS`).
+    rho : array_like
+        Curvature radius of the flank at the contact [mm] (ρ < 0 convex).
+    r : float
+        Pin radius [mm].
+    E : float
+        Young's modulus of pin and disc [MPa].
+    nu : float
+        Poisson's ratio [-].
+    b : float
+        Face width [mm].
+    rho_cap : float, optional
+        Cap on |ρ| in the logarithm [mm] (as in :func:`log_law_coefficients`).
+
+    Returns
+    -------
+    numpy.ndarray
+        k_t [N/mm].
 
     References
     ----------

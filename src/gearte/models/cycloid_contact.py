@@ -63,7 +63,7 @@ HALF_WIDTH_FACTOR = HU2020_HALF_WIDTH_FACTOR
 
 
 def compliance_constants(
-    rho: float, r: float, E: float, mu: float, b: float, law: str = "hu2020"
+    rho: float, r: float, E: float, mu: float, b: float, *, law: str
 ) -> tuple[float, float]:
     """Constants (A [mm/N], B [N]) with δ(F) = A F (2/3 + ln(B/F)) for a contact law.
 
@@ -80,13 +80,18 @@ def compliance_constants(
     b : float
         Face width of one disc [mm].
     law : {"hu2020", "line_contact"}
-        The law of :mod:`gearte.models.contact_law` (Hu 2020 eq 38–39 by default, as printed).
+        The law of :mod:`gearte.models.contact_law` (``"hu2020"``: eq 38–39 as printed); no
+        default, the caller names it.
 
     Notes
     -----
     Both laws have the form δ = F (a0 − a1 ln F) (:func:`gearte.models.contact_law.
     log_law_coefficients`); here A = a1 and B = exp(a0/a1 − 2/3), the form the compiled solver
     of eq 42–44 takes.
+
+    References
+    ----------
+    Hu et al. (2020) eq 38–39 and 42–44, doi:10.3390/app10020481.
     """
     for name, v in (("rho", abs(rho)), ("r", r), ("E", E), ("b", b)):
         if not (math.isfinite(v) and v > 0.0):
@@ -104,6 +109,30 @@ def half_width(F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float
     ``c = 4.99e-3 (4 (1−μ²) F |ρ| r / (E b (|ρ| + r)))^½`` with F [N], ρ, r, b [mm], E [MPa].
     Not Hertz's half-width (:func:`gearte.models.contact_law.hertz_half_width`); see
     docs/contact-law.md.
+
+    Parameters
+    ----------
+    F : array_like
+        Contact force [N].
+    rho : float
+        Curvature radius of the disc profile at the contact [mm] (ρ < 0 convex).
+    r : float
+        Pin radius [mm].
+    E : float
+        Young's modulus [MPa].
+    mu : float
+        Poisson's ratio μ [-].
+    b : float
+        Face width of one disc [mm].
+
+    Returns
+    -------
+    numpy.ndarray
+        c [mm].
+
+    References
+    ----------
+    Hu et al. (2020) eq 39, doi:10.3390/app10020481.
     """
     F = np.asarray(F, dtype=float)
     rho = abs(rho)
@@ -111,7 +140,7 @@ def half_width(F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float
 
 
 def max_normal_deformation(
-    F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float, law: str = "hu2020"
+    F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float, *, law: str
 ) -> np.ndarray:
     """Maximum normal deformation δ_max [mm] under the pin force F [N] (eq 38).
 
@@ -119,28 +148,85 @@ def max_normal_deformation(
     ----------
     F : array_like
         Maximum contact force F_max [N].
-    rho, r, E, mu, b
-        As in :func:`compliance_constants`.
+    rho : float
+        Curvature radius of the disc profile at the contact [mm] (ρ < 0 convex).
+    r : float
+        Pin radius [mm].
+    E : float
+        Young's modulus [MPa].
+    mu : float
+        Poisson's ratio [-].
+    b : float
+        Face width of one disc [mm].
     law : {"hu2020", "line_contact"}
-        :func:`gearte.models.contact_law.approach` of this law (Hu 2020 eq 38–39 by default).
+        :func:`gearte.models.contact_law.approach` of this law (``"hu2020"``: eq 38–39 as
+        printed); no default, the caller names it.
+
+    Returns
+    -------
+    numpy.ndarray
+        δ_max [mm].
 
     Examples
     --------
-    >>> round(float(max_normal_deformation(1910.3, -43.598, 2.978, 2.06e5, 0.3, 11.0)), 4)
+    >>> d = max_normal_deformation(1910.3, -43.598, 2.978, 2.06e5, 0.3, 11.0, law="hu2020")
+    >>> round(float(d), 4)
     0.0116
+
+    References
+    ----------
+    Hu et al. (2020) eq 38, doi:10.3390/app10020481.
     """
     return approach(F, law, rho, r, E, mu, b)
 
 
 def pin_approach(lr: ArrayLike, delta_max: ArrayLike) -> np.ndarray:
-    """Normal approach δ_i = (l_i/r_c) δ_max [mm] (eq 37); negative on the unloaded flank."""
+    """Normal approach δ_i = (l_i/r_c) δ_max [mm] (eq 37); negative on the unloaded flank.
+
+    Parameters
+    ----------
+    lr : array_like
+        Arm ratio l_i / r_c of each pin [-].
+    delta_max : array_like
+        Normal deformation at the largest arm δ_max [mm].
+
+    Returns
+    -------
+    numpy.ndarray
+        δ_i [mm].
+
+    References
+    ----------
+    Hu et al. (2020) eq 37, doi:10.3390/app10020481.
+    """
     return np.asarray(lr, dtype=float) * np.asarray(delta_max, dtype=float)[..., None]
 
 
 def pin_forces(
     approach: ArrayLike, clearance: ArrayLike, delta_max: ArrayLike, F_max: ArrayLike
 ) -> np.ndarray:
-    """Contact force per pin F_i = max(δ_i − Δ_i, 0)/δ_max · F_max [N] (eq 41)."""
+    """Contact force per pin F_i = max(δ_i − Δ_i, 0)/δ_max · F_max [N] (eq 41).
+
+    Parameters
+    ----------
+    approach : array_like
+        Normal approach δ_i of each pin [mm] (:func:`pin_approach`).
+    clearance : array_like
+        Initial clearance Δ_i of each pin [mm].
+    delta_max : array_like
+        Normal deformation at the largest arm δ_max [mm].
+    F_max : array_like
+        Force at the largest arm [N].
+
+    Returns
+    -------
+    numpy.ndarray
+        F_i [N].
+
+    References
+    ----------
+    Hu et al. (2020) eq 41, doi:10.3390/app10020481.
+    """
     approach = np.asarray(approach, dtype=float)
     gap = np.maximum(approach - np.asarray(clearance, dtype=float), 0.0)
     dm = np.asarray(delta_max, dtype=float)[..., None]
@@ -152,6 +238,26 @@ def start_force(T_c: float, K1: float, z_c: int, r_p: float) -> float:
 
     F1 = 4 T_c / (K1 z_c r_p) (eq 30: all z_p/2 pins loaded, no modification) and F2 = T_c / r_p
     (one pin). Any positive start gives the same solution (the fixed point is unique).
+
+    Parameters
+    ----------
+    T_c : float
+        Torque on the analysed disc [N·mm].
+    K1 : float
+        Short-width coefficient [-].
+    z_c : int
+        Number of cycloid teeth [-].
+    r_p : float
+        Pin-centre-circle radius [mm].
+
+    Returns
+    -------
+    float
+        F_max⁰ [N].
+
+    References
+    ----------
+    Hu et al. (2020) eq 30 and 45–47, doi:10.3390/app10020481.
     """
     return 0.5 * (4.0 * T_c / (K1 * z_c * r_p) + T_c / r_p)
 
@@ -227,9 +333,9 @@ def tooth_contact(
     stage: CycloidStage,
     torque: float,
     *,
-    disc_share: float = 0.55,
-    E: float = 2.06e5,
-    mu: float = 0.3,
+    disc_share: float,
+    E: float,
+    mu: float,
     mesh_angle: ArrayLike = 0.0,
     F_start: float | None = None,
     rtol: float = 1e-12,
@@ -247,7 +353,8 @@ def tooth_contact(
     torque : float
         Output torque of the stage T [N·mm].
     disc_share : float
-        Share s of the torque carried by the analysed disc, T_c = s T [-] (paper: 0.55).
+        Share s of the torque carried by the analysed disc, T_c = s T [-] (Hu et al.: 0.55;
+        required, no paper value as a default).
     E : float
         Young's modulus [MPa].
     mu : float
@@ -280,6 +387,10 @@ def tooth_contact(
     -------
     ToothContact
         Per-position and per-pin results.
+
+    References
+    ----------
+    Hu et al. (2020) section 4, eq 28–47, doi:10.3390/app10020481.
     """
     if not (math.isfinite(torque) and torque > 0.0):
         raise ParameterError("torque", torque, "must be finite and > 0 [N·mm]")

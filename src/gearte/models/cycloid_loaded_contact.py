@@ -51,14 +51,15 @@ __all__ = [
     "mesh_period_contact",
     "fourier_fit",
     "fourier_eval",
-    "LI2023_PAIR",
-    "LI2023_PAIR_MODIFIED",
 ]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class CycloidPinPair:
-    """Cycloid–pin pair of one disc (paper 004, Table 1) with its material.
+    """Cycloid–pin pair of one disc (the quantities of paper 004's Table 1) with its material.
+
+    Geometry and material have no defaults (no paper data as code defaults): a missing one is an
+    error naming it. Li et al.'s Table 1 pair is data of the bundled ``li2023_rv*`` cases.
 
     The geometry (K1, S, arms, eq 32 clearance, curvature) is that of the
     :class:`gearte.geometry.cycloid.CycloidStage` built from these fields (:attr:`stage`), the
@@ -77,11 +78,11 @@ class CycloidPinPair:
     face_width_mm : float
         B, disc face width [mm].
     youngs_modulus_MPa, poisson_ratio : float
-        E [MPa] and ν [-] of disc and pins (same material, paper section 4).
+        E [MPa] and ν [-] of disc and pins (one material, as in paper section 4).
     pin_radius_modification_mm : float
-        Δr_rp, equidistant ("roller radius") modification [mm]; paper: −0.01.
+        Δr_rp, equidistant ("roller radius") modification [mm]; default 0 (unmodified).
     pin_position_modification_mm : float
-        Δr_p, shifted ("roller position") modification [mm]; paper: −0.05.
+        Δr_p, shifted ("roller position") modification [mm]; default 0 (unmodified).
     curvature_cap_mm : float or None
         Upper bound of |ρ_c| in the Hertz logarithm [mm]. The profile's curvature radius passes
         through infinity at its inflection (≈ 50.8° for Table 1), next to the most loaded pins;
@@ -95,13 +96,13 @@ class CycloidPinPair:
         textbook line contact.
     """
 
-    pin_count: int = 40
-    pin_radius_mm: float = 3.0
-    pin_circle_radius_mm: float = 85.8
-    eccentricity_mm: float = 1.3
-    face_width_mm: float = 12.0
-    youngs_modulus_MPa: float = 2.06e5  # noqa: N815 - unit suffix
-    poisson_ratio: float = 0.3
+    pin_count: int
+    pin_radius_mm: float
+    pin_circle_radius_mm: float
+    eccentricity_mm: float
+    face_width_mm: float
+    youngs_modulus_MPa: float  # noqa: N815 - unit suffix
+    poisson_ratio: float
     pin_radius_modification_mm: float = 0.0
     pin_position_modification_mm: float = 0.0
     curvature_cap_mm: float | None = None
@@ -198,6 +199,7 @@ def pin_geometry(pair: CycloidPinPair, phi: ArrayLike) -> tuple[np.ndarray, np.n
     Parameters
     ----------
     pair : CycloidPinPair
+        The cycloid–pin pair of one disc (geometry [mm], material [MPa], contact law).
     phi : array_like
         Meshing phase φ_i of the pins [rad], measured from the line of centres; the loaded flank
         is sin φ > 0.
@@ -214,6 +216,10 @@ def pin_geometry(pair: CycloidPinPair, phi: ArrayLike) -> tuple[np.ndarray, np.n
     :meth:`CycloidStage.normal_arm` and :meth:`CycloidStage.S` (Hu 2020 eq 36, 4). Every contact
     normal passes through the pitch point P at distance r_c = e z_c from the disc centre;
     |P − pin centre| = r_p S, hence l = r_c sin φ / S ≤ r_c, with equality at φ0 = arccos K1.
+
+    References
+    ----------
+    Hu et al. (2020) eq 4 and 36, doi:10.3390/app10020481.
     """
     return pair.stage.normal_arm(phi), pair.stage.S(phi)
 
@@ -223,6 +229,23 @@ def modification_clearance(pair: CycloidPinPair, phi: ArrayLike) -> np.ndarray:
 
     Hu et al. (2020) eq 32 (:meth:`CycloidStage.initial_clearance`), which paper 004 uses through
     its ref. [31]; zero at φ0 = arccos K1.
+
+    Parameters
+    ----------
+    pair : CycloidPinPair
+        The cycloid–pin pair of one disc (geometry [mm], material [MPa], contact law).
+    phi : array_like
+        Meshing phase φ_i of the pins [rad].
+
+    Returns
+    -------
+    numpy.ndarray
+        Δ_i [mm].
+
+    References
+    ----------
+    Hu et al. (2020) eq 32, doi:10.3390/app10020481; Li et al. (2023) ref. [31],
+    doi:10.3390/machines11060626.
     """
     return pair.stage.initial_clearance(phi)
 
@@ -232,6 +255,22 @@ def profile_curvature_radius(pair: CycloidPinPair, phi: ArrayLike) -> np.ndarray
 
     Hu et al. 2020 eq 40 (:meth:`CycloidStage.curvature_radius`); ρ > 0: concave flank (root
     side), ρ < 0: convex (tip side); |ρ| → ∞ at the inflection.
+
+    Parameters
+    ----------
+    pair : CycloidPinPair
+        The cycloid–pin pair of one disc (geometry [mm], material [MPa], contact law).
+    phi : array_like
+        Meshing phase φ of the pin [rad].
+
+    Returns
+    -------
+    numpy.ndarray
+        ρ [mm].
+
+    References
+    ----------
+    Hu et al. (2020) eq 40, doi:10.3390/app10020481.
     """
     return pair.stage.curvature_radius(phi)
 
@@ -255,7 +294,22 @@ def hertz_line_deflection(pair: CycloidPinPair, force_N: ArrayLike, rho_c: Array
     b = sqrt(4 F R* / (π B E*)),  1/R* = 1/r − 1/ρ_c,  1/E* = Σ (1 − ν_k²)/E_k,
 
     with ρ_r = r for the pin and ρ_c = min(|ρ_c|, cap) for the disc: the ``"line_contact"`` law of
-    :mod:`gearte.models.contact_law` (or the pair's other law). ``force_N`` must be > 0.
+    :mod:`gearte.models.contact_law` (or the pair's other law).
+
+    Parameters
+    ----------
+    pair : CycloidPinPair
+        The cycloid–pin pair of one disc (geometry [mm], material [MPa], contact law).
+    force_N : array_like
+        Pin force F [N], > 0.
+    rho_c : array_like
+        Signed curvature radius of the disc flank at the contact [mm]
+        (:func:`profile_curvature_radius`).
+
+    Returns
+    -------
+    numpy.ndarray
+        δ [mm].
 
     Notes
     -----
@@ -263,6 +317,11 @@ def hertz_line_deflection(pair: CycloidPinPair, force_N: ArrayLike, rho_c: Array
     classical line-contact approach of a cylinder, Johnson 1985 §5.6), since the full width would
     only shift the log by ln 2. The relative radius uses the sign of ρ_c (concave root flank vs
     convex tip flank). The pin radius is that of the ground profile, r_rp + Δr_rp.
+
+    References
+    ----------
+    Li et al. (2023) eq 2, doi:10.3390/machines11060626; Johnson (1985) §5.6,
+    doi:10.1017/CBO9781139171731.
     """
     f = np.asarray(force_N, dtype=float)
     a0, a1 = _law_coefficients(pair, rho_c)
@@ -275,6 +334,22 @@ def hertz_line_force(
     """Inverse of :func:`hertz_line_deflection`: pin force F [N] for a deflection δ [mm].
 
     :func:`gearte.models.contact_law.force_from_coefficients`; δ ≤ 0 gives F = 0.
+
+    Parameters
+    ----------
+    pair : CycloidPinPair
+        The cycloid–pin pair of one disc (geometry [mm], material [MPa], contact law).
+    deflection_mm : array_like
+        Normal deflection δ [mm].
+    rho_c : array_like
+        Signed curvature radius of the disc flank at the contact [mm].
+    rtol : float
+        Relative tolerance on F [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        F [N].
     """
     a0, a1 = _law_coefficients(pair, rho_c)
     return force_from_coefficients(deflection_mm, a0, a1, rtol=rtol)
@@ -424,12 +499,13 @@ def loaded_contact(
     Parameters
     ----------
     pair : CycloidPinPair
+        The cycloid–pin pair of one disc (geometry [mm], material [MPa], contact law).
     torque_Nmm : float
         T, torque carried by this disc [N·mm] (paper: 450 N·m output over 2 discs → 225e3).
     mesh_position : array_like
         Meshing phase of pin 1, p ∈ [0, 2π/z_p) [rad]; pin i sits at φ_i = p + 2π(i−1)/z_p.
     rtol : float
-        Relative tolerance on the torque balance.
+        Relative tolerance on the torque balance [-].
 
     Returns
     -------
@@ -450,9 +526,18 @@ def loaded_contact(
 
     Examples
     --------
-    >>> c = loaded_contact(LI2023_PAIR, 225e3, 0.0)
-    >>> 31.5 < float(np.degrees(c.pressure_angle[0])) < 33.5
-    True
+    The unmodified pair of Li et al.'s Table 1 (data of ``examples/li2023_rv_unmodified.toml``)
+    at 225 N·m per disc:
+
+    >>> pair = CycloidPinPair(pin_count=40, pin_radius_mm=3.0, pin_circle_radius_mm=85.8,
+    ...     eccentricity_mm=1.3, face_width_mm=12.0, youngs_modulus_MPa=2.06e5, poisson_ratio=0.3)
+    >>> c = loaded_contact(pair, 225e3, 0.0)
+    >>> round(float(np.degrees(c.pressure_angle[0])), 1)
+    32.6
+
+    References
+    ----------
+    Li et al. (2023) §2.2–2.3, eq 2–7, doi:10.3390/machines11060626.
     """
     if not np.isfinite(torque_Nmm) or torque_Nmm <= 0:
         raise ParameterError("torque_Nmm", torque_Nmm, "must be finite and > 0")
@@ -533,7 +618,22 @@ class MeshPeriodContact:
 def mesh_period_contact(
     pair: CycloidPinPair, torque_Nmm: float, n_positions: int = 48
 ) -> MeshPeriodContact:
-    """Loaded contact at ``n_positions`` equally spaced positions over one mesh period."""
+    """Loaded contact at ``n_positions`` equally spaced positions over one mesh period.
+
+    Parameters
+    ----------
+    pair : CycloidPinPair
+        The cycloid–pin pair of one disc (geometry [mm], material [MPa], contact law).
+    torque_Nmm : float
+        Torque carried by this disc [N·mm], > 0.
+    n_positions : int
+        Mesh positions over one period 2π/z_p [-], ≥ 4.
+
+    Returns
+    -------
+    MeshPeriodContact
+        β [rad], k_cr [N/mm] and the contact at each position (paper 004 Fig 9).
+    """
     if n_positions < 4:
         raise ParameterError("n_positions", n_positions, "must be ≥ 4")
     p = np.arange(n_positions) * pair.mesh_pitch_rad / n_positions
@@ -553,6 +653,24 @@ def fourier_fit(values: ArrayLike, n_harmonics: int) -> tuple[float, np.ndarray,
 
     Returns (mean, a_l, b_l) such that v(s) ≈ mean + Σ_l a_l cos(l s) + b_l sin(l s), with s the
     phase over the period in [0, 2π), l = 1..n_harmonics.
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        Samples over one period, equally spaced from phase 0 [any unit].
+    n_harmonics : int
+        Number of harmonics [-], 1 ≤ n_harmonics < n/2.
+
+    Returns
+    -------
+    mean : float
+        Mean of the samples [their unit].
+    a, b : numpy.ndarray
+        Cosine and sine amplitudes a_l, b_l [their unit].
+
+    References
+    ----------
+    Li et al. (2023) eq 11 and 13, doi:10.3390/machines11060626.
     """
     v = np.asarray(values, dtype=float)
     n = v.size
@@ -565,17 +683,24 @@ def fourier_fit(values: ArrayLike, n_harmonics: int) -> tuple[float, np.ndarray,
 
 
 def fourier_eval(mean: float, a: ArrayLike, b: ArrayLike, phase: ArrayLike) -> np.ndarray:
-    """Evaluate a :func:`fourier_fit` series at ``phase`` [rad over one period]."""
+    """Evaluate a :func:`fourier_fit` series at ``phase`` [rad over one period].
+
+    Parameters
+    ----------
+    mean : float
+        Mean term [the series' unit].
+    a, b : array_like
+        Cosine and sine amplitudes [the series' unit].
+    phase : array_like
+        Phase s over the period [rad], 2π = one period.
+
+    Returns
+    -------
+    numpy.ndarray
+        v(s) [the series' unit].
+    """
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
     s = np.asarray(phase, dtype=float)[..., None]
     ll = np.arange(1, a.size + 1)
     return mean + np.sum(a * np.cos(ll * s) + b * np.sin(ll * s), axis=-1)
-
-
-LI2023_PAIR = CycloidPinPair()
-"""Paper 004 Table 1 pair without modification."""
-LI2023_PAIR_MODIFIED = CycloidPinPair(
-    pin_radius_modification_mm=-0.01, pin_position_modification_mm=-0.05
-)
-"""Paper 004 Table 1 pair with the section 4.1 modification (Δr_p = −0.05, Δr_rp = −0.01 mm)."""

@@ -128,6 +128,10 @@ def error_coefficients(K1: ArrayLike) -> dict[str, np.ndarray | float]:
     --------
     >>> round(error_coefficients(0.78993)["pin_housing_position_error"], 5)
     0.78993
+
+    References
+    ----------
+    Hu et al. (2020) eq 24, Table 2, doi:10.3390/app10020481.
     """
     K1 = np.asarray(K1, dtype=float)
     root = np.sqrt(1.0 - K1 * K1)
@@ -146,7 +150,22 @@ def error_coefficients(K1: ArrayLike) -> dict[str, np.ndarray | float]:
 
 
 def te_gradients(stage: CycloidStage) -> dict[str, float]:
-    """Error gains g_j = ∂Δθ/∂δ_j [rad/mm] (eq 21–22): 2 c_j / (a z_c)."""
+    """Error gains g_j = ∂Δθ/∂δ_j [rad/mm] (eq 21–22): 2 c_j / (a z_c).
+
+    Parameters
+    ----------
+    stage : CycloidStage
+        The stage (fixes K1 and r_c = a z_c).
+
+    Returns
+    -------
+    dict
+        Factor name → g_j [rad/mm].
+
+    References
+    ----------
+    Hu et al. (2020) eq 21–22, doi:10.3390/app10020481.
+    """
     scale = 2.0 / stage.r_c
     return {k: scale * float(v) for k, v in error_coefficients(stage.K1).items()}
 
@@ -167,6 +186,10 @@ def sensitivity_indices(
     --------
     >>> round(sensitivity_indices(0.78993)["pin_radius_error"], 4)
     -1.6308
+
+    References
+    ----------
+    Hu et al. (2020) eq 22, Table 2, doi:10.3390/app10020481.
     """
     K1 = stage_or_K1.K1 if isinstance(stage_or_K1, CycloidStage) else float(stage_or_K1)
     c = error_coefficients(K1)
@@ -264,6 +287,10 @@ def factor_contributions(
     dict
         The three design modifications (:data:`MODIFICATION_FACTORS`) then the nine errors →
         contribution [rad]. Their sum is the mean geometric TE (eq 16).
+
+    References
+    ----------
+    Hu et al. (2020) eq 5–13 and 16, doi:10.3390/app10020481.
     """
     e = _check_errors(errors or {}, "errors")
     g = te_gradients(stage)
@@ -293,10 +320,21 @@ def factor_tolerances(
 
     Parameters
     ----------
+    stage : CycloidStage
+        The stage (fixes K1 and r_c = a z_c).
     tolerances : mapping
         Factor name → tolerance band width T_j [mm] (≥ 0; missing names are 0).
     means : mapping, optional
         Factor name → mean error [mm] (only the eccentricity's mean matters).
+
+    Returns
+    -------
+    dict
+        Factor name → T_Δθj [rad].
+
+    References
+    ----------
+    Hu et al. (2020) eq 17, doi:10.3390/app10020481.
     """
     t = _check_errors(tolerances, "tolerances")
     m = _check_errors(means or {}, "errors")
@@ -382,6 +420,10 @@ def geometric_te(
     GeometricTE
         ``mean = Σ Δθ_j`` (eq 16) and ``tolerance = (Σ T_Δθj²)^½`` (eq 17), both [rad]; convert
         with :func:`gearte.units.rad_to_arcmin` (the paper's 180·60/π).
+
+    References
+    ----------
+    Hu et al. (2020) eq 5–17, doi:10.3390/app10020481.
     """
     contrib = factor_contributions(stage, means)
     tols = factor_tolerances(stage, tolerances or {}, means)
@@ -466,6 +508,10 @@ def compensate(
     -----
     The paper assigns 1.4559′ "in inverse proportion" to the three factors; none of these rules
     (nor any split we tried) reproduces Table 6 through eq 27 — see docs/validation/hu2020.md.
+
+    References
+    ----------
+    Hu et al. (2020) eq 24–27, Table 6, doi:10.3390/app10020481.
     """
     if rule not in ALLOCATION_RULES:
         raise ParameterError("rule", rule, f"must be one of {list(ALLOCATION_RULES)}")

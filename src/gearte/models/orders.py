@@ -36,6 +36,21 @@ def label_frequency(f: float, sources: dict[str, float], tol: float) -> str:
     harmonics, 1..4 for rotations), then mesh ± k × rotation sidebands (k = 1..3); returns
     ``"unidentified"`` when nothing lies within ``tol`` [Hz]. ``f``, ``sources`` and ``tol`` may
     equally be orders (per output revolution).
+
+    Parameters
+    ----------
+    f : float
+        Frequency of the line [Hz] (or order [-]).
+    sources : dict
+        Source name → its fundamental frequency [Hz] (or order [-]); names containing "mesh" or
+        "rotation" take part in sidebands.
+    tol : float
+        Largest distance accepted [Hz] (or [-]).
+
+    Returns
+    -------
+    str
+        The label, e.g. ``"2× cycloid mesh"``, a sideband, or ``"unidentified"``.
     """
     best, err = "unidentified", tol
     for name, fs in sources.items():

@@ -50,6 +50,18 @@ __all__ = [
 def torque_path(turning_points: ArrayLike, steps_per_segment: int = 20) -> np.ndarray:
     """Densify a torque sweep given by its turning points (fractions of rated torque).
 
+    Parameters
+    ----------
+    turning_points : array_like
+        Turning points of the torque sweep as fractions of the rated torque [-].
+    steps_per_segment : int
+        Torque steps between two turning points [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        The densified sweep as fractions of the rated torque [-].
+
     Raises
     ------
     ParameterError
@@ -118,7 +130,27 @@ def torsion_test(
     steps_per_segment: int = 20,
     law: PinContactLaw | ContactLaw | None = None,
 ) -> TorsionTest:
-    """Hysteresis curve: output torsion angle along a torque sweep (fractions of rated torque)."""
+    """Hysteresis curve: output torsion angle along a torque sweep (fractions of rated torque).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    turning_points : array_like
+        Turning points of the torque sweep as fractions of the rated torque [-].
+    theta : float
+        Output angle of the test [rad].
+    steps_per_segment : int
+        Torque steps between two turning points [-].
+    law : PinContactLaw or ContactLaw, optional
+        Pin-contact law; default the reducer's own
+        (:func:`gearte.models.rv_load_sharing.contact_law`).
+
+    Returns
+    -------
+    TorsionTest
+        Torque [N·mm] and output torsion angle [rad] along the sweep.
+    """
     frac = torque_path(turning_points, steps_per_segment)
     law = contact_law(reducer) if law is None else law
     # a torque of exactly zero leaves the output free inside its backlash; approach it from the
@@ -138,6 +170,21 @@ def backlash(
     """Backlash θ(0⁺) − θ(0⁻) [rad]; the smallest over the output angles ``theta`` [rad].
 
     0 (to the elastic deflection at ±1e-4 T_r) when the reducer is preloaded.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    theta : array_like
+        Output angles [rad].
+    law : PinContactLaw or ContactLaw, optional
+        Pin-contact law; default the reducer's own
+        (:func:`gearte.models.rv_load_sharing.contact_law`).
+
+    Returns
+    -------
+    float
+        Backlash [rad].
     """
     law = contact_law(reducer) if law is None else law
     th = np.atleast_1d(np.asarray(theta, dtype=float))
@@ -180,6 +227,23 @@ def virtual_loop(
     Descending branch ``+T_r → −T_r`` then ascending ``−T_r → +T_r`` through
     ``±{1, 0.5, f, ε}·T_r`` and zero (where the output stays on the side it comes from), each
     branch followed with warm starts; returns the loop and its branch marks (+1 rising torque).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    theta : float
+        Output angle of the test [rad].
+    lost_motion_fraction : float
+        f of the lost-motion definition [-] (0.03 or 0.05).
+    law : PinContactLaw or ContactLaw, optional
+        Pin-contact law; default the reducer's own
+        (:func:`gearte.models.rv_load_sharing.contact_law`).
+
+    Returns
+    -------
+    (TorsionTest, numpy.ndarray)
+        The loop and its branch marks [-].
     """
     law = contact_law(reducer) if law is None else law
     tr = reducer.rated_torque
@@ -213,6 +277,27 @@ def catalogue_values(
     The virtual loop (:func:`virtual_loop`) is read by the shared catalogue definitions
     (:func:`gearte.models.catalogue.hysteresis_values`), the same functions that read a
     measured bench curve.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    theta : float
+        Output angle of the test [rad].
+    turning_points : array_like
+        Turning points of the torque sweep as fractions of the rated torque [-].
+    steps_per_segment : int
+        Torque steps between two turning points [-].
+    lost_motion_fraction : float
+        f of the lost-motion definition [-] (0.03 or 0.05).
+    law : PinContactLaw or ContactLaw, optional
+        Pin-contact law; default the reducer's own
+        (:func:`gearte.models.rv_load_sharing.contact_law`).
+
+    Returns
+    -------
+    CatalogueValues
+        Rigidity [N·mm/rad], lost motion, backlash and hysteresis loss [rad].
     """
     if not 0 < lost_motion_fraction < 0.5:
         raise ParameterError("lost_motion_fraction", lost_motion_fraction, "must be in (0, 0.5)")

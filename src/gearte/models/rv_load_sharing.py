@@ -87,6 +87,20 @@ def cycloid_stage(reducer: RVReducer) -> CycloidStage:
     """The reducer's cycloid–pin stage as a :class:`gearte.geometry.cycloid.CycloidStage`.
 
     Its validation (K1 < 1, no undercut, pins fit, non-interfering eq 32 clearance) applies.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    CycloidStage
+        The stage (K1, clearances and curvature of Hu et al.'s eq 3, 32 and 40).
+
+    References
+    ----------
+    Hu et al. (2020) eq 1–4, 32–40, doi:10.3390/app10020481.
     """
     return CycloidStage(
         z_p=reducer.pins.count,
@@ -166,6 +180,20 @@ def contact_law(
 
     The constants (ρ from :meth:`CycloidStage.curvature_radius`, pin radius ``stage.r``, E, ν,
     b) are those the cycloid-stage contact analysis uses, so both analyses share one law.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    law : {"line_contact", "hu2020", "linear"}, optional
+        The law's name; ``None``: the reducer's own.
+    stiffness : float
+        Constant pin-contact stiffness of ``"linear"`` [N/mm].
+
+    Returns
+    -------
+    PinContactLaw
+        The law with its constants.
     """
     if law is None:
         law = getattr(reducer.discs, "contact_law", DEFAULT_LAW)
@@ -186,7 +214,22 @@ def contact_law(
 def solver_law(
     reducer: RVReducer, system: RVSystem, law: PinContactLaw | ContactLaw | None
 ) -> ContactLaw:
-    """The solver law for ``system``: ``law`` as given, or built from a :class:`PinContactLaw`."""
+    """The solver law for ``system``: ``law`` as given, or built from a :class:`PinContactLaw`.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    system : RVSystem
+        The spring and contact rows the law is for.
+    law : PinContactLaw or ContactLaw, optional
+        The law; ``None``: the reducer's own.
+
+    Returns
+    -------
+    ContactLaw
+        The solver's law.
+    """
     return as_solver_law(contact_law(reducer) if law is None else law, system)
 
 
@@ -642,6 +685,16 @@ def mesh_period(reducer: RVReducer) -> float:
 
     The eccentric turns ``-z_c θ`` and the pattern repeats when the pin phases have moved by one
     pin pitch ``2π / z_p``; the mesh-stiffness ripple of the TE has this period.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    float
+        The mesh period of the output angle [rad].
     """
     return 2.0 * np.pi / (reducer.pins.count * reducer.cycloid_teeth)
 
@@ -692,11 +745,18 @@ def transmission_error(
     theta : array_like, optional
         Output angles [rad] (default 360 over one revolution).
     zero_load_fraction : float
-        The geometric TE is solved at ``zero_load_fraction * torque`` in the same direction, so
+        [-] The geometric TE is solved at ``zero_load_fraction * torque`` in the same direction, so
         that the contacts close their clearance without deflecting (a zero torque leaves the
         output free within its backlash).
     mesh_samples : int
         Positions per mesh period in the refinement around the extremes (0: no refinement).
+    law : PinContactLaw or ContactLaw, optional
+        Pin-contact law; default the reducer's own (:func:`contact_law`).
+
+    Returns
+    -------
+    TransmissionError
+        Total, geometric and elastic output angle error [rad] over ``theta``.
     """
     if not torque > 0:
         raise ParameterError("torque", torque, "must be > 0 N·mm for the TE analysis")

@@ -30,7 +30,22 @@ __all__ = [
 
 
 def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:
-    """Histogram of sampled normal backlash [µm] with the analytic normal density overlaid."""
+    """Histogram of sampled normal backlash [µm] with the analytic normal density overlaid.
+
+    Parameters
+    ----------
+    backlash : AnalysisResult
+        The pair's backlash analysis (``backlash_mean [um]``, ``backlash_sd [um]``).
+    mc : object
+        Monte-Carlo result whose ``samples`` are the normal backlash [mm].
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    Figure
+        The matplotlib figure (never shown).
+    """
     v = backlash.values
     mean, sd = v["backlash_mean [um]"], v["backlash_sd [um]"]
     samples = mm_to_um(np.asarray(mc.samples))
@@ -65,7 +80,20 @@ def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:
 
 
 def contribution_pareto(contrib: Any, title: str) -> Figure:
-    """Pareto chart of variance shares [%] with the cumulative share."""
+    """Pareto chart of variance shares [%] with the cumulative share.
+
+    Parameters
+    ----------
+    contrib : AnalysisResult
+        The contribution analysis (``variance_share [%]`` per tolerance).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    Figure
+        The matplotlib figure (never shown).
+    """
     shares = contrib.values["variance_share [%]"]
     items = sorted(shares.items(), key=lambda kv: kv[1], reverse=True)
     names = [k for k, _ in items]
@@ -82,7 +110,18 @@ def contribution_pareto(contrib: Any, title: str) -> Figure:
 
 
 def chain_diagram(chain: Any) -> Figure:
-    """Stages from motor to joint as boxes; each labelled with its share of the joint error."""
+    """Stages from motor to joint as boxes; each labelled with its share of the joint error.
+
+    Parameters
+    ----------
+    chain : AnalysisResult
+        The ``chain`` analysis (``stage_share [%]``, ``stage_ratio``).
+
+    Returns
+    -------
+    Figure
+        The matplotlib figure (never shown).
+    """
     from matplotlib.patches import FancyBboxPatch
 
     v = chain.values
@@ -127,7 +166,18 @@ def chain_diagram(chain: Any) -> Figure:
 
 
 def compensation(result: Any) -> Figure:
-    """Stage contributions at the joint [arcmin] before, after shim and after compensation."""
+    """Stage contributions at the joint [arcmin] before, after shim and after compensation.
+
+    Parameters
+    ----------
+    result : StudyResult
+        A ``gear_chain`` result (its ``chain``, ``shim`` and ``compensation`` analyses).
+
+    Returns
+    -------
+    Figure
+        The matplotlib figure (never shown).
+    """
     chain = result["chain"]
     stages = list(chain.values["stage_share [%]"])
     cols = [("before", chain.values["stage_at_joint_max [arcmin]"])]

@@ -19,7 +19,18 @@ __all__ = ["figures", "phasor_figure", "te_period_figure", "mc_histograms_figure
 
 
 def phasor_figure(result: Any) -> Figure | None:
-    """Group phasors (one arrow per same-frequency group) at the coupled-TE assembly."""
+    """Group phasors (one arrow per same-frequency group) at the coupled-TE assembly.
+
+    Parameters
+    ----------
+    result : StudyResult
+        A ``planetary`` result (its coupled-TE assembly analysis is read).
+
+    Returns
+    -------
+    Figure or None
+        The figure, or ``None`` when the result lacks that analysis.
+    """
     if "coupled_te" not in result:
         return None
     te = result["coupled_te"].data["te"]
@@ -57,7 +68,18 @@ def phasor_figure(result: Any) -> Figure | None:
 
 
 def te_period_figure(result: Any) -> Figure | None:
-    """Σe(t) converted to output TE over one common period."""
+    """Σe(t) converted to output TE over one common period.
+
+    Parameters
+    ----------
+    result : StudyResult
+        A ``planetary`` result (its coupled TE analysis is read).
+
+    Returns
+    -------
+    Figure or None
+        The figure, or ``None`` when the result lacks that analysis.
+    """
     if "coupled_te" not in result:
         return None
     a = result["coupled_te"]
@@ -98,7 +120,18 @@ def te_period_figure(result: Any) -> Figure | None:
 
 
 def mc_histograms_figure(result: Any) -> Figure | None:
-    """Histogram of the coupled TE per Monte-Carlo scenario."""
+    """Histogram of the coupled TE per Monte-Carlo scenario.
+
+    Parameters
+    ----------
+    result : StudyResult
+        A ``planetary`` result (its Monte-Carlo scenarios analysis is read).
+
+    Returns
+    -------
+    Figure or None
+        The figure, or ``None`` when the result lacks that analysis.
+    """
     mcs = [a for a in result.analyses if a.name.startswith("mc_")]
     if not mcs:
         return None

@@ -105,6 +105,19 @@ def _trend(orders) -> Figure | None:
 
 
 def figures(result) -> list[Figure]:
+    """The figures of an ``rv_bench`` result: hysteresis with the calibrated model, TE traces,
+    order spectrum and order trend (each where its analysis ran).
+
+    Parameters
+    ----------
+    result : StudyResult
+        An ``rv_bench`` result.
+
+    Returns
+    -------
+    list of Figure
+        Titled figures for the report.
+    """
     cat = _analysis(result, "catalogue")
     orders = _analysis(result, "te_orders")
     cal_a = _analysis(result, "calibration")

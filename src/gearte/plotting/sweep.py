@@ -54,13 +54,17 @@ def _panel(ax: Any, result: Any, column: str, key: str) -> str:
         cats = list(dict.fromkeys(map(str, xs)))
         x_pos = [float(cats.index(str(x))) for x in xs]
         ax.set_xticks(range(len(cats)), cats)
-    others = [k for k in result.keys if k != key]
+    coupled = result.coupled_with(key) if hasattr(result, "coupled_with") else (key,)
+    others = [k for k in result.keys if k not in coupled]
     groups: dict[tuple[Any, ...], list[int]] = {}
     for i, p in enumerate(result.points):
         groups.setdefault(tuple(p[k] for k in others), []).append(i)
     if len(groups) <= MAX_LINES:
         for n, (g, idx) in enumerate(groups.items()):
-            label = ", ".join(f"{k} = {v}" for k, v in zip(others, g, strict=True)) or None
+            label = (
+                ", ".join(f"{k.rsplit('.', 1)[-1]} = {v}" for k, v in zip(others, g, strict=True))
+                or None
+            )
             ax.plot(
                 [x_pos[i] for i in idx],
                 [y[i] for i in idx],
@@ -69,24 +73,33 @@ def _panel(ax: Any, result: Any, column: str, key: str) -> str:
                 color=PALETTE[n % len(PALETTE)],
                 label=label,
             )
-        if others:
+        if others:  # moved below the panel, out of the data, by ``polish``
             ax.legend(fontsize="x-small")
         how = f"lines: {', '.join(others)}" if others else ""
     else:
         ax.scatter(x_pos, y, s=12, color=PALETTE[0])
         how = "all points"
     for i, e in enumerate(result.errors):
-        if e:
+        if e:  # failed or invalid (skipped) points
             ax.axvline(x_pos[i], color="0.8", lw=0.8, ls=":")
-    ax.set_xlabel(key)
+    ax.set_xlabel(key if len(coupled) == 1 else f"{key} (with {', '.join(coupled[1:])})")
     ax.set_ylabel(column)
     ax.grid(True, alpha=0.3)
     return how
 
 
+def _axis_keys(result: Any) -> list[str]:
+    """One key per axis of the grid: the first of each group of coupled keys."""
+    vary = getattr(result, "vary", None)
+    if vary is None:
+        return list(result.keys)
+    return [v.keys[0] for v in vary]
+
+
 def figure_for(result: Any, column: str) -> Figure:
-    """``column`` (a scalar result) against each varied key, one panel per key."""
-    keys = result.keys
+    """``column`` (a scalar result) against each axis of the grid, one panel per axis (coupled
+    keys share one panel, drawn over the first of them)."""
+    keys = _axis_keys(result)
     fig, axes = new_figure(1, len(keys), figsize=(5.0 * len(keys), 3.6), squeeze=False)
     hows = [_panel(ax, result, column, key) for ax, key in zip(axes[0], keys, strict=True)]
     caption = f"{column} over the sweep of {', '.join(keys)}"
@@ -95,7 +108,29 @@ def figure_for(result: Any, column: str) -> Figure:
         caption += f" ({'; '.join(extra)})"
     failed = sum(1 for e in result.errors if e)
     if failed:
-        caption += f"; dotted: {failed} point(s) that failed"
+        caption += f"; dotted: {failed} point(s) that failed or did not validate"
+    from gearte.plotting.display import polish
+
+    polish(fig)  # legends out of the data (below each panel), integer ticks for counts
+    lines = 0
+    for ax in fig.axes:  # one legend entry per row: panels side by side must not overlap
+        leg = ax.get_legend()
+        if leg is None:
+            continue
+        handles, labels = leg.legend_handles, [t.get_text() for t in leg.get_texts()]
+        leg.remove()
+        ax.legend(
+            handles,
+            labels,
+            loc="upper center",
+            bbox_to_anchor=(0.5, -0.16),
+            ncols=1,
+            fontsize=7,
+            frameon=False,
+        )
+        lines = max(lines, len(labels))
+    if lines:
+        fig.set_size_inches(fig.get_figwidth(), 3.6 + 0.17 * lines)
     return Figure(f"{column} vs {', '.join(keys)}", caption, fig)
 
 

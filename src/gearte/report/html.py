@@ -39,7 +39,20 @@ class RenderedFigure:
 
 
 def figure_to_png_base64(fig: Any, dpi: int = DPI) -> str:
-    """PNG of a matplotlib figure, base64 encoded."""
+    """PNG of a matplotlib figure, base64 encoded.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    dpi : int
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    str
+        Base64 text of the PNG.
+    """
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
     return base64.b64encode(buf.getvalue()).decode("ascii")
@@ -157,6 +170,18 @@ def render_report(result: Any, figures: list[RenderedFigure] | None = None) -> s
     """HTML text of the report of a :class:`~gearte.results.StudyResult`.
 
     ``figures``: already rendered figures (:func:`render_figures`); rendered here if ``None``.
+
+    Parameters
+    ----------
+    result : StudyResult
+        The result to report.
+    figures : list of RenderedFigure, optional
+        Already rendered figures (:func:`render_figures`); rendered here if ``None``.
+
+    Returns
+    -------
+    str
+        The self-contained HTML page.
     """
     import jinja2
 

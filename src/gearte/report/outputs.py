@@ -54,6 +54,18 @@ def safe_label(name: str, *, default: str = "case") -> str:
 
     >>> safe_label("../../x")
     '_.._x'
+
+    Parameters
+    ----------
+    name : str
+        The case name.
+    default : str
+        Used when nothing is left of ``name``.
+
+    Returns
+    -------
+    str
+        The folder name.
     """
     label = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).lstrip(".")[:100]
     return label or default
@@ -273,7 +285,15 @@ def write_file_set(out_dir: str | os.PathLike[str], files: Mapping[str, bytes]) 
 
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write one file ``path`` atomically (temporary file in the same folder + rename), with the
-    mode of a normally created file; creates the folder. For single files outside a result set."""
+    mode of a normally created file; creates the folder. For single files outside a result set.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    data : bytes
+        Its content.
+    """
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -293,7 +313,15 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
 
 
 def atomic_write_text(path: Path, text: str) -> None:
-    """:func:`atomic_write_bytes` of ``text`` encoded as UTF-8."""
+    """:func:`atomic_write_bytes` of ``text`` encoded as UTF-8.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    text : str
+        Its content.
+    """
     atomic_write_bytes(path, text.encode("utf-8"))
 
 

@@ -238,10 +238,11 @@ def calibrate(
         a calibration shaft, ``{"encoder_eccentricity_cos": 0, ...}`` from a reversal test).
     torque_noise : float
         Standard deviation of the torque reading as a fraction of ``T_r`` (the sensor's
-        specification); near zero torque, where the curve is steep, it dominates the angle
+        specification) [-]; near zero torque, where the curve is steep, it dominates the angle
         error and the hysteresis residuals are weighted by the effective variance.
     max_relative_ci : float
-        A parameter whose 95 % half-width exceeds this fraction of its bound range is flagged.
+        A parameter whose 95 % half-width exceeds this fraction of its bound range is flagged
+        [-].
 
     Returns
     -------
@@ -486,6 +487,36 @@ def synthetic_bench(
     Gaussian noise ``angle_noise`` [rad] and are quantised to the encoder's ``encoder_counts``
     per revolution (TE: both encoders). The TE trace spans one output revolution forward and
     backward with ``samples_per_revolution`` samples each.
+
+    Parameters
+    ----------
+    model : ReducedRV
+        The reduced model.
+    params : dict
+        Its parameters (:func:`gearte.models.bench_reduced.parameter_names`), gearte units.
+    rng : numpy.random.Generator
+        Source of the noise.
+    samples_per_revolution : int
+        TE samples per revolution and direction [-].
+    hysteresis_points : int
+        Samples per half branch of the sweep [-].
+    angle_noise : float
+        Standard deviation of the angle readings [rad].
+    torque_noise : float
+        Standard deviation of the torque reading as a fraction of T_r [-].
+    encoder_counts : int
+        Encoder counts per revolution [-].
+    speed_rpm : float
+        Output speed written with the trace [rpm] (not modelled).
+    oil_temperature : float
+        Oil temperature written with the trace [°C] (not modelled).
+    serial : str
+        Serial number written with the data.
+
+    Returns
+    -------
+    (HysteresisCurve, TETrace)
+        The synthetic bench data.
     """
     tr = model.rated_torque
     h = hysteresis_points
@@ -522,6 +553,20 @@ def reduced_constants(reducer, families: dict[str, int], *, clearance: float = 0
     ``g_cam``, ``g_car`` [rad/mm] are the backlash added per mm of radial clearance of the cam
     and carrier crank bearings, by finite difference of the virtual backlash with ``clearance``
     [mm] added to each in turn.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer type as described.
+    families : dict
+        Error family name → its order per output revolution [-].
+    clearance : float
+        Clearance step of the finite difference [mm].
+
+    Returns
+    -------
+    ReducedRV
+        ``K_nom`` [N·mm/rad], ``(g_cam, g_car)`` [rad/mm] and the families.
     """
     from gearte.models.rv_catalogue import backlash, catalogue_values
 

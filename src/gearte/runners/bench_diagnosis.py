@@ -112,11 +112,11 @@ def diagnose(
         Labelled orders of the measured TE (:func:`gearte.models.orders.labelled_orders`, amplitude
         [rad]); strong lines no family explains are reported.
     lost_motion_fraction : float
-        ``f`` of the lost-motion definition.
+        ``f`` of the lost-motion definition [-].
     draws, seed : int
         Parameter draws for the confidences (seeded: the same serial gives the same answer).
     correlation_limit : float
-        Two lost-motion contributors whose parameters correlate beyond this are merged.
+        Two lost-motion contributors whose parameters correlate beyond this are merged [-].
 
     Returns
     -------

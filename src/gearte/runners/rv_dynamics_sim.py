@@ -227,7 +227,26 @@ class ErrorTolerances:
 def draw_errors(
     rng: np.random.Generator, tol: ErrorTolerances, crank_count: int, disc_count: int, **cl
 ) -> RVErrors:
-    """One random realisation of the errors (amplitude U(0, tol), phase U(0, 2π))."""
+    """One random realisation of the errors (amplitude U(0, tol), phase U(0, 2π)).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The random stream.
+    tol : ErrorTolerances
+        Amplitude tolerances [mm].
+    crank_count : int
+        Number of cranks [-].
+    disc_count : int
+        Number of discs [-].
+    **cl
+        Clearances [mm] passed on to :class:`RVErrors`.
+
+    Returns
+    -------
+    RVErrors
+        One realisation.
+    """
     m, n = crank_count, disc_count
 
     def pair(t, shape=()):
@@ -301,6 +320,39 @@ def dte_batch(
     worker count. A run takes seconds, so the default is one realisation per chunk: any batch
     of >= 2 runs keeps every worker busy (with 4 per chunk, a batch of 2 ran on one worker). The kernel reduces each run to (p2p, rms, mean) inside the time loop; nothing
     else is stored. Returns the per-realisation rows and their summary.
+
+    Parameters
+    ----------
+    model : RVDynamicModel
+        The compiled dynamic model.
+    samples : int
+        Number of error realisations [-].
+    tolerances : ErrorTolerances, optional
+        Amplitude tolerances [mm]; required unless the model's own.
+    seed : int, optional
+        Seed of the chunks' generators.
+    duration_s : float
+        Simulated time per realisation after settling [s].
+    settle_s : float
+        Settling time before the DTE is summarised [s].
+    dt : float, optional
+        RK4 step [s]; default the model's.
+    chunk_size : int
+        Realisations per chunk [-].
+    workers : int, optional
+        Parallel workers.
+    scheduler : optional
+        Execution backend (:func:`gearte.execution.open_executor`).
+    progress : bool
+        Show a progress bar.
+    clearances : dict, optional
+        Bearing clearances [mm] of every realisation.
+
+    Returns
+    -------
+    dict
+        ``rows`` (p2p, rms, mean DTE [arcsec] per realisation) and the summary
+        statistics of the p2p.
     """
     from gearte.execution import chunk_sizes, map_chunks, spawn_generators
 

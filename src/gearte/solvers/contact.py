@@ -255,6 +255,32 @@ def solve_load_sharing_plain(
     """Plain-Python twin of :func:`solve_load_sharing`: per-pin loops and bisection.
 
     Same arguments and results; kept flat and readable as the reference implementation.
+
+    Parameters
+    ----------
+    lr : ndarray, shape (n, z_p)
+        l_i / r_c of every pin at each mesh position [-]; pins with lr ≤ 0 never touch.
+    clr : ndarray, shape (n, z_p)
+        Initial clearance Δ_i (eq 32) [mm].
+    T_c : float
+        Torque on the disc [N·mm].
+    r_c : float
+        Cycloid pitch radius a z_c [mm].
+    A, B : float
+        Compliance constants: δ_max(F) = A F (2/3 + ln(B/F)) [mm/N, N].
+    F_start : float or ndarray
+        Start value(s) of F_max [N] (seed the bracket only).
+    rtol : float
+        Relative width of the final bracket [-].
+    max_iter : int
+        Iterations allowed after bracketing.
+
+    Returns
+    -------
+    F_max : ndarray, shape (n,)
+        The fixed point [N].
+    n_eval : ndarray, shape (n,)
+        Residual evaluations used.
     """
     lr, clr, F0 = _prep(lr, clr, T_c, r_c, A, B, F_start)
     Fcap = compliance_limit(B)

@@ -440,7 +440,7 @@ def integrate(
     record_dt : float, optional
         Recording interval [s] (a multiple of dt for RK4); ``None`` records nothing.
     record_states : sequence of int, optional
-        Indices of state components recorded beside the output.
+        Indices of state components recorded beside the output [-].
     max_records : int
         Most recorded rows allowed (memory bound; a longer record is an error).
     max_steps : int

@@ -387,9 +387,12 @@ def solve_positions(
         Output load torque [N·mm] (positive resists the drive; may change sign along a sweep).
     law : ContactLaw or a model-level law with ``for_system(system)``
     q0, k0 : arrays, optional
-        Warm start for the first position (displacements, per-disc contact stiffness).
+        Warm start for the first position: displacements [mm, rad] and per-disc contact
+        stiffness [N/mm].
     tol : float
-        Relative tolerance of the contact-stiffness fixed point.
+        Relative tolerance of the contact-stiffness fixed point [-].
+    maxit : int
+        Most fixed-point iterations per position [-].
     compiled : bool
         ``False`` runs the plain-Python twin of the same kernel (for tests).
 
@@ -456,6 +459,26 @@ def solve_reference(system, torque: float, law: ContactLaw, p: int = 0, k=None, 
     stall near a kink ("not making good progress"); it is then restarted from its last iterate
     with Levenberg–Marquardt (``lm``). The answer is accepted on its scaled residual, not on the
     solvers' own flags: ``‖r(q)‖∞ ≤ tol`` or :class:`~gearte.errors.ConvergenceError`.
+
+    Parameters
+    ----------
+    system : gearte.models.rv_load_sharing.RVSystem
+        Spring and contact rows.
+    torque : float
+        Output load torque [N·mm].
+    law : ContactLaw
+        The contact law (its stiffness scheme).
+    p : int
+        The position checked [-].
+    k : array_like, optional
+        Fixed contact stiffness [N/mm], per disc or per contact.
+    tol : float
+        Accepted scaled residual ‖r(q)‖∞ [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        q, the displacements [mm, rad].
     """
     from scipy.optimize import root
 

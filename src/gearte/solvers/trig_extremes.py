@@ -122,7 +122,18 @@ def sincos(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def grid_points(harmonics: Sequence[int] | np.ndarray) -> int:
     """Nodes of the dense stage: 8 per period of the highest of ``harmonics`` (>= 16), so that
-    ``n_max h = pi/4`` bounds the rotation angles of the refinement."""
+    ``n_max h = pi/4`` bounds the rotation angles of the refinement.
+
+    Parameters
+    ----------
+    harmonics : sequence of int
+        Harmonic orders of the trigonometric polynomial [-].
+
+    Returns
+    -------
+    int
+        Number of grid nodes [-].
+    """
     return max(16, 8 * int(max(harmonics)) if len(harmonics) else 16)
 
 

@@ -97,9 +97,23 @@ def check_samples_override(case: Any, samples: int | None) -> None:
 def run_case(case: Any, options: RunOptions | None = None) -> Any:
     """Run a case: a validated ``Case``, a path to a TOML file, a bundled name or a dict.
 
+    Parameters
+    ----------
+    case : Case, str, os.PathLike or dict
+        What to run.
+    options : RunOptions, optional
+        Execution options; default :class:`RunOptions` ().
+
     Returns
     -------
     gearte.results.StudyResult
+
+    Raises
+    ------
+    gearte.errors.Interrupted, gearte.errors.ClusterLostError
+        The run was stopped (SIGINT/SIGTERM) or lost its cluster during sampled work after
+        chunks had finished: ``exc.partial`` is the result computed from the finished chunks,
+        marked partial (``result.partial``, first warning), see :mod:`gearte.execution.stop`.
     """
     if isinstance(case, str | os.PathLike | dict):
         from gearte.io.case_file import load_case
@@ -109,13 +123,23 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
     module = get_kind(case.case.kind)
     check_samples_override(case, (options or RunOptions()).samples)
     t0 = time.perf_counter()
-    with _numba_timer() as numba:
+    from gearte.execution.stop import keep_finished_chunks
+
+    with _numba_timer() as numba, keep_finished_chunks() as stop:
         result = module.run(case, options or RunOptions())
     t_end = time.perf_counter()
     result.elapsed_s = t_end - t0
     result.timings["imports: study kind"] = t0 - t_imp
     result.timings.update(numba)
     result.timings.update(analysis_timings(result.analyses, t0, t_end))
+    if stop.stopped:
+        from gearte.errors import ClusterLostError, Interrupted
+
+        result.partial = True
+        result.warnings.insert(0, stop.summary())
+        if stop.signum is not None:
+            raise Interrupted(stop.signum, partial=result) from None
+        raise ClusterLostError(str(stop.cause), partial=result) from None
     return result
 
 

@@ -54,10 +54,22 @@ class ToleranceEntry(StrictModel):
     """One error's tolerance; lengths in µm, angles in deg (as the error key's unit)."""
 
     kind: Literal["normal", "truncated_normal", "uniform", "rayleigh", "empirical", "constant"] = (
-        "normal"
+        Field(
+            "normal",
+            description="Law of the error: normal (σ = tolerance / sigmas), truncated_normal (cut "
+            "at ±tolerance), uniform, rayleigh (a magnitude), empirical (values_um resampled) or "
+            "constant.",
+        )
     )
-    tolerance_um: float | None = Field(default=None, ge=0, le=100_000)
-    tolerance_deg: float | None = Field(default=None, ge=0, le=360)
+    tolerance_um: float | None = Field(
+        default=None,
+        ge=0,
+        le=100_000,
+        description="Tolerance t of a length error [µm]: nominal ± t (3σ by default).",
+    )
+    tolerance_deg: float | None = Field(
+        default=None, ge=0, le=360, description="Tolerance of an angle error [deg]."
+    )
     grade: int | None = Field(
         default=None,
         ge=1,
@@ -65,11 +77,33 @@ class ToleranceEntry(StrictModel):
         description="ISO 1328-1:2013 class instead of tolerance_um, where the error is a gear's "
         "eccentricity: tolerance = F_rT / 2",
     )
-    nominal_um: float | None = Field(default=None, ge=-100_000, le=100_000)
-    nominal_deg: float | None = Field(default=None, ge=-360, le=360)
-    sigmas: float | None = Field(default=None, gt=0, le=100)
-    phase: bool = False
-    values_um: list[float] | None = Field(default=None, min_length=2, max_length=1_000_000)
+    nominal_um: float | None = Field(
+        default=None,
+        ge=-100_000,
+        le=100_000,
+        description="Mean of a length error [µm]; default: the case's value of that error.",
+    )
+    nominal_deg: float | None = Field(
+        default=None,
+        ge=-360,
+        le=360,
+        description="Mean of an angle error [deg]; default: the case's value of that error.",
+    )
+    sigmas: float | None = Field(
+        default=None,
+        gt=0,
+        le=100,
+        description="σ = tolerance / sigmas [-] (default 3; rayleigh 3.44, 99.73 % inside).",
+    )
+    phase: bool = Field(
+        False, description="rayleigh only: also draw a uniform direction of the error."
+    )
+    values_um: list[float] | None = Field(
+        default=None,
+        min_length=2,
+        max_length=1_000_000,
+        description="empirical only: measured deviations [µm], resampled.",
+    )
 
     @model_validator(mode="after")
     def _one_unit(self) -> ToleranceEntry:
@@ -90,7 +124,11 @@ class ToleranceEntry(StrictModel):
 class GroupEntry(StrictModel):
     """Correlated errors (one grinding batch, one fixture)."""
 
-    name: str = Field(min_length=1, max_length=100)
+    name: str = Field(
+        min_length=1,
+        max_length=100,
+        description="Name of the correlated group (a grinding batch, a fixture).",
+    )
     keys: list[str] = Field(min_length=1, max_length=1000, description="keys or families")
     rho: float = Field(ge=0, le=1, description="correlation of the members' standard normals")
 
@@ -98,8 +136,12 @@ class GroupEntry(StrictModel):
 class SpecEntry(StrictModel):
     """``lower <= quantity <= upper``."""
 
-    lower: float | None = None
-    upper: float | None = None
+    lower: float | None = Field(
+        None, description="Lower spec limit, in the quantity's unit (the key's brackets)."
+    )
+    upper: float | None = Field(
+        None, description="Upper spec limit, in the quantity's unit (the key's brackets)."
+    )
 
     @model_validator(mode="after")
     def _limits(self) -> SpecEntry:
@@ -113,11 +155,32 @@ class SpecEntry(StrictModel):
 class CostEntry(StrictModel):
     """``cost = a + b / t^k`` (t in the error's unit) or a table of widths and prices."""
 
-    a: float = Field(default=0.0, ge=0, le=1e12)
-    b: float | None = Field(default=None, ge=0, le=1e12)
-    k: float = Field(default=1.0, ge=0, le=10)
-    widths: list[float] | None = Field(default=None, min_length=2, max_length=100)
-    prices: list[float] | None = Field(default=None, min_length=2, max_length=100)
+    a: float = Field(
+        default=0.0,
+        ge=0,
+        le=1e12,
+        description="Fixed cost per part in cost = a + b / t^k (any currency).",
+    )
+    b: float | None = Field(
+        default=None,
+        ge=0,
+        le=1e12,
+        description="Cost coefficient b of cost = a + b / t^k, t the tolerance in the error's "
+        "unit; or give widths and prices.",
+    )
+    k: float = Field(default=1.0, ge=0, le=10, description="Exponent k of cost = a + b / t^k [-].")
+    widths: list[float] | None = Field(
+        default=None,
+        min_length=2,
+        max_length=100,
+        description="Tolerance widths of a price table, in the error's unit (with prices).",
+    )
+    prices: list[float] | None = Field(
+        default=None,
+        min_length=2,
+        max_length=100,
+        description="Price per part at each of widths (same length).",
+    )
 
     @model_validator(mode="after")
     def _one_form(self) -> CostEntry:
@@ -132,26 +195,57 @@ class CostEntry(StrictModel):
 
 
 class AllocationEntry(StrictModel):
-    target_yield: float = Field(gt=0, lt=1)
+    target_yield: float = Field(
+        gt=0, lt=1, description="Yield the cheapest tolerance set must reach [-] (0.99: 99 %)."
+    )
     costs: dict[str, CostEntry] = Field(min_length=1)
-    samples: int | None = Field(default=None, ge=100, le=10**8)
+    samples: int | None = Field(
+        default=None,
+        ge=100,
+        le=10**8,
+        description="Samples per candidate tolerance set (default: the section's samples).",
+    )
 
 
 class YieldSection(StrictModel):
     """``[analyses.yield]`` (module docstring)."""
 
-    samples: int = Field(default=20_000, ge=1, le=10**9)
-    seed: int = Field(default=0, ge=0)
-    chunk_size: int = Field(default=2_000, ge=1, le=10**7)
-    confidence: float = Field(default=0.95, gt=0.5, lt=1)
-    ci_method: Literal["wilson", "clopper-pearson"] = "wilson"
-    sobol_samples: int = Field(default=0, ge=0, le=10**7)
-    bootstrap: int = Field(default=100, ge=0, le=10_000)
-    keep_worst: int = Field(default=3, ge=0, le=100)
+    samples: int = Field(default=20_000, ge=1, le=10**9, description="Assembled drives drawn [-].")
+    seed: int = Field(
+        default=0,
+        ge=0,
+        description="Seed of the random streams (same seed, same result on any backend).",
+    )
+    chunk_size: int = Field(
+        default=2_000, ge=1, le=10**7, description="Samples per chunk of the execution layer."
+    )
+    confidence: float = Field(
+        default=0.95, gt=0.5, lt=1, description="Confidence level of the yield's interval [-]."
+    )
+    ci_method: Literal["wilson", "clopper-pearson"] = Field(
+        "wilson", description="Interval of the yield: Wilson score or exact Clopper–Pearson."
+    )
+    sobol_samples: int = Field(
+        default=0,
+        ge=0,
+        le=10**7,
+        description="Base samples for Sobol indices per tolerance (0: none).",
+    )
+    bootstrap: int = Field(
+        default=100,
+        ge=0,
+        le=10_000,
+        description="Bootstrap resamples for the Sobol indices' intervals (0: none).",
+    )
+    keep_worst: int = Field(
+        default=3, ge=0, le=100, description="Worst samples kept and written as case files."
+    )
     tolerances: dict[str, ToleranceEntry] = Field(default_factory=dict)
     groups: list[GroupEntry] = Field(default_factory=list)
     spec: dict[str, SpecEntry] = Field(default_factory=dict)
-    allocation: AllocationEntry | None = None
+    allocation: AllocationEntry | None = Field(
+        None, description="Optional: the cheapest tolerances for a target yield."
+    )
 
 
 def _tolerances(

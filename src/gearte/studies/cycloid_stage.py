@@ -59,6 +59,13 @@ _TableFactor = Literal[
     "cumulative_pitch_error",
 ]
 
+#: The factors whose error coefficient is negative (Table 2): the default compensation set.
+_NEGATIVE_COEFFICIENT_FACTORS: tuple[_TableFactor, ...] = (
+    "pin_radius_error",
+    "shifted_modification_error",
+    "cumulative_pitch_error",
+)
+
 _STAGE_FIELD = {
     "z_p": "pins",
     "z_c": "cycloid_teeth",
@@ -155,10 +162,10 @@ class ToothContactOptions(_Section):
 
     torque_Nm: float = Field(gt=0, le=1e6, description="Output torque of the stage T [N·m].")
     disc_share: float = Field(
-        default=0.55, gt=0, le=1, description="Share of T carried by the analysed disc (0.55)."
+        gt=0, le=1, description="Share of T carried by the analysed disc (Hu et al.: 0.55)."
     )
-    youngs_modulus_MPa: float = Field(default=2.06e5, gt=0, le=1e7, description="E [MPa].")
-    poisson_ratio: float = Field(default=0.3, ge=0, lt=0.5, description="μ [-].")
+    youngs_modulus_MPa: float = Field(gt=0, le=1e7, description="E of disc and pins [MPa].")
+    poisson_ratio: float = Field(ge=0, lt=0.5, description="μ of disc and pins [-].")
     mesh_positions: int = Field(
         default=1, ge=1, le=100000, description="Mesh positions over one tooth pitch (1: paper's)."
     )
@@ -189,15 +196,16 @@ class CompensationOptions(_Section):
         description="Wanted change of the mean geometric TE; default: remove the mean.",
     )
     factors: list[_TableFactor] = Field(
-        default_factory=lambda: [
-            "pin_radius_error",
-            "shifted_modification_error",
-            "cumulative_pitch_error",
-        ],
+        default_factory=lambda: list(_NEGATIVE_COEFFICIENT_FACTORS),
         min_length=1,
         description="Factors allowed to change (default: the negative-coefficient ones).",
     )
-    rule: Literal["equal_share", "equal_change", "tolerance_weighted"] = "equal_share"
+    rule: Literal["equal_share", "equal_change", "tolerance_weighted"] = Field(
+        "equal_share",
+        description="How the TE change is shared among the factors: equal_share (same TE share "
+        "each), equal_change (same change each) or tolerance_weighted (least change in units of "
+        "each tolerance).",
+    )
 
 
 class Analyses(_Section):
@@ -239,7 +247,7 @@ def build_stage(stage: Stage):
 
     return CycloidStage(
         z_p=stage.pins,
-        z_c=stage.cycloid_teeth,
+        z_c=stage.pins - 1 if stage.cycloid_teeth is None else stage.cycloid_teeth,
         r_p=stage.pin_circle_radius_mm,
         r_rp=stage.pin_radius_mm,
         a=stage.eccentricity_mm,
@@ -281,11 +289,10 @@ def _geometry(st) -> AnalysisResult:
     )
 
 
-def _geometric_te(st, case: Case) -> AnalysisResult:
+def _geometric_te(st, case: Case, opts: GeometricTEOptions) -> AnalysisResult:
     from gearte.models.cycloid_te import PAPER_SYMBOLS, geometric_te, sensitivity_indices
     from gearte.units import rad_to_arcmin, um_to_mm
 
-    opts = case.analyses.geometric_te
     means = case.errors.means_mm()
     tols = case.errors.tolerances_mm()
     te = geometric_te(st, means, tols)
@@ -325,21 +332,26 @@ def _geometric_te(st, case: Case) -> AnalysisResult:
     )
 
 
-def _tooth_contact(st, case: Case) -> tuple[AnalysisResult, list[str]]:
+def _tooth_contact(st, o: ToothContactOptions) -> tuple[AnalysisResult, list[str]]:
     from gearte.models.cycloid_contact import tooth_contact
     from gearte.units import Nm_to_Nmm, rad_to_deg
 
-    o = case.analyses.tooth_contact
     T = float(Nm_to_Nmm(o.torque_Nm))
-    kw = dict(
-        disc_share=o.disc_share,
-        E=o.youngs_modulus_MPa,
-        mu=o.poisson_ratio,
-        F_start=o.start_force_N,
-        clearance_model=o.clearance_model,
-        contact_law=o.contact_law,
-    )
-    tc = tooth_contact(st, T, mesh_angle=0.0, **kw)
+
+    def contact(mesh_angle):
+        return tooth_contact(
+            st,
+            T,
+            disc_share=o.disc_share,
+            E=o.youngs_modulus_MPa,
+            mu=o.poisson_ratio,
+            mesh_angle=mesh_angle,
+            F_start=o.start_force_N,
+            clearance_model=o.clearance_model,
+            contact_law=o.contact_law,
+        )
+
+    tc = contact(0.0)
     values = {
         "contact_law": o.contact_law,
         "pins_in_mesh": int(tc.pins_in_mesh[0]),
@@ -363,7 +375,7 @@ def _tooth_contact(st, case: Case) -> tuple[AnalysisResult, list[str]]:
     sweep = None
     if o.mesh_positions > 1:
         theta = np.arange(o.mesh_positions) * (2.0 * np.pi / st.z_p) / o.mesh_positions
-        sweep = tooth_contact(st, T, mesh_angle=theta, **kw)
+        sweep = contact(theta)
         values.update(
             {
                 "mesh_angle [deg]": rad_to_deg(theta),
@@ -414,11 +426,10 @@ def _tooth_contact(st, case: Case) -> tuple[AnalysisResult, list[str]]:
     return res, warnings
 
 
-def _compensation(st, case: Case) -> AnalysisResult:
+def _compensation(st, case: Case, o: CompensationOptions) -> AnalysisResult:
     from gearte.models.cycloid_te import compensate, geometric_te
     from gearte.units import arcmin_to_rad, mm_to_um, rad_to_arcmin
 
-    o = case.analyses.compensation
     means = case.errors.means_mm()
     tols = case.errors.tolerances_mm()
     before = geometric_te(st, means, tols)
@@ -470,7 +481,20 @@ def _compensation(st, case: Case) -> AnalysisResult:
 
 
 def run(case: Case, options) -> StudyResult:
-    """Run a ``cycloid_stage`` case; no I/O, no plotting."""
+    """Run a ``cycloid_stage`` case; no I/O, no plotting.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case.
+    options : RunOptions
+        Execution options (workers, scheduler, progress); the runner passes them.
+
+    Returns
+    -------
+    StudyResult
+        Geometry and the analyses whose table is present.
+    """
     st = build_stage(case.stage)
     analyses = [_geometry(st)]
     warnings: list[str] = []
@@ -483,7 +507,7 @@ def run(case: Case, options) -> StudyResult:
             "unless the errors open it"
         )
     if case.analyses.geometric_te is not None:
-        a = _geometric_te(st, case)
+        a = _geometric_te(st, case, case.analyses.geometric_te)
         analyses.append(a)
         if a.values["geometric_te_min [arcmin]"] < 0:
             warnings.append(
@@ -491,11 +515,11 @@ def run(case: Case, options) -> StudyResult:
                 "interferes (no lost motion left)"
             )
     if case.analyses.tooth_contact is not None:
-        a, w = _tooth_contact(st, case)
+        a, w = _tooth_contact(st, case.analyses.tooth_contact)
         analyses.append(a)
         warnings += w
     if case.analyses.compensation is not None:
-        analyses.append(_compensation(st, case))
+        analyses.append(_compensation(st, case, case.analyses.compensation))
     if case.analyses.yield_ is not None:
         analyses.append(_yield(st, case, options))
     return StudyResult(case=case, analyses=analyses, warnings=warnings)

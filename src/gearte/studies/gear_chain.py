@@ -86,18 +86,60 @@ class StageSpec(StrictModel):
     name: str = Field(min_length=1, description="Unique stage name.")
     ratio: float = Field(gt=0, le=1e6, description="Reduction ratio i = ω_in/ω_out (> 0).")
     compensate: bool = Field(default=False, description="Compensate by the motor angle (eq. 33).")
-    lost_motion_max_arcmin: float | None = Field(default=None, ge=0, le=6000)
-    lost_motion_mean_arcmin: float | None = Field(default=None, ge=0, le=6000)
-    lost_motion_min_arcmin: float | None = Field(default=None, ge=0, le=6000)
-    backlash_min_um: float | None = Field(default=None, ge=0, le=100_000)
-    backlash_mean_um: float | None = Field(default=None, ge=0, le=100_000)
-    backlash_max_um: float | None = Field(default=None, ge=0, le=100_000)
+    lost_motion_max_arcmin: float | None = Field(
+        default=None,
+        ge=0,
+        le=6000,
+        description="Catalogue lost motion of the stage [arcmin] (one of three ways to give a "
+        "stage's return error).",
+    )
+    lost_motion_mean_arcmin: float | None = Field(
+        default=None,
+        ge=0,
+        le=6000,
+        description="Catalogue mean lost motion [arcmin] (optional, with the maximum).",
+    )
+    lost_motion_min_arcmin: float | None = Field(
+        default=None,
+        ge=0,
+        le=6000,
+        description="Catalogue minimum lost motion [arcmin] (optional, with the maximum).",
+    )
+    backlash_min_um: float | None = Field(
+        default=None,
+        ge=0,
+        le=100_000,
+        description="Minimum normal backlash obtained elsewhere (measured, simulated) [µm], with "
+        "output_diameter_mm.",
+    )
+    backlash_mean_um: float | None = Field(
+        default=None, ge=0, le=100_000, description="Mean normal backlash obtained elsewhere [µm]."
+    )
+    backlash_max_um: float | None = Field(
+        default=None,
+        ge=0,
+        le=100_000,
+        description="Maximum normal backlash obtained elsewhere [µm].",
+    )
     output_diameter_mm: float | None = Field(
         default=None, gt=0, le=100_000, description="Driven gear d (spur) or dm (bevel) [mm]."
     )
-    pressure_angle_deg: float = Field(default=20.0, gt=0, lt=45)
-    min_backlash_limit_um: float = Field(default=0.0, ge=0, le=100_000)
-    pair: PairSpec | None = None
+    pressure_angle_deg: float = Field(
+        default=20.0,
+        gt=0,
+        lt=45,
+        description="Pressure angle α of a stage given by backlash values [deg].",
+    )
+    min_backlash_limit_um: float = Field(
+        default=0.0,
+        ge=0,
+        le=100_000,
+        description="Smallest allowed minimum backlash of a stage given by values [µm] (0: none).",
+    )
+    pair: PairSpec | None = Field(
+        None,
+        description="The stage's gear pair and its tolerances (same tables as the gear_pair kind).",
+    )
     drive: DriveSpec | None = Field(
         default=None, description="A drive gearte models (rv_reducer, cycloid_stage, ...)."
     )
@@ -239,9 +281,25 @@ class ShimSpec(StrictModel):
     cone_angle_driven_deg: float = Field(
         default=45.0, gt=0, lt=90, description="δ2, only for stages given by backlash values."
     )
-    verified_backlash_min_um: float | None = Field(default=None, ge=0, le=100_000)
-    verified_backlash_mean_um: float | None = Field(default=None, ge=0, le=100_000)
-    verified_backlash_max_um: float | None = Field(default=None, ge=0, le=100_000)
+    verified_backlash_min_um: float | None = Field(
+        default=None,
+        ge=0,
+        le=100_000,
+        description="Verified (measured or simulated) minimum backlash after shimming [µm], used "
+        "downstream instead of gearte's shifted backlash.",
+    )
+    verified_backlash_mean_um: float | None = Field(
+        default=None,
+        ge=0,
+        le=100_000,
+        description="Verified mean backlash after shimming [µm] (needs min and max).",
+    )
+    verified_backlash_max_um: float | None = Field(
+        default=None,
+        ge=0,
+        le=100_000,
+        description="Verified maximum backlash after shimming [µm] (with the minimum).",
+    )
 
     @model_validator(mode="after")
     def _verified(self):
@@ -266,7 +324,9 @@ class ShimSpec(StrictModel):
 class CompensationSpec(StrictModel):
     """Motor-angle compensation when the load torque reverses (eq. 33)."""
 
-    enabled: bool = True
+    enabled: bool = Field(
+        True, description="Compute the motor-angle compensation (false: skip it)."
+    )
 
 
 class Case(CaseBase):
@@ -504,6 +564,21 @@ def _round_shim(x: float, step: float, how: str) -> float:
 
 
 def run(case: Case, options) -> StudyResult:
+    """Run a ``gear_chain`` case: each stage's lost motion, the joint and end-effector error,
+    shim and motor compensation; no I/O, no plotting.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case.
+    options : RunOptions
+        Execution options (workers, scheduler, progress); the runner passes them.
+
+    Returns
+    -------
+    StudyResult
+        The analyses and warnings.
+    """
     conf = case.analysis.confidence
     analyses: list[AnalysisResult] = []
     warnings: list[str] = []

@@ -142,11 +142,31 @@ class DistributionSpec(StrictModel):
     runout the distribution is that of the magnitude ``e ≥ 0``.
     """
 
-    kind: Literal["normal", "truncated_normal", "uniform", "rayleigh", "empirical"]
-    lower_um: float | None = Field(default=None, ge=-100_000, le=100_000)
-    upper_um: float | None = Field(default=None, ge=-100_000, le=100_000)
-    scale_um: float | None = Field(default=None, gt=0, le=100_000)
-    values_um: list[float] | None = Field(default=None, min_length=2, max_length=10_000_000)
+    kind: Literal["normal", "truncated_normal", "uniform", "rayleigh", "empirical"] = Field(
+        description="Law of the source: normal (σ = range/6), truncated_normal, uniform, rayleigh "
+        "(a magnitude) or empirical (values_um resampled)."
+    )
+    lower_um: float | None = Field(
+        default=None,
+        ge=-100_000,
+        le=100_000,
+        description="Lower limit of the source [µm] (normal, truncated_normal, uniform).",
+    )
+    upper_um: float | None = Field(
+        default=None,
+        ge=-100_000,
+        le=100_000,
+        description="Upper limit of the source [µm] (normal, truncated_normal, uniform).",
+    )
+    scale_um: float | None = Field(
+        default=None, gt=0, le=100_000, description="Rayleigh scale σ of the magnitude [µm]."
+    )
+    values_um: list[float] | None = Field(
+        default=None,
+        min_length=2,
+        max_length=10_000_000,
+        description="empirical: values measured on real parts [µm], resampled.",
+    )
 
     @model_validator(mode="after")
     def _fields_of_kind(self):
@@ -243,7 +263,7 @@ class _Distributions(StrictModel):
 class SpurPairSpec(_Clearance, _Distributions):
     """A spur pair and its mounting (Jiang et al. 2024, Tables 1–2)."""
 
-    type: Literal["spur"] = "spur"
+    type: Literal["spur"] = Field("spur", description="Pair type: a spur pair.")
     module_mm: float = Field(
         ge=0.05, le=100, description="Module m [mm] (0.05 mm: the finest instrument gears)."
     )
@@ -313,7 +333,7 @@ class BevelGearSpec(_ThicknessLimits, _Clearance):
 class BevelPairSpec(_Distributions):
     """A straight bevel pair and its mounting (Jiang et al. 2024, Tables 5–6)."""
 
-    type: Literal["bevel"] = "bevel"
+    type: Literal["bevel"] = Field("bevel", description="Pair type: a bevel pair.")
     module_mm: float = Field(
         ge=0.05, le=100, description="Outer transverse module m [mm] (0.05 mm: the finest gears)."
     )
@@ -376,7 +396,12 @@ class PairAnalysisSpec(StrictModel):
         default=1_000_000, ge=0, le=10**10, description="Monte-Carlo samples (0: skip)."
     )
     seed: int = Field(default=2024, ge=0, description="Seed of the Monte-Carlo streams.")
-    chunk_size: int = Field(default=1_000_000, ge=1000, le=50_000_000)
+    chunk_size: int = Field(
+        default=1_000_000,
+        ge=1000,
+        le=50_000_000,
+        description="Monte-Carlo samples per chunk of the execution layer.",
+    )
     sobol_samples: int = Field(
         default=0, ge=0, le=10**7, description="Base samples for Sobol indices (0: skip)."
     )
@@ -411,7 +436,26 @@ def analyse_pair(
     prefix: str = "",
     title_prefix: str = "",
 ) -> list[AnalysisResult]:
-    """Backlash, Monte-Carlo and contribution analyses of one pair (shared with gear_chain)."""
+    """Backlash, Monte-Carlo and contribution analyses of one pair (shared with gear_chain).
+
+    Parameters
+    ----------
+    spec : SpurPairSpec or BevelPairSpec
+        The pair and its tolerances.
+    analysis : PairAnalysisSpec
+        What to compute (confidence, Monte-Carlo samples, seed).
+    options : RunOptions
+        Execution options (workers, scheduler, progress); the runner passes them.
+    prefix : str
+        Prefix of the analysis names (a chain's stage).
+    title_prefix : str
+        Prefix of the analysis titles.
+
+    Returns
+    -------
+    list of AnalysisResult
+        Backlash, Monte-Carlo and contribution analyses.
+    """
     from gearte.tolerance.contributions import group_shares, sobol_indices, variance_shares
     from gearte.tolerance.montecarlo import monte_carlo
 
@@ -577,6 +621,20 @@ def analyse_pair(
 
 
 def run(case: Case, options) -> StudyResult:
+    """Run a ``gear_pair`` case (:func:`analyse_pair` on its pair); no I/O, no plotting.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case.
+    options : RunOptions
+        Execution options (workers, scheduler, progress); the runner passes them.
+
+    Returns
+    -------
+    StudyResult
+        The analyses and warnings.
+    """
     analyses = analyse_pair(case.pair, case.analysis, options)
     warnings = []
     if not analyses[0].values["meets_min_backlash_limit"]:

@@ -77,9 +77,9 @@ class GearSet(StrictModel):
     planet_angles_deg: list[float] | None = Field(
         default=None, description="planet position angles [deg], first 0; default equal spacing"
     )
-    fixed: Member = "ring"
-    input: Member = "sun"
-    output: Member = "carrier"
+    fixed: Member = Field("ring", description="The member held fixed.")
+    input: Member = Field("sun", description="The input member.")
+    output: Member = Field("carrier", description="The output member.")
     standard: bool = Field(default=True, description="standard gears: z_r = z_s + 2 z_p required")
 
     @model_validator(mode="after")
@@ -114,13 +114,13 @@ MAX_TERM_DENOMINATOR = 10_000
 class TermRow(StrictModel):
     """One published term ``gain * M sin(q w_in t + phase + angle_coeff * angle)``."""
 
-    name: str | None = None
+    name: str | None = Field(None, description="Label of the term (as the paper names it).")
     magnitude: str = Field(description="key into errors.magnitudes_um")
     gain: float = Field(default=1.0, description="factor on the magnitude [-]")
     frequency: float | str = Field(description="multiple of the input speed, number or 'p/q'")
     phase_deg: float = Field(description="constant phase [deg]")
     angle: str | None = Field(default=None, description="key into errors.angles_deg")
-    angle_coeff: Sign = 1
+    angle_coeff: Sign = Field(1, description="Sign (-1 or 1) of the angle in the term's phase.")
 
     @field_validator("frequency")
     @classmethod
@@ -194,20 +194,32 @@ class AssemblyOptions(StrictModel):
 
     starts: int = Field(default=4096, ge=16, le=1_000_000, description="quasi-random starts")
     polish: int = Field(default=8, ge=1, le=200, description="starts refined by Nelder-Mead")
-    seed: int = Field(default=20130808, ge=0)
+    seed: int = Field(default=20130808, ge=0, description="Seed of the quasi-random starts.")
 
 
 class MonteCarloOptions(StrictModel):
     """``[analyses.monte_carlo]``: Wang 2013 §3.2 scenarios."""
 
-    samples: int = Field(default=50_000, ge=1, le=100_000_000)
-    seed: int = Field(default=2013, ge=0)
-    chunk_size: int = Field(default=10_000, ge=100, le=10_000_000)
-    scenarios: list[Scenario] = Field(default_factory=lambda: list(get_args(Scenario)))
+    samples: int = Field(
+        default=50_000, ge=1, le=100_000_000, description="Assemblies drawn per scenario [-]."
+    )
+    seed: int = Field(default=2013, ge=0, description="Seed of the random streams.")
+    chunk_size: int = Field(
+        default=10_000,
+        ge=100,
+        le=10_000_000,
+        description="Samples per chunk of the execution layer.",
+    )
+    scenarios: list[Scenario] = Field(
+        default_factory=lambda: list(get_args(Scenario)),
+        description="Scenarios of Wang 2013 §3.2 to run (default: all).",
+    )
     rayleigh_sigma_fraction: float = Field(
         default=0.5, gt=0, le=10, description="Rayleigh scale / tolerance (0.5: tol = 2 sigma)"
     )
-    bins: int = Field(default=120, ge=5, le=10_000)
+    bins: int = Field(
+        default=120, ge=5, le=10_000, description="Histogram bins of the TE amplitude."
+    )
 
 
 class Analyses(StrictModel):

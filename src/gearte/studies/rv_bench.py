@@ -112,33 +112,70 @@ class DataSection(StrictModel):
 
 
 class CatalogueSection(StrictModel):
-    lost_motion_fraction: float = Field(default=0.03, gt=0.0, lt=0.5)
+    lost_motion_fraction: float = Field(
+        default=0.03,
+        gt=0.0,
+        lt=0.5,
+        description="Lost motion between ±fraction × rated torque [-] (0.03 or 0.05 in "
+        "catalogues).",
+    )
 
 
 class OrdersSection(StrictModel):
-    n_orders: int = Field(default=12, ge=1, le=200)
+    n_orders: int = Field(
+        default=12, ge=1, le=200, description="Largest TE orders listed per trace."
+    )
 
 
 class CalibrationSection(StrictModel):
-    families: list[FamilyName] = Field(default_factory=lambda: list(_DEFAULT_FAMILIES))
+    families: list[FamilyName] = Field(
+        default_factory=lambda: list(_DEFAULT_FAMILIES),
+        description="Parameter families the calibration may fit.",
+    )
     fit: list[str] | None = Field(default=None, description="parameters to fit (default all)")
     encoder_eccentricity_arcsec: tuple[float, float] | None = Field(
         default=None, description="known (cos, sin) of the output encoder's eccentricity"
     )
-    rig_compliance_arcsec_per_kNm: float | None = Field(default=None, ge=0.0, le=1e4)
-    max_relative_ci: float = Field(default=0.25, gt=0.0, le=10.0)
+    rig_compliance_arcsec_per_kNm: float | None = Field(
+        default=None,
+        ge=0.0,
+        le=1e4,
+        description="Known test-rig compliance [arcsec/kN·m], held fixed (default: fitted).",
+    )
+    max_relative_ci: float = Field(
+        default=0.25,
+        gt=0.0,
+        le=10.0,
+        description="A parameter whose 95 % half-width exceeds this fraction of its range is "
+        "flagged poorly identified [-].",
+    )
 
 
 class DiagnosisSection(StrictModel):
-    draws: int = Field(default=2000, ge=100, le=100_000)
-    seed: int = Field(default=0, ge=0)
+    draws: int = Field(
+        default=2000,
+        ge=100,
+        le=100_000,
+        description="Parameter draws from the calibration's Gaussian.",
+    )
+    seed: int = Field(default=0, ge=0, description="Seed of the draws.")
 
 
 class Analyses(StrictModel):
-    catalogue: CatalogueSection | None = None
-    te_orders: OrdersSection | None = None
-    calibration: CalibrationSection | None = None
-    diagnosis: DiagnosisSection | None = None
+    catalogue: CatalogueSection | None = Field(
+        None,
+        description="Catalogue numbers from the hysteresis curve (rigidity, lost motion, "
+        "backlash).",
+    )
+    te_orders: OrdersSection | None = Field(
+        None, description="TE orders labelled from the drive's tooth numbers."
+    )
+    calibration: CalibrationSection | None = Field(
+        None, description="Reduced-model calibration to this serial's data."
+    )
+    diagnosis: DiagnosisSection | None = Field(
+        None, description="Likely culprit parts, from the calibration's uncertainty."
+    )
 
     @model_validator(mode="after")
     def _diagnosis_needs_calibration(self) -> Analyses:

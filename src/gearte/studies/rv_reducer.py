@@ -519,7 +519,20 @@ class Case(CaseBase):
 # Case -> domain objects
 # ------------------------------------------------------------------------------------------
 def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer:
-    """The :class:`RVReducer` a case's ``[reducer]`` section describes."""
+    """The :class:`RVReducer` a case's ``[reducer]`` section describes.
+
+    Parameters
+    ----------
+    sec : ReducerSection
+        The validated ``[reducer]`` table.
+    with_errors : bool
+        Include the ``[[reducer.errors]]`` (``False``: the nominal reducer).
+
+    Returns
+    -------
+    RVReducer
+        The description every RV analysis reads.
+    """
     fs = sec.first_stage
     if fs.mesh_stiffness_N_per_mm is not None:
         mesh = fs.mesh_stiffness_N_per_mm
@@ -910,6 +923,18 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
 
     ``reducer`` replaces the one the case describes (a measured serial, ``rv_serial``); its
     errors are compared with the design's errors removed.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case.
+    options : RunOptions, optional
+        Execution options (workers, scheduler, progress).
+
+    Returns
+    -------
+    StudyResult
+        The analyses and warnings.
     """
     from gearte.models.rv_load_sharing import contact_law
 

@@ -270,7 +270,7 @@ def reduce_samples(
     """Plain-numpy twin of the kernel's reduction (same formulas, same bin edges).
 
     ``y`` samples [the quantity's unit]; ``shift`` [same unit] subtracted before the moments;
-    histogram over [``lo``, ``hi``] [same unit] in ``nbins`` bins; ``lsl``/``usl`` spec limits
+    histogram from ``lo`` to ``hi`` [same unit] in ``nbins`` bins; ``lsl``/``usl`` spec limits
     [same unit] for the out-of-spec count; ``keep`` samples kept.
     """
     y = np.asarray(y, dtype=float)

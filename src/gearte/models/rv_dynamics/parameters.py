@@ -240,6 +240,16 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
     The description's mean involute mesh stiffness k̄ becomes the single-pair stiffness k̄/ε_α of
     the rectangular wave.
 
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (geometry [mm], stiffnesses [N/mm], material [MPa]).
+
+    Returns
+    -------
+    RVDynamicsParameters
+        The parameters of the lumped model.
+
     Raises
     ------
     ParameterError
@@ -337,6 +347,16 @@ def errors_from_reducer(reducer, **paper004) -> RVErrors:
     disc-bore array is indexed (disc, crank) and is transposed. ``paper004`` adds the errors the
     description does not hold (sun_eccentricity, sun_assembly, output_assembly, pin_composite,
     output_bearing_clearance_mm).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description with its measured errors and clearances.
+
+    Returns
+    -------
+    RVErrors
+        The errors of the dynamic model (amplitudes [mm], phases [rad]).
     """
     e = reducer.errors
     m, n = reducer.cranks.count, reducer.discs.count

@@ -1,0 +1,23 @@
+"""Dask worker plugins of gearte's ``local-cluster`` backend (imported only with Dask)."""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+from typing import Any
+
+from distributed import WorkerPlugin
+
+__all__ = ["IgnoreSigint"]
+
+
+class IgnoreSigint(WorkerPlugin):
+    """The worker process ignores SIGINT: Ctrl-C in a terminal reaches the whole process group,
+    and the process that started the cluster stops the work and the cluster itself (no worker
+    ``KeyboardInterrupt`` tracebacks). Applies to workers the nannies restart as well."""
+
+    idempotent = True
+
+    def setup(self, worker: Any) -> None:
+        with contextlib.suppress(ValueError):  # not the main thread: nothing to do
+            signal.signal(signal.SIGINT, signal.SIG_IGN)

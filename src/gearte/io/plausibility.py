@@ -1,0 +1,180 @@
+"""Physical-plausibility checks made at validation time (issue 15 item 6).
+
+A value can lie inside its schema range and still be impossible for the drive it is given for:
+a torque typed in N·mm where the key asks for N·m passes ``torque_Nm <= 1e6`` on a small reducer
+and fails only in ``run`` (or gives a result no material could carry). These checks relate such a
+value to the drive's size and refuse it at ``gearte validate``, naming the key and the value in
+the user's units.
+
+Torque against size (``cycloid_stage``, ``rv_reducer``): the torque a disc carries is turned into
+the force on the most loaded pin with Hu et al. (2020) eq 30 (all z_p/2 pins of the loaded flank
+share the torque: F = 4 T_c / (K1 z_c r_p), a lower bound of the real F_max) and into the largest
+Hertz line-contact pressure of that pin on the flank at its first-contact phase φ0 (Johnson eq
+4.45, :func:`gearte.models.contact_law.max_contact_pressure`). Above
+:data:`MAX_CONTACT_PRESSURE_MPA` no steel carries the load even once (through-hardened bearing
+steel: about 4 000 MPa static line contact, ISO 76), so the torque is refused with the pressure and
+the torque read as N·mm beside it. A torque that is high but possible is left to the analyses (and
+to ``allowable_contact_pressure_MPa``, which warns).
+
+References
+----------
+Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+Johnson K. L. (1985). Contact Mechanics, eq 4.45. doi:10.1017/CBO9781139171731
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from gearte.errors import ParameterError
+
+__all__ = ["MAX_CONTACT_PRESSURE_MPA", "pin_pressure_estimate", "plausibility_problems"]
+
+#: Largest pin–disc Hertz pressure a torque may give at validation [MPa] (2.5× the static
+#: capacity of bearing steel in line contact: far beyond any real design, reached by a torque
+#: given in N·mm where N·m is asked for, which multiplies the pressure by √1000 ≈ 32).
+MAX_CONTACT_PRESSURE_MPA = 10_000.0
+
+
+def pin_pressure_estimate(
+    stage: Any, torque_Nmm: float, share: float, E: float, nu: float
+) -> float:
+    """Hertz pressure of the most loaded pin under an ideal load share [MPa].
+
+    Parameters
+    ----------
+    stage : CycloidStage
+        The cycloid–pin stage (its K1, z_c, r_p, pin radius, face width and ρ(φ0)).
+    torque_Nmm : float
+        Output torque of the stage [N·mm].
+    share : float
+        Share of the torque carried by one disc [-].
+    E : float
+        Young's modulus [MPa].
+    nu : float
+        Poisson's ratio [-].
+
+    Returns
+    -------
+    float
+        p0 [MPa] of the force F = 4 share T / (K1 z_c r_p) (Hu 2020 eq 30) at the flank curvature
+        ρ(φ0) (eq 40).
+
+    References
+    ----------
+    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+    """
+    from gearte.models.contact_law import max_contact_pressure
+
+    force = 4.0 * share * torque_Nmm / (stage.K1 * stage.z_c * stage.r_p)
+    return float(max_contact_pressure(force, stage.rho0, stage.r, E, nu, stage.b))
+
+
+def _torque_problem(
+    field: str, torque_Nm: float, stage: Any, share: float, E: float, nu: float
+) -> tuple[str, str] | None:
+    from gearte.units import Nm_to_Nmm
+
+    p = pin_pressure_estimate(stage, float(Nm_to_Nmm(torque_Nm)), share, E, nu)
+    if p <= MAX_CONTACT_PRESSURE_MPA:
+        return None
+    return (
+        field,
+        f"{torque_Nm:g} N·m is implausible for this stage: it gives a pin–disc contact pressure "
+        f"of about {p:,.0f} MPa (ideal load share, Hu 2020 eq 30), above the "
+        f"{MAX_CONTACT_PRESSURE_MPA:,.0f} MPa no steel carries; was it given in N·mm? "
+        f"({torque_Nm:g} N·mm = {torque_Nm / 1000:g} N·m)",
+    )
+
+
+def _cycloid_stage(case: Any) -> list[tuple[str, str]]:
+    tc = case.analyses.tooth_contact
+    if tc is None:
+        return []
+    from gearte.geometry.cycloid import CycloidStage
+    from gearte.units import arcmin_to_rad
+
+    st = case.stage
+    stage = CycloidStage(
+        z_p=st.pins,
+        r_p=st.pin_circle_radius_mm,
+        r_rp=st.pin_radius_mm,
+        a=st.eccentricity_mm,
+        b=st.face_width_mm,
+        dr_rp=st.equidistant_modification_mm,
+        dr_p=st.shifted_modification_mm,
+        rotation=float(arcmin_to_rad(st.rotation_modification_arcmin)),
+    )
+    field = "analyses.tooth_contact.torque_Nm"
+    got = _torque_problem(
+        field, tc.torque_Nm, stage, tc.disc_share, tc.youngs_modulus_MPa, tc.poisson_ratio
+    )
+    return [got] if got else []
+
+
+def _rv_reducer(case: Any) -> list[tuple[str, str]]:
+    from gearte.geometry.cycloid import CycloidStage
+
+    r = case.reducer
+    stage = CycloidStage(
+        z_p=r.pins.count,
+        r_p=r.pins.circle_radius_mm,
+        r_rp=r.pins.pin_radius_mm,
+        a=r.cranks.eccentricity_mm,
+        b=r.discs.face_width_mm,
+        dr_rp=r.discs.equidistant_modification_mm,
+        dr_p=r.discs.shift_modification_mm,
+    )
+    E, nu, share = r.discs.youngs_modulus_MPa, r.discs.poisson_ratio, 1.0 / r.discs.count
+    torques: list[tuple[str, float, float]] = []
+    if r.rated_torque_Nm is not None:
+        torques.append(("reducer.rated_torque_Nm", r.rated_torque_Nm, share))
+    if case.operation is not None:
+        torques.append(("operation.output_torque_Nm", case.operation.output_torque_Nm, share))
+    for name in type(case.analyses).model_fields:
+        sec = getattr(case.analyses, name)
+        value = getattr(sec, "torque_Nm", None)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            key = type(case.analyses).model_fields[name].alias or name
+            torques.append(
+                (f"analyses.{key}.torque_Nm", float(value), getattr(sec, "disc_share", share))
+            )
+    out = []
+    for field, value, s in torques:
+        got = _torque_problem(field, value, stage, s, E, nu)
+        if got:
+            out.append(got)
+    return out
+
+
+_CHECKS: dict[str, Callable[[Any], list[tuple[str, str]]]] = {
+    "cycloid_stage": _cycloid_stage,
+    "rv_reducer": _rv_reducer,
+}
+
+
+def plausibility_problems(kind: str, case: Any) -> list[tuple[str, str]]:
+    """``(field, message)`` for each implausible value of a validated ``case`` of ``kind``.
+
+    Parameters
+    ----------
+    kind : str
+        The study kind.
+    case : Case
+        The case (validated; its sections may be placeholders of sections that did not validate,
+        whose use stops the check: see ``gearte.io.case_file``).
+
+    Returns
+    -------
+    list of (str, str)
+        Empty when every value is plausible, or when the drive itself cannot be built (the
+        schema's own checks report that).
+    """
+    check = _CHECKS.get(kind)
+    if check is None:
+        return []
+    try:
+        return check(case)
+    except ParameterError:  # the geometry itself is refused: reported by the schema's checks
+        return []
