@@ -139,7 +139,6 @@ def test_meaning_debt_only_shrinks() -> None:
 # type, unit, range and default. Fill the description and remove the entry.
 PENDING = frozenset(
     {
-        "_rv_dynamics.BatchOptions.chunk_size",
         "_rv_dynamics.BatchOptions.duration_s",
         "_rv_dynamics.BatchOptions.samples",
         "_rv_dynamics.BatchOptions.seed",

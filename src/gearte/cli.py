@@ -475,11 +475,14 @@ def warm_cache_cmd(kinds: tuple[str, ...], debug: bool) -> None:
 
         from gearte.warm import warm_cache
 
+        cpu = [0.0]
+
         def report(kind: str, case: str, seconds: float) -> None:
             if seconds < 0:
+                cpu[0] = time.process_time()
                 click.echo(f"  {kind:14s} {case:32s} ...", nl=False)
             else:
-                click.echo(f" {seconds:6.1f} s")
+                click.echo(f" {seconds:6.1f} s ({time.process_time() - cpu[0]:.1f} s CPU)")
 
         t0 = time.perf_counter()
         click.echo("==> compiling gearte's numba kernels, one bundled case per kernel group")

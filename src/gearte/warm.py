@@ -44,8 +44,8 @@ def warm_cache(
     kinds : sequence of str, optional
         Study kinds to warm; unknown names raise :class:`~gearte.errors.ParameterError`.
     report : callable, optional
-        Called as ``report(kind, case, seconds)`` before each case starts (``seconds`` = -1)
-        and after it ends, for progress output.
+        Called as ``report(kind, case, seconds)`` with ``seconds`` [s] = -1 before each case
+        starts and its wall time after it ends, for progress output.
 
     Yields
     ------
