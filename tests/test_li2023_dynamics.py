@@ -224,11 +224,12 @@ def test_paper_stiffness_puts_first_mode_near_cycloid_mesh():
 
 
 def _li2023_reducer(errors=None):
+    from gearte.geometry.planetary import SunPlanets
     from gearte.geometry.rv import Cranks, Discs, FirstStage, PinRing, RVReducer, Supports
 
     eps = 1.556394  # contact ratio of 12/36, m = 1.5, α = 20° (checked below)
     return RVReducer(
-        first_stage=FirstStage(12, 36, 1.5, np.deg2rad(20.0), 1.4e5 * eps, 4.68e4),
+        first_stage=FirstStage(SunPlanets(12, 36, 1.5, np.deg2rad(20.0)), 1.4e5 * eps, 4.68e4),
         cranks=Cranks(3, 36.0, 1.3, 2.84e5, 5.76e5),
         discs=Discs(2, 12.0, -0.01, -0.05, 2.06e5, 0.3),
         pins=PinRing(40, 3.0, 85.8),

@@ -242,11 +242,3 @@ def test_disc_profile_errors_raise_peak_pin_load():
     assert (
         load_sharing(red, 1.078e6, th).peak_pin_load > load_sharing(red0, 1.078e6, th).peak_pin_load
     )
-
-
-def test_dynamics_refuse_disc_profile_errors_they_cannot_hold():
-    data = _han_errors([{"part": "disc_radial_runout", "disc": 1, "value_um": 5.0, "angle_deg": 0}])
-    data["analyses"] = {"modal": {}}
-    with pytest.raises(ParameterError) as exc:
-        run_case(load_case_dict(data), RunOptions(progress=False))
-    assert "disc_radial_runout" in str(exc.value)

@@ -176,3 +176,22 @@ def test_every_bundled_case_is_plausible():
 
     for name in list_cases():
         load_case(name)
+
+
+@pytest.mark.parametrize(
+    "key, value, expected",
+    [
+        ("torque_Nmm", 1011500.0, "write torque_Nm = 1011.5"),
+        ("pin_radius_um", 3000, "write pin_radius_mm = 3"),
+        ("youngs_modulus_GPa", 206, "write youngs_modulus_MPa = 206000"),
+        ("rotation_modification_deg", 0.5, "write rotation_modification_arcmin = 30"),
+    ],
+)
+def test_wrong_unit_suffix_hint_converts_the_value(key, value, expected):
+    known = {"torque_Nm", "pin_radius_mm", "youngs_modulus_MPa", "rotation_modification_arcmin"}
+    assert expected in did_you_mean(key, known, value)
+
+
+def test_unit_suffix_hint_gives_no_number_across_dimensions_or_for_text():
+    assert "write" not in did_you_mean("length_Nm", {"length_mm"}, 3.0)
+    assert "write" not in did_you_mean("torque_Nmm", {"torque_Nm"}, "1000")

@@ -21,7 +21,7 @@ import numpy as np
 
 from gearte.errors import ParameterError
 
-__all__ = ["MEMBERS", "PlanetarySet", "willis_speeds"]
+__all__ = ["MEMBERS", "PlanetarySet", "SunPlanets", "willis_speeds"]
 
 Member = Literal["sun", "ring", "carrier"]
 MEMBERS: tuple[str, ...] = ("sun", "ring", "carrier")
@@ -69,6 +69,133 @@ def willis_speeds(
 
 
 @dataclass(frozen=True)
+class SunPlanets:
+    """Sun and ``N`` identical planets of an involute planetary stage; a ring is optional.
+
+    The gear set of the ``planetary`` kind (:class:`PlanetarySet`, with its ring) and of the
+    first stage of an RV reducer (:class:`gearte.geometry.rv.FirstStage`, no ring: the planets
+    sit on the cranks) — one class, one validation.
+
+    Parameters
+    ----------
+    z_sun, z_planet : int
+        Tooth numbers [-].
+    module : float
+        Normal module m [mm].
+    pressure_angle : float
+        Pressure angle of the sun–planet mesh alpha [rad].
+    n_planets : int
+        Number of planets N [-].
+    planet_angles : tuple of float, optional
+        Position angles eta_i of the planets on the carrier [rad], the first 0; default equal
+        spacing 2 pi i / N.
+    z_ring : int, optional
+        Ring tooth number [-]; None for a stage without ring (RV first stage).
+    standard : bool
+        With a ring: standard (unshifted) gears, ``z_r = z_s + 2 z_p`` must hold.
+
+    Raises
+    ------
+    ParameterError
+        Teeth < 3, module or pressure angle out of range, wrong number of planet angles,
+        ``z_r != z_s + 2 z_p`` for standard gears or ``z_r <= z_s + z_p``, planets that cannot be
+        assembled with the ring (``(z_s + z_r) eta_i / 2 pi`` not an integer), neighbouring
+        planets whose tip circles overlap.
+
+    References
+    ----------
+    Wang C. et al. (2013), Trans. CSAM 44(8), 287-292, Table 1.
+    doi:10.6041/j.issn.1000-1298.2013.08.049
+    """
+
+    z_sun: int
+    z_planet: int
+    module: float
+    pressure_angle: float
+    n_planets: int = 3
+    planet_angles: tuple[float, ...] | None = None
+    z_ring: int | None = None
+    standard: bool = True
+    _eta: tuple[float, ...] = field(init=False, repr=False, compare=False, default=())
+
+    def __post_init__(self) -> None:
+        for name in ("z_sun", "z_planet") + (("z_ring",) if self.z_ring is not None else ()):
+            z = getattr(self, name)
+            if int(z) != z or z < 3:
+                raise ParameterError(name, z, "must be an integer >= 3")
+        if not (np.isfinite(self.module) and self.module > 0):
+            raise ParameterError("module", self.module, "must be > 0 [mm]")
+        if not (0.0 < self.pressure_angle < np.pi / 4):
+            raise ParameterError(
+                "pressure_angle", self.pressure_angle, "must be in (0, pi/4) [rad]"
+            )
+        if int(self.n_planets) != self.n_planets or self.n_planets < 1:
+            raise ParameterError("n_planets", self.n_planets, "must be an integer >= 1")
+        if self.z_ring is not None:
+            if self.standard and self.z_ring != self.z_sun + 2 * self.z_planet:
+                raise ParameterError(
+                    "z_ring",
+                    self.z_ring,
+                    f"standard gears need z_r = z_s + 2 z_p = {self.z_sun + 2 * self.z_planet}",
+                )
+            if self.z_ring <= self.z_sun + self.z_planet:
+                raise ParameterError("z_ring", self.z_ring, "must exceed z_s + z_p")
+        n = int(self.n_planets)
+        if self.planet_angles is None:
+            eta = tuple(2.0 * np.pi * i / n for i in range(n))
+        else:
+            eta = tuple(float(x) for x in self.planet_angles)
+            if len(eta) != n:
+                raise ParameterError(
+                    "planet_angles", self.planet_angles, f"needs n_planets = {n} angles"
+                )
+            if eta[0] != 0.0:
+                raise ParameterError("planet_angles", self.planet_angles, "first angle must be 0")
+        if self.z_ring is not None:
+            zsum = self.z_sun + self.z_ring
+            for i, e in enumerate(eta):
+                k = zsum * e / (2.0 * np.pi)
+                if abs(k - round(k)) > 1e-6:
+                    raise ParameterError(
+                        f"planet_angles[{i}]" if self.planet_angles is not None else "n_planets",
+                        e if self.planet_angles is not None else n,
+                        f"planet cannot be assembled: (z_s + z_r) * eta / 2pi = {k:.4g} is not "
+                        f"an integer (z_s + z_r = {zsum})",
+                    )
+        # neighbouring planets must not overlap (tip circle m (z_p + 2) for standard addendum)
+        if n > 1:
+            srt = np.sort(np.mod(np.asarray(eta), 2 * np.pi))
+            gaps = np.diff(np.concatenate([srt, [srt[0] + 2 * np.pi]]))
+            chord = 2.0 * self.centre_distance * np.sin(gaps.min() / 2.0)
+            tip = self.module * (self.z_planet + 2)
+            if chord <= tip:
+                raise ParameterError(
+                    "n_planets",
+                    n,
+                    f"neighbouring planets overlap: centre chord {chord:.4g} mm <= planet tip "
+                    f"diameter {tip:.4g} mm",
+                )
+        object.__setattr__(self, "_eta", eta)
+
+    @property
+    def eta(self) -> np.ndarray:
+        """Planet position angles eta_i [rad]."""
+        return np.asarray(self._eta)
+
+    def base_radius(self, member: str) -> float:
+        """Base-circle radius r_b = m z cos(alpha) / 2 of ``sun``, ``planet`` or ``ring`` [mm]."""
+        z = {"sun": self.z_sun, "planet": self.z_planet, "ring": self.z_ring}[member]
+        if z is None:
+            raise ParameterError("member", member, "this gear set has no ring")
+        return 0.5 * self.module * z * np.cos(self.pressure_angle)
+
+    @property
+    def centre_distance(self) -> float:
+        """Sun–planet centre distance a = m (z_s + z_p) / 2 [mm]."""
+        return 0.5 * self.module * (self.z_sun + self.z_planet)
+
+
+@dataclass(frozen=True)
 class PlanetarySet:
     """A 2K-H planetary gear set with involute gears.
 
@@ -94,7 +221,8 @@ class PlanetarySet:
     ParameterError
         Teeth < 3, module or pressure angle out of range, ``z_r != z_s + 2 z_p`` for standard
         gears, planets that cannot be assembled (``(z_s + z_r) eta_i / 2 pi`` not an integer),
-        neighbouring planets whose tip circles overlap, or members not a permutation.
+        neighbouring planets whose tip circles overlap (the checks of :class:`SunPlanets`, which
+        holds the sun, planets and ring as ``gears``), or members not a permutation.
     """
 
     z_sun: int
@@ -109,69 +237,27 @@ class PlanetarySet:
     output: str = "carrier"
     standard: bool = True
     _eta: tuple[float, ...] = field(init=False, repr=False, compare=False, default=())
+    gears: SunPlanets = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ("z_sun", "z_planet", "z_ring"):
-            z = getattr(self, name)
-            if int(z) != z or z < 3:
-                raise ParameterError(name, z, "must be an integer >= 3")
-        if not (np.isfinite(self.module) and self.module > 0):
-            raise ParameterError("module", self.module, "must be > 0 [mm]")
-        if not (0.0 < self.pressure_angle < np.pi / 4):
-            raise ParameterError(
-                "pressure_angle", self.pressure_angle, "must be in (0, pi/4) [rad]"
-            )
-        if int(self.n_planets) != self.n_planets or self.n_planets < 1:
-            raise ParameterError("n_planets", self.n_planets, "must be an integer >= 1")
+        gears = SunPlanets(  # the sun, planets and ring: validated there (one set of rules)
+            self.z_sun,
+            self.z_planet,
+            self.module,
+            self.pressure_angle,
+            self.n_planets,
+            self.planet_angles,
+            z_ring=self.z_ring,
+            standard=self.standard,
+        )
         if sorted((self.fixed, self.input, self.output)) != sorted(MEMBERS):
             raise ParameterError(
                 "fixed/input/output",
                 (self.fixed, self.input, self.output),
                 f"must be a permutation of {MEMBERS}",
             )
-        if self.standard and self.z_ring != self.z_sun + 2 * self.z_planet:
-            raise ParameterError(
-                "z_ring",
-                self.z_ring,
-                f"standard gears need z_r = z_s + 2 z_p = {self.z_sun + 2 * self.z_planet}",
-            )
-        if self.z_ring <= self.z_sun + self.z_planet:
-            raise ParameterError("z_ring", self.z_ring, "must exceed z_s + z_p")
-        n = int(self.n_planets)
-        if self.planet_angles is None:
-            eta = tuple(2.0 * np.pi * i / n for i in range(n))
-        else:
-            eta = tuple(float(x) for x in self.planet_angles)
-            if len(eta) != n:
-                raise ParameterError(
-                    "planet_angles", self.planet_angles, f"needs n_planets = {n} angles"
-                )
-            if eta[0] != 0.0:
-                raise ParameterError("planet_angles", self.planet_angles, "first angle must be 0")
-        zsum = self.z_sun + self.z_ring
-        for i, e in enumerate(eta):
-            k = zsum * e / (2.0 * np.pi)
-            if abs(k - round(k)) > 1e-6:
-                raise ParameterError(
-                    f"planet_angles[{i}]" if self.planet_angles is not None else "n_planets",
-                    e if self.planet_angles is not None else n,
-                    f"planet cannot be assembled: (z_s + z_r) * eta / 2pi = {k:.4g} is not an "
-                    f"integer (z_s + z_r = {zsum})",
-                )
-        # neighbouring planets must not overlap (tip circle m (z_p + 2) for standard addendum)
-        if n > 1:
-            srt = np.sort(np.mod(np.asarray(eta), 2 * np.pi))
-            gaps = np.diff(np.concatenate([srt, [srt[0] + 2 * np.pi]]))
-            chord = 2.0 * self.centre_distance * np.sin(gaps.min() / 2.0)
-            tip = self.module * (self.z_planet + 2)
-            if chord <= tip:
-                raise ParameterError(
-                    "n_planets",
-                    n,
-                    f"neighbouring planets overlap: centre chord {chord:.4g} mm <= planet tip "
-                    f"diameter {tip:.4g} mm",
-                )
-        object.__setattr__(self, "_eta", eta)
+        object.__setattr__(self, "gears", gears)
+        object.__setattr__(self, "_eta", gears._eta)
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -181,13 +267,12 @@ class PlanetarySet:
 
     def base_radius(self, member: str) -> float:
         """Base-circle radius r_b = m z cos(alpha) / 2 of ``sun``, ``planet`` or ``ring`` [mm]."""
-        z = {"sun": self.z_sun, "planet": self.z_planet, "ring": self.z_ring}[member]
-        return 0.5 * self.module * z * np.cos(self.pressure_angle)
+        return self.gears.base_radius(member)
 
     @property
     def centre_distance(self) -> float:
         """Sun–planet centre distance a = m (z_s + z_p) / 2 [mm]."""
-        return 0.5 * self.module * (self.z_sun + self.z_planet)
+        return self.gears.centre_distance
 
     # ---------------------------------------------------------------- kinematics
     def speed_ratios(self) -> dict[str, Fraction]:

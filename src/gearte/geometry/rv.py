@@ -58,6 +58,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gearte.errors import ParameterError
+from gearte.geometry.planetary import SunPlanets
 from gearte.units import um_to_mm
 
 __all__ = [
@@ -72,6 +73,8 @@ __all__ = [
     "MassProperties",
     "mass_properties",
     "RVReducer",
+    "PinContacts",
+    "pin_contacts",
     "palmgren_radial_stiffness",
     "iso6336_mesh_stiffness",
 ]
@@ -155,16 +158,16 @@ def iso6336_mesh_stiffness(face_width: float, c_gamma: float = 20.0) -> float:
 
 @dataclass(frozen=True)
 class FirstStage:
-    """Involute first stage: sun (input) and ``M`` planets, each fixed to a crankshaft.
+    """Involute first stage: sun (input) and ``M`` planets, each fixed to a crankshaft; no ring.
+
+    Its gears are the gear set of the ``planetary`` kind without a ring
+    (:class:`gearte.geometry.planetary.SunPlanets`: the same class, the same validation).
 
     Attributes
     ----------
-    sun_teeth, planet_teeth : int
-        ``z_1``, ``z_2``.
-    module : float
-        Normal module [mm].
-    pressure_angle : float
-        Standard pressure angle [rad].
+    gears : SunPlanets
+        Sun and planets: tooth numbers ``z_1``, ``z_2``, module [mm], standard pressure angle
+        [rad], number of planets (= cranks), planet position angles.
     mesh_stiffness : float
         Sun–planet mesh stiffness along the line of action [N/mm].
     sun_support_stiffness : float
@@ -173,21 +176,15 @@ class FirstStage:
         Face width of the sun and planets [mm] (needed only to derive their masses).
     """
 
-    sun_teeth: int
-    planet_teeth: int
-    module: float
-    pressure_angle: float
+    gears: SunPlanets
     mesh_stiffness: float
     sun_support_stiffness: float
     face_width: float | None = None
 
     def __post_init__(self) -> None:
-        _check_int("first_stage.sun_teeth", self.sun_teeth, 6)
-        _check_int("first_stage.planet_teeth", self.planet_teeth, 6)
-        _check_pos("first_stage.module", self.module)
-        if not 0 < self.pressure_angle < np.pi / 4:
+        if self.gears.z_ring is not None:
             raise ParameterError(
-                "first_stage.pressure_angle", self.pressure_angle, "must be in (0, pi/4) rad"
+                "first_stage.ring", self.gears.z_ring, "an RV first stage has no ring"
             )
         _check_pos("first_stage.mesh_stiffness", self.mesh_stiffness)
         _check_pos("first_stage.sun_support_stiffness", self.sun_support_stiffness)
@@ -195,10 +192,29 @@ class FirstStage:
             _check_pos("first_stage.face_width", self.face_width)
 
     @property
+    def sun_teeth(self) -> int:
+        """``z_1`` [-]."""
+        return self.gears.z_sun
+
+    @property
+    def planet_teeth(self) -> int:
+        """``z_2`` [-]."""
+        return self.gears.z_planet
+
+    @property
+    def module(self) -> float:
+        """Module [mm]."""
+        return self.gears.module
+
+    @property
+    def pressure_angle(self) -> float:
+        """Standard pressure angle [rad]."""
+        return self.gears.pressure_angle
+
+    @property
     def base_radii(self) -> tuple[float, float]:
         """Base radii of sun and planet [mm]."""
-        c = np.cos(self.pressure_angle) * self.module / 2.0
-        return float(self.sun_teeth * c), float(self.planet_teeth * c)
+        return self.gears.base_radius("sun"), self.gears.base_radius("planet")
 
 
 @dataclass(frozen=True)
@@ -614,7 +630,8 @@ class RVReducer:
     rated_torque : float or None
         Rated output torque [N·mm] (catalogue value; needed by the virtual torsion test only).
     planets : int, optional
-        Number of planets of the first stage; must equal ``cranks.count`` (default: equal).
+        Number of planets of the first stage; must equal ``cranks.count`` (default: that of
+        ``first_stage.gears``).
 
     Raises
     ------
@@ -634,7 +651,13 @@ class RVReducer:
     errors: ManufacturingErrors | None = None
 
     def __post_init__(self) -> None:
-        planets = self.cranks.count if self.planets is None else self.planets
+        planets = self.first_stage.gears.n_planets if self.planets is None else self.planets
+        if planets != self.first_stage.gears.n_planets:
+            raise ParameterError(
+                "first_stage.planets",
+                planets,
+                f"must equal the gear set's n_planets = {self.first_stage.gears.n_planets}",
+            )
         if planets != self.cranks.count:
             raise ParameterError(
                 "first_stage.planets",
@@ -732,6 +755,126 @@ class RVReducer:
     def replace(self, **changes) -> RVReducer:
         """Copy with some of the sections replaced (``discs=..., pins=...``)."""
         return dataclasses.replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class PinContacts:
+    """Geometry and initial clearance of every pin contact of every disc at output angles.
+
+    Attributes (shape ``(P, N, z_p)`` over output angles, discs and pins, plus a trailing 2 for
+    vectors)
+    ----------
+    theta : numpy.ndarray
+        Output (carrier) angles [rad], ``(P,)``.
+    normal : numpy.ndarray
+        Unit contact normal ``n`` (from the pitch point towards the pin centre), ground frame.
+    lever : numpy.ndarray
+        Contact point − disc centre [mm].
+    arm : numpy.ndarray
+        ``lever × n`` [mm]: the moment arm of the normal about the disc centre (the rotation
+        column of the contact row; negative on the flank that carries the output torque).
+    phase : numpy.ndarray
+        Meshing phase ``φ = α_k − χ_j`` of pin ``k`` on disc ``j`` [rad].
+    gap : numpy.ndarray
+        Initial normal clearance [mm] at the nominal positions: the eq-32 clearance of the
+        disc's modified profile (nominal modifications + that disc's modification errors),
+        minus the pin-radius error, plus the pin-centre error on the normal, minus the disc's
+        radial run-out on the normal, minus the arm × the local rotation of the cumulative
+        pitch deviation, plus the change a measured disc causes
+        (:meth:`gearte.geometry.measured.MeasuredDisc.gap_change`).
+    """
+
+    theta: np.ndarray
+    normal: np.ndarray
+    lever: np.ndarray
+    arm: np.ndarray
+    phase: np.ndarray
+    gap: np.ndarray
+
+
+def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
+    """Contact normals, arms and initial clearances of all pins of all discs (every error family).
+
+    The one computation of the pin clearances that the quasi-static model
+    (:func:`gearte.models.rv_load_sharing.assemble`) and the dynamics
+    (:func:`gearte.models.rv_dynamics.disc_rotation_error`) read.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The description with its errors (per-pin radius and position, disc run-out and
+        cumulative pitch, per-disc modification errors).
+    theta : numpy.ndarray
+        Output angles [rad], ``(P,)``.
+
+    Returns
+    -------
+    PinContacts
+
+    Notes
+    -----
+    Disc ``j``'s eccentric points along ``χ_j = −z_c θ + 2π j / N`` (module conventions); its
+    pitch point is ``P_j = a z_p ê(χ_j)``; the normal of pin ``k`` (centre ``p_k`` at
+    ``α_k = 2π k / z_p``) passes through ``P_j`` and ``p_k`` (Hu 2020 eq 36), the contact point
+    lies ``r_rp`` inside the pin centre on it. The clearance of the modified profile is Hu 2020
+    eq 32 (:func:`gearte.geometry.cycloid.normal_clearance_unclosed`). Disc errors are in the
+    disc frame, which turns with the carrier (angle ``θ``): the run-out ``r`` translates the
+    profile (gap ``−n·r``); the cumulative pitch deviation ``s(ψ) = ΔF_p/2 sin(ψ − angle)`` at
+    the contact's disc-frame angle ``ψ`` turns the flank locally by ``s / r_c`` (gap
+    ``−arm · s / r_c``).
+
+    References
+    ----------
+    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481, eq 32, 36.
+    doi:10.3390/app10020481
+    """
+    from gearte.geometry.cycloid import normal_clearance_unclosed
+
+    th = np.atleast_1d(np.asarray(theta, dtype=float))
+    P = th.size
+    N = reducer.discs.count
+    pins, err = reducer.pins, reducer.error_set
+    zp, zc = pins.count, reducer.cycloid_teeth
+    a = reducer.cranks.eccentricity
+    alpha_k = 2.0 * np.pi * np.arange(zp) / zp
+    pin_dir = np.stack([np.cos(alpha_k), np.sin(alpha_k)], -1)  # (zp, 2)
+    pin_pos = pins.circle_radius * pin_dir
+    pin_err = pins.radial_position_errors[:, None] * pin_dir + pins.tangential_position_errors[
+        :, None
+    ] * np.stack([-pin_dir[:, 1], pin_dir[:, 0]], -1)
+    ecc = -zc * th[:, None] + 2.0 * np.pi * np.arange(N)[None, :] / N  # (P, N)
+    cdir = np.stack([np.cos(ecc), np.sin(ecc)], -1)  # (P, N, 2)
+    v = pin_pos[None, None] - (a * zp * cdir)[:, :, None, :]  # (P, N, zp, 2)
+    n = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    lever = pin_pos[None, None] - pins.pin_radius * n - (a * cdir)[:, :, None, :]
+    arm = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
+    phi = alpha_k[None, None, :] - ecc[:, :, None]
+    gap = np.empty((P, N, zp))
+    c, s_ = np.cos(th), np.sin(th)
+    for j in range(N):
+        d_rp, d_p = err.disc_modification[j]
+        g = normal_clearance_unclosed(
+            phi[:, j],
+            z_p=zp,
+            r_p=pins.circle_radius,
+            a=a,
+            dr_rp=reducer.discs.equidistant_modification + d_rp,
+            dr_p=reducer.discs.shift_modification + d_p,
+        )
+        g = g - pins.radius_errors[None, :] + np.sum(n[:, j] * pin_err[None], axis=-1)
+        rx, ry = err.disc_runout[j]
+        runout = np.stack([rx * c - ry * s_, rx * s_ + ry * c], -1)  # disc frame -> ground
+        g = g - np.sum(n[:, j] * runout[:, None, :], axis=-1)
+        fp = float(np.hypot(*err.disc_pitch[j]))
+        if fp > 0.0:
+            psi = np.arctan2(lever[:, j, :, 1], lever[:, j, :, 0]) - th[:, None]
+            ang = np.arctan2(err.disc_pitch[j, 1], err.disc_pitch[j, 0])
+            g = g - arm[:, j] * 0.5 * fp * np.sin(psi - ang) / (a * zc)
+        measured = None if err.measured_discs is None else err.measured_discs[j]
+        if measured is not None:  # measured flank per tooth and pitch per tooth (issue 16)
+            g = g + measured.gap_change(np.arange(zp)[None, :], phi[:, j], arm[:, j], a * zc)
+        gap[:, j] = g
+    return PinContacts(th, n, lever, arm, phi, gap)
 
 
 @dataclass(frozen=True)

@@ -137,8 +137,32 @@ def _fields_at(root: Any, loc: tuple[Any, ...]) -> set[str]:
     return {name for m in models for name in m.model_fields}
 
 
-def did_you_mean(key: str, known: set[str]) -> str:
-    """A hint for an unknown key: the field with another unit suffix, or a close spelling."""
+def _in_base_unit(unit: str) -> tuple[str, float] | None:
+    """``(dimension, size of one ``unit`` in the dimension's base unit)`` of a key suffix (mm, N·mm,
+    N, MPa, rad), or ``None`` for a suffix that is no known unit."""
+    from gearte import units as u
+
+    table: dict[str, tuple[str, float]] = {
+        "mm": ("length", 1.0),
+        "um": ("length", float(u.um_to_mm(1.0))),
+        "m": ("length", 1000.0),
+        "Nmm": ("torque", 1.0),
+        "Nm": ("torque", float(u.Nm_to_Nmm(1.0))),
+        "N": ("force", 1.0),
+        "kN": ("force", 1000.0),
+        "MPa": ("stress", 1.0),
+        "GPa": ("stress", 1000.0),
+        "rad": ("angle", 1.0),
+        "deg": ("angle", float(u.deg_to_rad(1.0))),
+        "arcmin": ("angle", float(u.arcmin_to_rad(1.0))),
+        "arcsec": ("angle", float(u.arcsec_to_rad(1.0))),
+    }
+    return table.get(unit)
+
+
+def did_you_mean(key: str, known: set[str], value: Any = None) -> str:
+    """A hint for an unknown key: the field with another unit suffix (with ``value``, a number,
+    converted to that unit), or a close spelling."""
     import difflib
 
     stem, _, unit = key.rpartition("_")
@@ -146,8 +170,14 @@ def did_you_mean(key: str, known: set[str]) -> str:
         same_stem = sorted(k for k in known if k.rpartition("_")[0] == stem and k != key)
         if same_stem:
             k = same_stem[0]
-            given = _UNITS.get(k.rpartition("_")[2], k.rpartition("_")[2])
-            return f"did you mean {k!r}? (this field is given in {given}, not {unit})"
+            target = k.rpartition("_")[2]
+            given = _UNITS.get(target, target)
+            hint = f"did you mean {k!r}? (this field is given in {given}, not {unit}"
+            a, b = _in_base_unit(unit), _in_base_unit(target)
+            number = isinstance(value, int | float) and not isinstance(value, bool)
+            if number and a is not None and b is not None and a[0] == b[0]:
+                hint += f": write {k} = {float(value) * a[1] / b[1]:.6g}"
+            return hint + ")"
     close = difflib.get_close_matches(key, sorted(known), n=1, cutoff=0.6)
     return f"did you mean {close[0]!r}?" if close else ""
 
@@ -182,7 +212,7 @@ def format_validation_errors(exc: Any, root: Any = None) -> list[tuple[str, str]
             msg = "unknown key (not allowed here; check spelling and section)"
             loc_t = _user_loc(root, tuple(err.get("loc", ())))
             if root is not None and loc_t:
-                hint = did_you_mean(str(loc_t[-1]), _fields_at(root, loc_t[:-1]))
+                hint = did_you_mean(str(loc_t[-1]), _fields_at(root, loc_t[:-1]), err.get("input"))
                 if hint:
                     msg = f"unknown key; {hint}"
         if "input" in err and kind not in ("missing",) and not isinstance(err["input"], dict):

@@ -46,8 +46,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
-from gearte.geometry.cycloid import CycloidStage, normal_clearance_unclosed
-from gearte.geometry.rv import RVReducer
+from gearte.geometry.cycloid import CycloidStage
+from gearte.geometry.rv import RVReducer, pin_contacts
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     check_law,
@@ -464,60 +464,20 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     spring_e = np.stack(offs, axis=1)
     spring_k = np.asarray(ks)
 
-    # pin contacts
-    pins = reducer.pins
-    alpha_k = 2.0 * np.pi * np.arange(zp) / zp
-    pin_pos = pins.circle_radius * _u(alpha_k)  # (zp, 2)
-    pin_err = pins.radial_position_errors[:, None] * _u(alpha_k) + pins.tangential_position_errors[
-        :, None
-    ] * _u(alpha_k + np.pi / 2)
+    # pin contacts: normals, arms and initial clearances with every error family
+    # (gearte.geometry.rv.pin_contacts, the one computation the dynamics reads too)
+    pc = pin_contacts(reducer, th)
     cB = np.zeros((P, N * zp, nd))
-    cg = np.zeros((P, N * zp))
-    cphase = np.zeros((P, N * zp))
     group = np.repeat(np.arange(N), zp)
     pin_index = np.tile(np.arange(zp), N)
     for j in range(N):
-        cdir = _u(ecc[:, j])  # (P, 2)
-        ppt = a * zp * cdir
-        centre = a * cdir
-        v = pin_pos[None, :, :] - ppt[:, None, :]  # (P, zp, 2)
-        n = v / np.linalg.norm(v, axis=-1, keepdims=True)
-        contact = pin_pos[None] - pins.pin_radius * n
-        lever = contact - centre[:, None, :]
         dof = lay.disc(j)
         sl = slice(j * zp, (j + 1) * zp)
-        cB[:, sl, dof] = n[..., 0]
-        cB[:, sl, dof + 1] = n[..., 1]
-        cB[:, sl, dof + 2] = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
-        phi = alpha_k[None, :] - ecc[:, j][:, None]
-        d_rp, d_p = err.disc_modification[j]
-        gap = normal_clearance_unclosed(
-            phi,
-            z_p=zp,
-            r_p=pins.circle_radius,
-            a=a,
-            dr_rp=reducer.discs.equidistant_modification + d_rp,
-            dr_p=reducer.discs.shift_modification + d_p,
-        )
-        gap = gap - pins.radius_errors[None, :] + np.sum(n * pin_err[None], axis=-1)
-        # disc profile errors (disc frame; the disc turns with the carrier, angle th):
-        # radial run-out moves the whole profile like a disc translation,
-        runout = _rot(np.broadcast_to(err.disc_runout[j], (P, 2)), th)
-        gap = gap - np.sum(n * runout[:, None, :], axis=-1)
-        # the cumulative pitch deviation s(psi) turns the flank at the contact like a local
-        # rotation s / r_c of the disc (psi: disc-frame angle of the contact point)
-        fp = np.hypot(*err.disc_pitch[j])
-        if fp > 0.0:
-            psi = np.arctan2(lever[..., 1], lever[..., 0]) - th[:, None]
-            ang = np.arctan2(err.disc_pitch[j, 1], err.disc_pitch[j, 0])
-            s_dev = 0.5 * fp * np.sin(psi - ang)
-            gap = gap - cB[:, sl, dof + 2] * s_dev / (a * zc)
-        measured = None if err.measured_discs is None else err.measured_discs[j]
-        if measured is not None:  # measured flank per tooth and pitch per tooth (issue 16)
-            arm = cB[:, sl, dof + 2]
-            gap = gap + measured.gap_change(np.arange(zp)[None, :], phi, arm, a * zc)
-        cg[:, sl] = gap
-        cphase[:, sl] = phi
+        cB[:, sl, dof] = pc.normal[:, j, :, 0]
+        cB[:, sl, dof + 1] = pc.normal[:, j, :, 1]
+        cB[:, sl, dof + 2] = pc.arm[:, j]
+    cg = pc.gap.reshape(P, N * zp)
+    cphase = pc.phase.reshape(P, N * zp)
 
     unit = np.zeros(nd)
     unit[lay.output_rotation] = -1.0  # load torque resists the drive

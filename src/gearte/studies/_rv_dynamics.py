@@ -24,7 +24,6 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer, mass_properties
 from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult
@@ -61,8 +60,12 @@ class ContactOptions(StrictModel):
 
 
 class ModalOptions(StrictModel):
-    speed_min_rpm: float = Field(100.0, gt=0, le=2e4)
-    speed_max_rpm: float = Field(3000.0, gt=0, le=2e4)
+    speed_min_rpm: float = Field(
+        100.0, gt=0, le=2e4, description="Lowest input speed of the Campbell diagram [rpm]."
+    )
+    speed_max_rpm: float = Field(
+        3000.0, gt=0, le=2e4, description="Highest input speed of the Campbell diagram [rpm]."
+    )
     resonance_margin: float = Field(0.1, gt=0, lt=1, description="relative band around a mode")
 
     @model_validator(mode="after")
@@ -75,7 +78,9 @@ class ModalOptions(StrictModel):
 class DTEOptions(StrictModel):
     duration_s: float = Field(0.5, gt=0, le=60, description="simulated time after settling [s]")
     settle_s: float = Field(0.1, ge=0, le=10, description="settling time from static equilibrium")
-    method: Literal["rk4", "dopri5", "scipy"] = "rk4"
+    method: Literal["rk4", "dopri5", "scipy"] = Field(
+        "rk4", description="Integrator: fixed-step RK4, adaptive DOPRI5, or scipy's solve_ivp."
+    )
     step_fraction: float = Field(0.85, gt=0, le=1, description="RK4 step / stability limit")
     record_dt_s: float = Field(1e-4, gt=0, le=0.1, description="recording interval [s]")
 
@@ -83,11 +88,15 @@ class DTEOptions(StrictModel):
 class SpeedSweepOptions(StrictModel):
     """DTE peak-to-peak over a range of input speeds (resonances of the mesh excitation)."""
 
-    speed_min_rpm: float = Field(300.0, gt=0, le=2e4)
-    speed_max_rpm: float = Field(3000.0, gt=0, le=2e4)
-    count: int = Field(19, ge=2, le=500)
+    speed_min_rpm: float = Field(
+        300.0, gt=0, le=2e4, description="Lowest input speed of the sweep [rpm]."
+    )
+    speed_max_rpm: float = Field(
+        3000.0, gt=0, le=2e4, description="Highest input speed of the sweep [rpm]."
+    )
+    count: int = Field(19, ge=2, le=500, description="Input speeds in the sweep [-].")
     duration_s: float = Field(0.1, gt=0, le=10, description="simulated time per speed [s]")
-    settle_s: float = Field(0.1, ge=0, le=10)
+    settle_s: float = Field(0.1, ge=0, le=10, description="Settling time at each speed [s].")
 
     @model_validator(mode="after")
     def _order(self):
@@ -97,15 +106,20 @@ class SpeedSweepOptions(StrictModel):
 
 
 class BatchOptions(StrictModel):
-    samples: int = Field(16, ge=1, le=100000)
-    duration_s: float = Field(0.5, gt=0, le=60)
-    settle_s: float = Field(0.1, ge=0, le=10)
-    seed: int = Field(0, ge=0)
+    samples: int = Field(
+        16, ge=1, le=100000, description="Random error realisations simulated [-]."
+    )
+    duration_s: float = Field(
+        0.5, gt=0, le=60, description="Simulated time per realisation after settling [s]."
+    )
+    settle_s: float = Field(0.1, ge=0, le=10, description="Settling time before recording [s].")
+    seed: int = Field(0, ge=0, description="Seed of the random realisations.")
     chunk_size: int = Field(
         1,
         ge=1,
         le=10000,
-        description="realisations per chunk (1: any batch of >= 2 uses every worker)",
+        description="Realisations per chunk of the execution layer (1: any batch of >= 2 "
+        "realisations uses every worker).",
     )
     tolerance_scale: float = Field(1.0, gt=0, le=10, description="× Table 3 amplitudes")
 
@@ -129,7 +143,6 @@ def build_dynamic_model(case, red: RVReducer):
     )
 
     d, op = case.reducer.dynamics, case.operation
-    _check_representable(red)
     mp = mass_properties(red, case.reducer.density, d.given("mass"), d.given("inertia"))
     kw: dict[str, Any] = {f"{b}_mass_kg": v for b, v in mp.mass_kg.items()}
     kw.update({f"{b}_inertia_kgm2": v for b, v in mp.inertia_kgm2.items()})
@@ -162,6 +175,7 @@ def build_dynamic_model(case, red: RVReducer):
         sun_assembly=polar(e.sun_seat),
         output_assembly=polar(e.output_seat),
         output_bearing_clearance_mm=red.supports.main_bearing_clearance,
+        output_torque_Nm=op.output_torque_Nm,
     )
     return RVDynamicModel(params, errors), mp
 
@@ -191,29 +205,10 @@ def batch_tolerances(red: RVReducer, scale: float = 1.0):
     )
 
 
-def _check_representable(red: RVReducer) -> None:
-    """The disc profile errors the quasi-static model reads but the dynamics cannot hold."""
-    amp = red.error_set.amplitudes()
-    for part in ("disc_radial_runout", "disc_cumulative_pitch"):
-        if amp[part] > 0:
-            raise ParameterError(
-                "reducer.errors",
-                part,
-                "disc profile errors are read by the quasi-static analyses only: the dynamic "
-                "model has one equivalent cycloid–pin spring per disc and cannot hold them; "
-                "leave them out of a case that asks for dynamic analyses",
-            )
-    if np.any(red.error_set.disc_modification != 0):
-        raise ParameterError(
-            "reducer.discs.equidistant_modification_errors_um/shift_modification_errors_um",
-            red.error_set.disc_modification.tolist(),
-            "per-disc modification errors are read by the quasi-static analyses only (the "
-            "dynamic model's discs share one cycloid–pin pair)",
-        )
-
-
 def _has_errors(red: RVReducer) -> bool:
-    return any(v > 0 for v in red.error_set.amplitudes().values())
+    from gearte.models.rv_dynamics.excitation import has_pin_errors
+
+    return any(v > 0 for v in red.error_set.amplitudes().values()) or has_pin_errors(red)
 
 
 # --- analyses --------------------------------------------------------------------------------
@@ -390,7 +385,10 @@ def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
     ]
     if _has_errors(red):
         notes.append(
-            "Errors: the case's [[reducer.errors]], the same the quasi-static model reads."
+            "Errors: the case's [[reducer.errors]] and per-pin errors, the same the "
+            "quasi-static model reads; pin, disc run-out, cumulative pitch and per-disc "
+            "modification errors act as each disc's loaded rotation shift computed from the "
+            "same pin clearances (gearte.models.rv_dynamics.excitation)."
         )
     if opts.duration_s * sources["output rotation"] < 0.99 and _has_errors(red):
         warnings.append(
@@ -508,7 +506,7 @@ def _batch(case, red, model, options) -> AnalysisResult:
         notes=[
             "Each part's error amplitude uniform in [0, tolerance] (the largest of the case's "
             f"errors of that part × {s:g}), phase uniform in [0, 2π), independently per crank "
-            f"and disc; seed {seed}.",
+            f"and disc; seed {seed}. Pin and disc-profile errors are not drawn.",
             "Peak-to-peak over the simulated span after settling, reduced inside the kernel.",
         ],
         data={"rows": res["rows"]},

@@ -62,6 +62,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from gearte.errors import ConvergenceError, ParameterError
+from gearte.geometry.planetary import SunPlanets
 from gearte.geometry.rv import (
     ERROR_PARTS,
     Cranks,
@@ -152,11 +153,13 @@ class Bearing(StrictModel):
 class FirstStageSection(StrictModel):
     """Involute first stage: sun and planets (an RV first stage has no ring)."""
 
-    sun_teeth: int = Field(ge=6, le=400)
-    planet_teeth: int = Field(ge=6, le=400)
+    sun_teeth: int = Field(ge=6, le=400, description="Teeth of the sun (input) gear [-].")
+    planet_teeth: int = Field(ge=6, le=400, description="Teeth of each planet [-].")
     planets: int = Field(ge=2, le=6, description="must equal cranks.count")
-    module_mm: float = Field(gt=0, le=20)
-    pressure_angle_deg: float = Field(gt=0, lt=45)
+    module_mm: float = Field(gt=0, le=20, description="Module m of the first stage [mm].")
+    pressure_angle_deg: float = Field(
+        gt=0, lt=45, description="Pressure angle α of the first stage [deg]."
+    )
     mesh_stiffness_N_per_mm: float | None = Field(
         default=None, gt=0, le=1e9, description="mean mesh stiffness; default ISO 6336 from b"
     )
@@ -167,7 +170,9 @@ class FirstStageSection(StrictModel):
         description="ISO 6336 mesh stiffness c_gamma = 20 N/(mm um) when no mesh stiffness is "
         "given; sun and planet masses",
     )
-    sun_support_stiffness_N_per_mm: float = Field(gt=0, le=1e9)
+    sun_support_stiffness_N_per_mm: float = Field(
+        gt=0, le=1e9, description="Radial stiffness of the sun's support [N/mm]."
+    )
 
     @model_validator(mode="after")
     def _mesh(self):
@@ -177,9 +182,11 @@ class FirstStageSection(StrictModel):
 
 
 class CranksSection(StrictModel):
-    count: int = Field(ge=2, le=6)
-    circle_radius_mm: float = Field(gt=0, le=1000)
-    eccentricity_mm: float = Field(gt=0, le=50)
+    count: int = Field(ge=2, le=6, description="Number of crank shafts (= planets) [-].")
+    circle_radius_mm: float = Field(
+        gt=0, le=1000, description="Radius of the circle of crank centres on the carrier [mm]."
+    )
+    eccentricity_mm: float = Field(gt=0, le=50, description="Crank (cam) eccentricity a [mm].")
     cam_bearing: Bearing
     carrier_bearing: Bearing
     shaft_diameter_mm: float | None = Field(default=None, gt=0, le=500, description="mass only")
@@ -187,12 +194,20 @@ class CranksSection(StrictModel):
 
 
 class DiscsSection(StrictModel):
-    count: int = Field(ge=1, le=3)
-    face_width_mm: float = Field(gt=0, le=200)
-    equidistant_modification_mm: float = Field(default=0.0, ge=-0.5, le=0.5)
-    shift_modification_mm: float = Field(default=0.0, ge=-0.5, le=0.5)
-    youngs_modulus_MPa: float = Field(gt=0, le=1e6)  # noqa: N815
-    poisson_ratio: float = Field(ge=0, lt=0.5)
+    count: int = Field(ge=1, le=3, description="Number of cycloid discs [-].")
+    face_width_mm: float = Field(gt=0, le=200, description="Face width of one disc [mm].")
+    equidistant_modification_mm: float = Field(
+        default=0.0, ge=-0.5, le=0.5, description="Equidistant modification Δr_rp [mm]."
+    )
+    shift_modification_mm: float = Field(
+        default=0.0, ge=-0.5, le=0.5, description="Shifted modification Δr_p [mm]."
+    )
+    youngs_modulus_MPa: float = Field(  # noqa: N815
+        gt=0, le=1e6, description="Young's modulus E of discs and pins [MPa]."
+    )
+    poisson_ratio: float = Field(
+        ge=0, lt=0.5, description="Poisson's ratio ν of discs and pins [-]."
+    )
     crank_bore_diameter_mm: float | None = Field(default=None, gt=0, le=500, description="mass")
     centre_bore_diameter_mm: float | None = Field(default=None, gt=0, le=2000, description="mass")
     equidistant_modification_errors_um: list[float] | None = Field(
@@ -224,12 +239,16 @@ class DiscsSection(StrictModel):
 
 
 class PinsSection(StrictModel):
-    count: int = Field(ge=8, le=200)
-    pin_radius_mm: float = Field(gt=0, le=50)
-    circle_radius_mm: float = Field(gt=0, le=2000)
+    count: int = Field(ge=8, le=200, description="Number of pins z_p [-].")
+    pin_radius_mm: float = Field(gt=0, le=50, description="Pin radius r_rp [mm].")
+    circle_radius_mm: float = Field(gt=0, le=2000, description="Pin-centre-circle radius r_p [mm].")
     radius_errors_um: list[float] | None = Field(default=None, description="one per pin [um]")
-    radial_position_errors_um: list[float] | None = None
-    tangential_position_errors_um: list[float] | None = None
+    radial_position_errors_um: list[float] | None = Field(
+        None, description="Radial position error of each pin centre, one per pin [µm]."
+    )
+    tangential_position_errors_um: list[float] | None = Field(
+        None, description="Tangential position error of each pin centre, one per pin [µm]."
+    )
 
     @model_validator(mode="after")
     def _lengths(self):
@@ -242,8 +261,15 @@ class PinsSection(StrictModel):
 
 
 class SupportsSection(StrictModel):
-    carrier_radial_stiffness_N_per_mm: float = Field(gt=0, le=1e10)
-    main_bearing_clearance_um: float = Field(default=0.0, ge=0, le=200)
+    carrier_radial_stiffness_N_per_mm: float = Field(
+        gt=0, le=1e10, description="Radial stiffness of the carrier (output) support [N/mm]."
+    )
+    main_bearing_clearance_um: float = Field(
+        default=0.0,
+        ge=0,
+        le=200,
+        description="Radial clearance of the main bearing ε_h [µm] (dynamics only).",
+    )
     carrier_outer_diameter_mm: float | None = Field(default=None, gt=0, le=5000, description="mass")
     carrier_length_mm: float | None = Field(default=None, gt=0, le=5000, description="mass")
 
@@ -265,29 +291,80 @@ assert set(ERROR_PARTS) == set(get_args(_Part))  # noqa: S101 - one list of part
 class ErrorSection(StrictModel):
     """One eccentricity error: its part, where it sits, magnitude and angle in the part's frame."""
 
-    part: _Part
+    part: _Part = Field(
+        description="The part the error sits on (docs/rv-reducer-description.md, Errors)."
+    )
     crank: int | None = Field(default=None, ge=1, description="1-based crank (= planet) index")
     disc: int | None = Field(default=None, ge=1, description="1-based disc index")
-    value_um: float = Field(ge=0, le=500)
-    angle_deg: float = Field(ge=-360, le=360)
+    value_um: float = Field(ge=0, le=500, description="Magnitude of the eccentricity error [µm].")
+    angle_deg: float = Field(
+        ge=-360, le=360, description="Angle of the error in the part's frame [deg]."
+    )
 
 
 class DynamicsSection(StrictModel):
     """What only the dynamics needs; masses and inertias left out are derived from geometry."""
 
-    sun_mass_kg: float | None = Field(default=None, gt=0, le=1e3)
-    planet_mass_kg: float | None = Field(default=None, gt=0, le=1e3)
-    crank_mass_kg: float | None = Field(default=None, gt=0, le=1e3)
-    disc_mass_kg: float | None = Field(default=None, gt=0, le=1e3)
-    output_mass_kg: float | None = Field(default=None, gt=0, le=1e4)
-    sun_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e3)
-    planet_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e3)
-    crank_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e3)
-    disc_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e3)
-    output_inertia_kgm2: float | None = Field(default=None, gt=0, le=1e4)
-    input_torsional_stiffness_Nm_per_rad: float = Field(gt=0, le=1e9)  # noqa: N815
-    crank_torsional_stiffness_Nm_per_rad: float = Field(gt=0, le=1e9)  # noqa: N815
-    crank_bending_stiffness_N_per_mm: float = Field(gt=0, le=1e10)  # noqa: N815
+    sun_mass_kg: float | None = Field(
+        default=None,
+        gt=0,
+        le=1e3,
+        description="Mass of the sun gear [kg]; default: derived from geometry and density.",
+    )
+    planet_mass_kg: float | None = Field(
+        default=None, gt=0, le=1e3, description="Mass of one planet [kg]; default: derived."
+    )
+    crank_mass_kg: float | None = Field(
+        default=None, gt=0, le=1e3, description="Mass of one crank shaft [kg]; default: derived."
+    )
+    disc_mass_kg: float | None = Field(
+        default=None, gt=0, le=1e3, description="Mass of one cycloid disc [kg]; default: derived."
+    )
+    output_mass_kg: float | None = Field(
+        default=None,
+        gt=0,
+        le=1e4,
+        description="Mass of the output (carrier) [kg]; default: derived.",
+    )
+    sun_inertia_kgm2: float | None = Field(
+        default=None,
+        gt=0,
+        le=1e3,
+        description="Moment of inertia of the sun gear [kg·m²]; default: derived.",
+    )
+    planet_inertia_kgm2: float | None = Field(
+        default=None,
+        gt=0,
+        le=1e3,
+        description="Moment of inertia of one planet [kg·m²]; default: derived.",
+    )
+    crank_inertia_kgm2: float | None = Field(
+        default=None,
+        gt=0,
+        le=1e3,
+        description="Moment of inertia of one crank shaft [kg·m²]; default: derived.",
+    )
+    disc_inertia_kgm2: float | None = Field(
+        default=None,
+        gt=0,
+        le=1e3,
+        description="Moment of inertia of one disc [kg·m²]; default: derived.",
+    )
+    output_inertia_kgm2: float | None = Field(
+        default=None,
+        gt=0,
+        le=1e4,
+        description="Moment of inertia of the output [kg·m²]; default: derived.",
+    )
+    input_torsional_stiffness_Nm_per_rad: float = Field(  # noqa: N815
+        gt=0, le=1e9, description="Torsional stiffness of the input shaft [N·m/rad]."
+    )
+    crank_torsional_stiffness_Nm_per_rad: float = Field(  # noqa: N815
+        gt=0, le=1e9, description="Torsional stiffness of one crank shaft [N·m/rad]."
+    )
+    crank_bending_stiffness_N_per_mm: float = Field(  # noqa: N815
+        gt=0, le=1e10, description="Bending stiffness of one crank shaft [N/mm]."
+    )
     damping_ratio: float = Field(gt=0, lt=1, description="ζ of the lowest elastic mode")
     cycloid_stiffness: Literal["fourier", "mean"] = Field(
         "fourier", description="time-varying k_cr (Fourier) or its mean (as Li 2023 §4.1)"
@@ -298,8 +375,12 @@ class DynamicsSection(StrictModel):
     cycloid_pressure_angle_deg: float | None = Field(
         None, ge=0, lt=90, description="override of the equivalent pressure angle β"
     )
-    involute_harmonics: int = Field(10, ge=1, le=60)
-    cycloid_harmonics: int = Field(8, ge=1, le=30)
+    involute_harmonics: int = Field(
+        10, ge=1, le=60, description="Fourier harmonics of the involute mesh stiffness [-]."
+    )
+    cycloid_harmonics: int = Field(
+        8, ge=1, le=30, description="Fourier harmonics of the cycloid–pin mesh stiffness [-]."
+    )
 
     def given(self, what: str) -> dict[str, float]:
         """Given masses (``what="mass"``, [kg]) or inertias (``"inertia"``, [kg·m²]) by body."""
@@ -326,12 +407,19 @@ class ReducerSection(StrictModel):
     material: Literal["steel"] | None = Field(
         default=None, description="names the density of derived masses (steel: 7850 kg/m³)"
     )
-    density_kg_per_m3: float | None = Field(default=None, gt=100, le=30000)
+    density_kg_per_m3: float | None = Field(
+        default=None,
+        gt=100,
+        le=30000,
+        description="Density of derived masses [kg/m³] (or give material).",
+    )
     first_stage: FirstStageSection
-    cranks: CranksSection
-    discs: DiscsSection
-    pins: PinsSection
-    supports: SupportsSection
+    cranks: CranksSection = Field(description="Crank shafts and their bearings.")
+    discs: DiscsSection = Field(
+        description="Cycloid discs: width, profile modifications, material."
+    )
+    pins: PinsSection = Field(description="Pin ring: pins, radii and per-pin errors.")
+    supports: SupportsSection = Field(description="Carrier support and main bearing.")
     errors: list[ErrorSection] = Field(default_factory=list)
     cycloid_errors: CycloidErrors | None = None
     dynamics: DynamicsSection | None = None
@@ -374,30 +462,54 @@ class ReducerSection(StrictModel):
 class OperationSection(StrictModel):
     """Operating point of the dynamic analyses."""
 
-    input_speed_rpm: float = Field(gt=0, le=2e4)
-    output_torque_Nm: float = Field(gt=0, le=1e6)  # noqa: N815
+    input_speed_rpm: float = Field(gt=0, le=2e4, description="Input speed [rpm].")
+    output_torque_Nm: float = Field(gt=0, le=1e6, description="Output (load) torque [N·m].")  # noqa: N815
 
 
 class LoadSharingSection(StrictModel):
-    torque_Nm: float = Field(gt=0, le=1e6)
-    positions: int = Field(default=360, ge=8, le=7200)
-    compare_without_errors: bool = True
+    torque_Nm: float = Field(gt=0, le=1e6, description="Output torque [N·m].")
+    positions: int = Field(
+        default=360, ge=8, le=7200, description="Output positions over one revolution [-]."
+    )
+    compare_without_errors: bool = Field(
+        True, description="Also solve without the errors, for comparison."
+    )
 
 
 class TESection(StrictModel):
-    torque_Nm: float = Field(gt=0, le=1e6)
-    positions: int = Field(default=360, ge=8, le=7200)
-    zero_load_fraction: float = Field(default=1e-3, gt=0, lt=0.05)
+    torque_Nm: float = Field(gt=0, le=1e6, description="Output torque of the loaded TE [N·m].")
+    positions: int = Field(
+        default=360, ge=8, le=7200, description="Output positions over one revolution [-]."
+    )
+    zero_load_fraction: float = Field(
+        default=1e-3,
+        gt=0,
+        lt=0.05,
+        description="The geometric part is solved at this fraction × torque [-].",
+    )
 
 
 class CatalogueSection(StrictModel):
-    position_deg: float = Field(default=0.0, ge=0, lt=360)
+    position_deg: float = Field(
+        default=0.0,
+        ge=0,
+        lt=360,
+        description="Output angle at which the virtual torsion test runs [deg].",
+    )
     torque_sweep: list[float] = Field(
         default=[0.0, 1.0, 0.0, -1.0, 0.0, 1.0],
         description="turning points of the torque sweep, fractions of rated torque",
     )
-    steps_per_segment: int = Field(default=20, ge=2, le=1000)
-    lost_motion_fraction: float = Field(default=0.03, gt=0, lt=0.5)
+    steps_per_segment: int = Field(
+        default=20, ge=2, le=1000, description="Torque steps per segment of the torque sweep [-]."
+    )
+    lost_motion_fraction: float = Field(
+        default=0.03,
+        gt=0,
+        lt=0.5,
+        description="Lost motion "
+        "between ±fraction × rated torque [-] (0.03 or 0.05 in catalogues).",
+    )
 
     @model_validator(mode="after")
     def _sweep(self):
@@ -415,10 +527,18 @@ class CatalogueSection(StrictModel):
 
 
 class Bounds(StrictModel):
-    equidistant_modification: tuple[float, float] | None = None
-    shift_modification: tuple[float, float] | None = None
-    pin_radius: tuple[float, float] | None = None
-    pin_circle_radius: tuple[float, float] | None = None
+    equidistant_modification: tuple[float, float] | None = Field(
+        None, description="[lower, upper] change of the equidistant modification Δr_rp [µm]."
+    )
+    shift_modification: tuple[float, float] | None = Field(
+        None, description="[lower, upper] change of the shifted modification Δr_p [µm]."
+    )
+    pin_radius: tuple[float, float] | None = Field(
+        None, description="[lower, upper] change of the pin radius r_rp [µm]."
+    )
+    pin_circle_radius: tuple[float, float] | None = Field(
+        None, description="[lower, upper] change of the pin-circle radius r_p [µm]."
+    )
 
     @model_validator(mode="after")
     def _order(self):
@@ -432,12 +552,31 @@ class Bounds(StrictModel):
 
 
 class CompensationSection(StrictModel):
-    torque_Nm: float = Field(gt=0, le=1e6)
-    objective: Literal["total_te_peak_to_peak", "mean_lag"] = "total_te_peak_to_peak"
-    min_backlash_arcmin: float = Field(default=0.0, ge=0, le=30)
-    positions: int = Field(default=72, ge=8, le=720)
-    grid: int = Field(default=3, ge=2, le=7)
-    bounds_um: Bounds
+    torque_Nm: float = Field(
+        gt=0, le=1e6, description="Output torque at which the objective is evaluated [N·m]."
+    )
+    objective: Literal["total_te_peak_to_peak", "mean_lag"] = Field(
+        "total_te_peak_to_peak",
+        description="What the compensation minimises: total TE peak-to-peak or the mean lag.",
+    )
+    min_backlash_arcmin: float = Field(
+        default=0.0,
+        ge=0,
+        le=30,
+        description="Backlash the changed design must keep at least [arcmin].",
+    )
+    positions: int = Field(
+        default=72, ge=8, le=720, description="Output positions per evaluation [-]."
+    )
+    grid: int = Field(
+        default=3,
+        ge=2,
+        le=7,
+        description="Points per design variable of the initial grid search [-].",
+    )
+    bounds_um: Bounds = Field(
+        description="The design variables and their [lower, upper] changes [µm]."
+    )
 
 
 class ToothContactSection(StrictModel):
@@ -445,9 +584,18 @@ class ToothContactSection(StrictModel):
 
     torque_Nm: float = Field(gt=0, le=1e6, description="output torque of the stage T [N·m]")
     disc_share: float = Field(gt=0, le=1, description="share of T carried by the analysed disc")
-    mesh_positions: int = Field(default=1, ge=1, le=100000)
-    start_force_N: float | None = Field(default=None, gt=0, le=1e9)
-    clearance_model: Literal["eq32", "envelope"] = "eq32"
+    mesh_positions: int = Field(
+        default=1,
+        ge=1,
+        le=100000,
+        description="Mesh positions over one tooth pitch (1: the paper's).",
+    )
+    start_force_N: float | None = Field(
+        default=None, gt=0, le=1e9, description="Start value of F_max [N]; default eq 45."
+    )
+    clearance_model: Literal["eq32", "envelope"] = Field(
+        "eq32", description="Initial clearance: eq 32 (paper, first order) or the exact envelope."
+    )
 
 
 class RVYieldSection(YieldSection):
@@ -464,18 +612,36 @@ class RVYieldSection(YieldSection):
 
 
 class Analyses(StrictModel):
-    load_sharing: LoadSharingSection | None = None
-    transmission_error: TESection | None = None
-    catalogue: CatalogueSection | None = None
-    compensation: CompensationSection | None = None
+    load_sharing: LoadSharingSection | None = Field(
+        None, description="Pin load sharing with the errors over one output revolution (Han 2023)."
+    )
+    transmission_error: TESection | None = Field(
+        None, description="Loaded output angle error: geometric and elastic parts, mean lag."
+    )
+    catalogue: CatalogueSection | None = Field(
+        None,
+        description="Virtual torsion test: rigidity, "
+        "lost motion, backlash (needs rated_torque_Nm).",
+    )
+    compensation: CompensationSection | None = Field(
+        None,
+        description="Profile and pin changes that minimise TE while keeping a minimum backlash.",
+    )
     geometric_te: GeometricTEOptions | None = None
     tooth_contact: ToothContactSection | None = None
     cycloid_compensation: CycloidCompensationOptions | None = None
-    contact: dyn.ContactOptions | None = None
-    modal: dyn.ModalOptions | None = None
-    dte: dyn.DTEOptions | None = None
+    contact: dyn.ContactOptions | None = Field(
+        None,
+        description="Loaded cycloid–pin contact over one mesh period: mesh stiffness (Li 2023).",
+    )
+    modal: dyn.ModalOptions | None = Field(
+        None, description="Natural frequencies and the Campbell diagram of the dynamic model."
+    )
+    dte: dyn.DTEOptions | None = Field(
+        None, description="Dynamic transmission error and its spectrum (Li 2023)."
+    )
     speed_sweep: dyn.SpeedSweepOptions | None = None
-    batch: dyn.BatchOptions | None = None
+    batch: dyn.BatchOptions | None = Field(None, description="DTE over random error realisations.")
 
     yield_: RVYieldSection | None = Field(default=None, alias="yield")
 
@@ -518,6 +684,16 @@ class Case(CaseBase):
 # ------------------------------------------------------------------------------------------
 # Case -> domain objects
 # ------------------------------------------------------------------------------------------
+#: ``[reducer.first_stage]`` key of each :class:`SunPlanets` field.
+_GEAR_SET_KEYS = {
+    "z_sun": "sun_teeth",
+    "z_planet": "planet_teeth",
+    "module": "module_mm",
+    "pressure_angle": "pressure_angle_deg",
+    "n_planets": "planets",
+}
+
+
 def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer:
     """The :class:`RVReducer` a case's ``[reducer]`` section describes.
 
@@ -542,15 +718,18 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         raise ParameterError(
             "reducer.first_stage.face_width_mm", None, "give it or mesh_stiffness_N_per_mm"
         )
-    first = FirstStage(
-        fs.sun_teeth,
-        fs.planet_teeth,
-        fs.module_mm,
-        deg_to_rad(fs.pressure_angle_deg),
-        mesh,
-        fs.sun_support_stiffness_N_per_mm,
-        fs.face_width_mm,
-    )
+    try:  # the planetary kind's gear set (its checks, its messages), named by the RV keys
+        gears = SunPlanets(
+            fs.sun_teeth,
+            fs.planet_teeth,
+            fs.module_mm,
+            float(deg_to_rad(fs.pressure_angle_deg)),
+            n_planets=fs.planets,
+        )
+    except ParameterError as exc:
+        key = _GEAR_SET_KEYS.get(exc.field, exc.field)
+        raise ParameterError(f"first_stage.{key}", exc.value, exc.reason) from None
+    first = FirstStage(gears, mesh, fs.sun_support_stiffness_N_per_mm, fs.face_width_mm)
     c = sec.cranks
     cranks = Cranks(
         c.count,

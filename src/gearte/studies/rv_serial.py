@@ -65,14 +65,30 @@ _FILE_PARTS = {
 class FilesSection(StrictModel):
     """Measurement files (``docs/metrology.md``), relative to the case file."""
 
-    disc_profile: str | None = None
-    disc_pitch: str | None = None
-    disc_bores: str | None = None
-    crank_eccentricity: str | None = None
-    bearing_clearance: str | None = None
-    planet_runout: str | None = None
-    sun_runout: str | None = None
-    pins: str | None = None
+    disc_profile: str | None = Field(
+        None, description="Measurement file of the discs' profiles (docs/metrology.md)."
+    )
+    disc_pitch: str | None = Field(
+        None, description="Measurement file of the discs' cumulative pitch (docs/metrology.md)."
+    )
+    disc_bores: str | None = Field(
+        None, description="Measurement file of the discs' crank bores (docs/metrology.md)."
+    )
+    crank_eccentricity: str | None = Field(
+        None, description="Measurement file of the cranks' eccentricities (docs/metrology.md)."
+    )
+    bearing_clearance: str | None = Field(
+        None, description="Measurement file of the bearing clearances (docs/metrology.md)."
+    )
+    planet_runout: str | None = Field(
+        None, description="Measurement file of the planets' run-out (docs/metrology.md)."
+    )
+    sun_runout: str | None = Field(
+        None, description="Measurement file of the sun's run-out (docs/metrology.md)."
+    )
+    pins: str | None = Field(
+        None, description="Measurement file of the pin ring (docs/metrology.md)."
+    )
 
     @field_validator(*_FILES)
     @classmethod
@@ -85,7 +101,7 @@ class SerialSection(StrictModel):
     discs: list[str] | None = Field(default=None, description="disc serials, disc 1 first")
     cranks: list[str] | None = Field(default=None, description="crank serials by position")
     planets: list[str] | None = Field(default=None, description="planet serials by position")
-    sun: str | None = None
+    sun: str | None = Field(None, description="Serial of the sun gear.")
     pins: str | None = Field(default=None, description="pin-ring serial")
     files: FilesSection
 
@@ -109,9 +125,15 @@ class SerialSection(StrictModel):
 
 
 class Analyses(StrictModel):
-    load_sharing: rv.LoadSharingSection | None = None
-    transmission_error: rv.TESection | None = None
-    catalogue: rv.CatalogueSection | None = None
+    load_sharing: rv.LoadSharingSection | None = Field(
+        None, description="Pin load sharing of this serial (as rv_reducer's)."
+    )
+    transmission_error: rv.TESection | None = Field(
+        None, description="Loaded TE of this serial (as rv_reducer's)."
+    )
+    catalogue: rv.CatalogueSection | None = Field(
+        None, description="Virtual torsion test of this serial (as rv_reducer's)."
+    )
 
 
 class Case(CaseBase):

@@ -38,7 +38,9 @@ Modules (one concern each):
 * :mod:`.assembly` — :class:`RVDynamicModel`: elements, stiffness matrix, forces, statics, and the
   packed arguments of the compiled right-hand side;
 * :mod:`.rhs` — the compiled right-hand side :func:`rv_rhs` and DTE output :func:`rv_dte`;
-* :mod:`.modal` — natural frequencies, rigid-body mode, damping, resonance warnings.
+* :mod:`.modal` — natural frequencies, rigid-body mode, damping, resonance warnings;
+* :mod:`.excitation` — per-pin and disc-profile errors as each disc's loaded rotation shift
+  (:func:`disc_rotation_error`), from the same pin clearances as the quasi-static model.
 
 Running the model (DTE, spectrum, error batches) composes it with the integrators and the
 execution layer: :mod:`gearte.runners.rv_dynamics_sim`.
@@ -51,6 +53,7 @@ doi:10.3390/machines11060626
 """
 
 from gearte.models.rv_dynamics.assembly import RVDynamicModel
+from gearte.models.rv_dynamics.excitation import disc_rotation_error, has_pin_errors
 from gearte.models.rv_dynamics.mesh_stiffness import (
     cycloid_mesh_stiffness_fourier,
     involute_contact_ratio,
@@ -81,4 +84,6 @@ __all__ = [
     "parameters_from_reducer",
     "errors_from_reducer",
     "DYNAMIC_ONLY",
+    "disc_rotation_error",
+    "has_pin_errors",
 ]

@@ -44,7 +44,30 @@ from gearte.units import (
     deg_to_rad,
 )
 
-__all__ = ["RVDynamicModel"]
+__all__ = ["RVDynamicModel", "periodic_interp"]
+
+
+def periodic_interp(table: np.ndarray, angle: float) -> float:
+    """Linear interpolation of ``table`` (K samples at ``2π k / K``) at ``angle`` [rad], periodic.
+
+    Plain twin of the interpolation in :func:`gearte.models.rv_dynamics.rhs.rv_rhs`.
+    """
+    k = table.size
+    x = (angle / (2.0 * np.pi)) % 1.0 * k
+    i0 = int(x) % k
+    w = x - int(x)
+    return float((1.0 - w) * table[i0] + w * table[(i0 + 1) % k])
+
+
+def _check_rotation_frame(p: RVDynamicsParameters, e: RVErrors) -> None:
+    """The discs' rotation excitation is tabulated with the eccentric at −z_c θ_o (no phase)."""
+    if p.crank_phase_deg != 0.0 and np.any(e.disc_rotation != 0.0):
+        raise ParameterError(
+            "crank_phase_deg",
+            p.crank_phase_deg,
+            "must be 0 with pin or disc-profile errors (their excitation is tabulated in the "
+            "frame of gearte.geometry.rv, eccentric of disc 1 along −z_c θ_o)",
+        )
 
 
 class RVDynamicModel:
@@ -74,6 +97,7 @@ class RVDynamicModel:
                 (self.errors.crank_count, self.errors.disc_count),
                 f"must be for ({m}, {n})",
             )
+        _check_rotation_frame(p, self.errors)
         self.n_bodies = 2 * m + n + 2
         self.n_dof = 3 * self.n_bodies
         t_disc = Nm_to_Nmm(p.output_torque_Nm) / n
@@ -198,6 +222,7 @@ class RVDynamicModel:
             np.ascontiguousarray(cart(pin)),
             np.ascontiguousarray(geo_m),
             np.ascontiguousarray(geo_n),
+            np.ascontiguousarray(e.disc_rotation),
         )
 
     # --- plain element model (readable twin) ------------------------------------------------
@@ -370,14 +395,18 @@ class RVDynamicModel:
             nvec = -dvec
             pp = p.pair.pin_count * cc
             r = pp - cc
-            g = row([(ic, (nvec[0], nvec[1], r[0] * nvec[1] - r[1] * nvec[0]))])
+            g_t = r[0] * nvec[1] - r[1] * nvec[0]
+            g = row([(ic, (nvec[0], nvec[1], g_t))])
+            # pin and disc-profile errors: the disc must turn by Δθ_j(θ_o) more to load the pins
+            d_rot = periodic_interp(e.disc_rotation[j], th_o)
             out.append(
                 dict(
                     name=f"disc{j + 1}-pins",
                     kind="line",
                     k=series(self.cycloid_fourier, p.pair.pin_count * chi),
                     g=g,
-                    e=float(e.pin_composite[j, 0] * np.sin(th_o + e.pin_composite[j, 1])),
+                    e=float(e.pin_composite[j, 0] * np.sin(th_o + e.pin_composite[j, 1]))
+                    - g_t * d_rot,
                 )
             )
         return out
@@ -529,6 +558,7 @@ class RVDynamicModel:
             self.params.disc_count,
         ):
             raise ParameterError("errors", (errors.crank_count, errors.disc_count), "wrong counts")
+        _check_rotation_frame(self.params, errors)
         new.errors = errors
         return new
 

@@ -179,6 +179,10 @@ class RVErrors:
     output_assembly (E_o, β_o): fixed offset of the output's support seat.
     pin_composite (E_cr,j, phase): composite error of disc j along its line of action,
       E sin(θ_o + phase) (paper eq 21; no value given).
+    disc_rotation (Δθ_j): shape (N, K), the loaded rotation shift [rad] of disc j caused by the
+      per-pin and disc-profile errors at K equally spaced output angles over one revolution
+      (:func:`gearte.models.rv_dynamics.excitation.disc_rotation_error`); the disc's cycloid–pin
+      spring reads θ_j − Δθ_j(θ_o), linearly interpolated. None → no such errors.
     Clearances [mm]: turning-arm (crank–disc) bearings ε_c, crank support bearings in the output
     disc ε_oH, output main bearing ε_h; radial dead zone of the bearing spring.
     """
@@ -193,6 +197,7 @@ class RVErrors:
     disc_hole: np.ndarray = None  # type: ignore[assignment]  # (M, N, 2); None → zeros
     cam: np.ndarray = None  # type: ignore[assignment]  # (M, N, 2); None → zeros
     pin_composite: np.ndarray = None  # type: ignore[assignment]  # (N, 2); None → zeros
+    disc_rotation: np.ndarray = None  # type: ignore[assignment]  # (N, K); None → zeros (N, 1)
     turning_arm_clearance_mm: float = 0.0
     crank_bearing_clearance_mm: float = 0.0
     output_bearing_clearance_mm: float = 0.0
@@ -214,6 +219,16 @@ class RVErrors:
             if not np.all(np.isfinite(arr)) or np.any(arr[..., 0] < 0):
                 raise ParameterError(name, arr.tolist(), "amplitudes must be finite and ≥ 0")
             object.__setattr__(self, name, arr)
+        rot = (
+            np.zeros((n, 1))
+            if self.disc_rotation is None
+            else np.array(self.disc_rotation, dtype=float, ndmin=2)
+        )
+        if rot.ndim != 2 or rot.shape[0] != n or rot.shape[1] < 1:
+            raise ParameterError("disc_rotation", rot.shape, f"must have shape ({n}, K ≥ 1)")
+        if not np.all(np.isfinite(rot)):
+            raise ParameterError("disc_rotation", "non-finite", "must be finite [rad]")
+        object.__setattr__(self, "disc_rotation", np.ascontiguousarray(rot))
         for name in ("sun_eccentricity", "sun_assembly", "output_assembly"):
             v = tuple(float(x) for x in getattr(self, name))
             if len(v) != 2 or v[0] < 0 or not np.all(np.isfinite(v)):
@@ -240,6 +255,9 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
     The description's mean involute mesh stiffness k̄ becomes the single-pair stiffness k̄/ε_α of
     the rectangular wave.
 
+    Per-pin and disc-profile errors are not parameters: :func:`errors_from_reducer` turns them
+    into the discs' rotation excitation.
+
     Parameters
     ----------
     reducer : RVReducer
@@ -254,8 +272,7 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
     ------
     ParameterError
         When the crank circle radius differs from the first-stage centre distance (the dynamic
-        model derives it from the gears) or a per-pin error is given (the equivalent single-spring
-        cycloid–pin contact cannot represent it).
+        model derives it from the gears).
     """
     fs, cr, di, pins = reducer.first_stage, reducer.cranks, reducer.discs, reducer.pins
     a_h = fs.module * (fs.sun_teeth + fs.planet_teeth) / 2.0
@@ -265,14 +282,6 @@ def parameters_from_reducer(reducer, **dynamic) -> RVDynamicsParameters:
             cr.circle_radius,
             f"must equal the first-stage centre distance m (z_1 + z_2)/2 = {a_h:g} mm",
         )
-    for name in ("radius_errors", "radial_position_errors", "tangential_position_errors"):
-        if np.any(getattr(pins, name) != 0):
-            raise ParameterError(
-                f"pins.{name}",
-                "non-zero",
-                "per-pin errors are not representable by the equivalent cycloid–pin spring of "
-                "the dynamic model; use the composite error RVErrors.pin_composite",
-            )
     pair = CycloidPinPair(
         pin_count=pins.count,
         pin_radius_mm=pins.pin_radius,
@@ -338,33 +347,67 @@ DYNAMIC_ONLY = (
 )
 
 
-def errors_from_reducer(reducer, **paper004) -> RVErrors:
+def errors_from_reducer(
+    reducer,
+    *,
+    output_torque_Nm: float | None = None,  # noqa: N803
+    samples_per_mesh: int = 4,
+    **paper004,
+) -> RVErrors:
     """RVErrors from the description's measured errors and clearances.
 
     The description's error vectors (x, y) in the part frames use the same frames as this model
     (planet: from disc 1's eccentric direction; disc bore and carrier bore: from the radial
     direction; cam: from its eccentric direction), so they map 1:1 to (amplitude, phase). Its
-    disc-bore array is indexed (disc, crank) and is transposed. ``paper004`` adds the errors the
-    description does not hold (sun_eccentricity, sun_assembly, output_assembly, pin_composite,
-    output_bearing_clearance_mm).
+    disc-bore array is indexed (disc, crank) and is transposed. The errors that act on single pin
+    contacts (per-pin radius and position, disc radial run-out and cumulative pitch, per-disc
+    modification errors) become each disc's rotation excitation ``disc_rotation``
+    (:func:`gearte.models.rv_dynamics.excitation.disc_rotation_error`, at the per-disc share of
+    ``output_torque_Nm`` [N·m], ``samples_per_mesh`` output angles per mesh period).
+    ``paper004`` adds the errors the description does not hold (sun_eccentricity, sun_assembly,
+    output_assembly, pin_composite, output_bearing_clearance_mm).
 
     Parameters
     ----------
     reducer : RVReducer
         The reducer description with its measured errors and clearances.
+    output_torque_Nm : float, optional
+        Output torque [N·m] at which the pin-error excitation is computed.
+    samples_per_mesh : int
+        Output angles per mesh period of the excitation table [-].
 
     Returns
     -------
     RVErrors
-        The errors of the dynamic model (amplitudes [mm], phases [rad]).
+        The errors of the dynamic model (amplitudes [mm], phases [rad], disc rotations [rad]).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``output_torque_Nm`` when the reducer has pin or disc-profile errors and no torque
+        is given (their effect on the loaded contact depends on the load).
     """
-    e = reducer.errors
+    from gearte.models.rv_dynamics.excitation import disc_rotation_error, has_pin_errors
+    from gearte.units import Nm_to_Nmm
+
+    e = reducer.error_set
     m, n = reducer.cranks.count, reducer.discs.count
 
     def polar(v):
         v = np.asarray(v, dtype=float)
         return np.stack([np.hypot(v[..., 0], v[..., 1]), np.arctan2(v[..., 1], v[..., 0])], -1)
 
+    if has_pin_errors(reducer) and "disc_rotation" not in paper004:
+        if output_torque_Nm is None:
+            raise ParameterError(
+                "output_torque_Nm",
+                None,
+                "needed to turn the pin and disc-profile errors into the discs' loaded "
+                "rotation excitation",
+            )
+        paper004["disc_rotation"] = disc_rotation_error(
+            reducer, Nm_to_Nmm(output_torque_Nm) / n, samples_per_mesh
+        )
     return RVErrors(
         crank_count=m,
         disc_count=n,

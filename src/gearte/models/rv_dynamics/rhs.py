@@ -108,14 +108,14 @@ def rv_rhs(t, y, args, dydt, work):
 
     y = [q (6M+3N+6), q̇]; q per body (x [mm], y [mm], θ [rad]) in the order sun, planets 1..M,
     cranks 1..M, discs 1..N, output. ``args`` = (pf, inv_mass, fsp, fcr, err_g, err_m, err_mn,
-    err_n, geo_m, geo_n) from :meth:`RVDynamicModel.kernel_args`; errors are given there as
+    err_n, geo_m, geo_n, rot_n) from :meth:`RVDynamicModel.kernel_args`; errors are given there as
     body-fixed Cartesian offsets (E cos β, E sin β) and rotated here with the body, so the only
     trigonometric calls per evaluation are the five nominal angles. ``work`` (``RHS_WORK_SIZE``
     floats, NaN-filled, one per integration) memoises them and the mesh stiffnesses for the last
     two times, so RK4 computes them twice per step instead of four times; pass
     ``np.full(RHS_WORK_SIZE, np.nan)`` (a shorter array makes the call allocate its own).
     """
-    pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n, geo_m, geo_n = args
+    pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n, geo_m, geo_n, rot_n = args
     nm = int(pf[30])
     nn = int(pf[31])
     nd = 3 * (2 * nm + nn + 2)
@@ -282,6 +282,15 @@ def rv_rhs(t, y, args, dydt, work):
     w_h = pf[2] * w_o
     sb = pf[35]
     cb = pf[34]
+    # pin and disc-profile errors: rotation shift Δθ_j(θ_o) of each disc, K samples per
+    # output revolution, linearly interpolated (plain twin: assembly.periodic_interp)
+    n_rot = rot_n.shape[1]
+    x_rot = th_o / (2.0 * np.pi)
+    x_rot = (x_rot - np.floor(x_rot)) * n_rot
+    i_rot = int(x_rot)
+    w_rot = x_rot - i_rot
+    i_rot = i_rot % n_rot
+    i_rot1 = (i_rot + 1) % n_rot
     for j in range(nn):
         ic = 3 * (1 + 2 * nm + j)
         ex = chh * geo_n[j, 0] - shh * geo_n[j, 1]  # chi_j = th_h + π j
@@ -323,7 +332,8 @@ def rv_rhs(t, y, args, dydt, work):
         ecr = (
             err_n[j, 0] * so + err_n[j, 1] * co
         )  # E sin(th_o + φ) = E cosφ sin th_o + E sinφ cos th_o
-        d = nx * q[ic] + ny * q[ic + 1] + g_t * q[ic + 2] + ecr
+        d_rot = (1.0 - w_rot) * rot_n[j, i_rot] + w_rot * rot_n[j, i_rot1]
+        d = nx * q[ic] + ny * q[ic + 1] + g_t * (q[ic + 2] - d_rot) + ecr
         dv = nx * v[ic] + ny * v[ic + 1] + g_t * v[ic + 2]
         fn = -kcr * d - br * kcr * dv
         f[ic] += fn * nx
