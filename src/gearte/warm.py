@@ -25,6 +25,8 @@ WARM_CASES: dict[str, tuple[str, ...]] = {
     "planetary": ("wang2013_2kh_eq9", "wang2013_2kh_eq9_yield"),
     "rv_reducer": ("hu2020_rv80e_initial_reducer", "li2023_rv", "han2023_rv110e_yield"),
     "rv_bench": ("synthetic_rv_bench",),
+    "rv_lot": ("synthetic_rv110e_lot",),
+    "rv_serial": ("synthetic_rv110e_serial",),
 }
 """Per study kind, the bundled cases whose analyses together call every kernel of the kind."""
 
