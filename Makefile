@@ -52,10 +52,15 @@ docs: $(DEV_STAMP)
 	NO_MKDOCS_2_WARNING=1 NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/mkdocs build --strict
 	@echo "docs: site/index.html"
 
-# The long fuzzing job (issue 13): FUZZ_COUNT mutants of the bundled cases through validation.
+# The long fuzzing job (issue 13): FUZZ_COUNT mutants of the bundled cases through validation,
+# the first FUZZ_RUNS accepted ones also through `gearte run`, and FUZZ_FILES mutated measurement
+# files through their readers (docs/errors.md, "Fuzzing").
 FUZZ_COUNT ?= 10000
+FUZZ_FILES ?= 10000
+FUZZ_RUNS ?= 300
 fuzz: $(DEV_STAMP)
-	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python tests/fuzzing.py --count $(FUZZ_COUNT)
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python tests/fuzzing.py \
+		--count $(FUZZ_COUNT) --files $(FUZZ_FILES) --runs $(FUZZ_RUNS)
 
 test-slow: $(DEV_STAMP)
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q -m slow

@@ -11,8 +11,24 @@ and is classified:
 * ``rejected``: a ``CaseFileError``; every line must be one line naming a key;
 * ``crash``: any other exception (would be exit 3 "bug" in the CLI).
 
+Accepted mutants can also go through ``gearte run`` (``--runs N``): in this process, through the
+CLI's own entry point (its exit codes), with ``--samples 4 --workers 1`` and tight time/memory
+budgets (``GEARTE_MAX_SECONDS``/``GEARTE_MAX_MEMORY_GB``, so an oversized mutant is refused at
+validation as it would be for a user), under an address-space limit (:data:`RUN_MEMORY_LIMIT`, the
+memory bound) and a per-run alarm. Exit 0, 1 or 2 is fine; exit 3 (a bug), a timeout or a run
+past the memory bound is not; and the input recorded in ``results.json`` must keep every given
+value's type (no coercion through ``run`` either).
+
+Measurement files are fuzzed too (``--files N``): the bundled bench files (TE traces, hysteresis
+curve, :mod:`gearte.io.bench`) and one file of each metrology format written from seeded parts
+(:mod:`gearte.io.metrology`), mutated line- and cell-wise (hostile cells, deleted, duplicated or
+swapped rows, ×50 blow-ups, renamed or re-united columns, hostile metadata, cut or corrupted
+bytes), read by their reader: a complete object with finite numbers, or one
+``BenchFileError``/``MeasurementFileError`` line naming the file; anything else is a crash.
+
 Small runs are part of the test suite (``tests/test_fuzz_cases.py``, hypothesis-driven); the long
-job is ``make fuzz`` (``python tests/fuzzing.py --count 10000``), which prints the tallies.
+job is ``make fuzz`` (``python tests/fuzzing.py --count 10000 --files 10000 --runs 300``), which
+prints the tallies.
 """
 
 from __future__ import annotations
@@ -279,37 +295,280 @@ def check_text(text: str, tmp: Path) -> Outcome:
     return Outcome("coerced", "; ".join(found)[:300]) if found else Outcome("accepted")
 
 
-#: Memory limit of one fuzzed ``gearte run`` (address space) [bytes]: the memory bound.
+#: Address-space limit of the fuzzing process while it runs mutants (``--runs``) [bytes]: the
+#: memory bound. A run past it fails to allocate (exit 3 or a crash), which the harness counts.
 RUN_MEMORY_LIMIT = 6 * 2**30
+#: ``--samples`` of fuzzed runs (Monte-Carlo, yield, dynamics batches).
+RUN_SAMPLES = 4
+#: Budgets of fuzzed runs (gearte.limits): an oversized mutant is refused at validation.
+RUN_BUDGETS = {"GEARTE_MAX_SECONDS": "20", "GEARTE_MAX_MEMORY_GB": "2"}
+
+
+class _Alarm(BaseException):
+    """The per-run alarm (a BaseException, so the CLI's last-resort handler does not take it)."""
 
 
 def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
-    """``gearte run`` of an accepted mutant in a subprocess under a memory limit: exit 0, 1
-    (analysis failed) or 2 (bad input) are fine; 3 (bug), a kill or a timeout are not."""
-    import resource
-    import subprocess
+    """``gearte run`` of an accepted mutant through the CLI entry point, in this process:
+    exit 0, 1 (analysis failed) or 2 (bad input) are fine; 3 (bug) or a timeout are not; the
+    case input recorded in ``results.json`` must keep the given types (``run_coerced``)."""
+    import contextlib
+    import io
+    import os
+    import signal
+
+    from gearte.cli import main as cli_main
 
     path = tmp / "run.toml"
     path.write_text(text, encoding="utf-8")
+    out = tmp / "out"
+    args = ["run", str(path), "--out", str(out), "--no-report", "--no-progress"]
+    args += ["--samples", str(RUN_SAMPLES), "--workers", "1"]
 
-    def limit() -> None:
-        resource.setrlimit(resource.RLIMIT_AS, (RUN_MEMORY_LIMIT, RUN_MEMORY_LIMIT))
+    def alarm(_signum: int, _frame: Any) -> None:
+        raise _Alarm
 
-    args = ["run", str(path), "--out", str(tmp / "out"), "--no-report", "--no-progress"]
-    args += ["--samples", "20", "--workers", "1"]
+    old_env = {k: os.environ.get(k) for k in RUN_BUDGETS}
+    os.environ.update(RUN_BUDGETS)
+    old = signal.signal(signal.SIGALRM, alarm)
+    old_term = signal.getsignal(signal.SIGTERM)  # the CLI installs its own: restore it after
+    signal.setitimer(signal.ITIMER_REAL, timeout_s)
+    err = io.StringIO()
     try:
-        p = subprocess.run(
-            [sys.executable, "-m", "gearte", *args],
-            capture_output=True,
-            text=True,
-            timeout=timeout_s,
-            preexec_fn=limit,
-        )
-    except subprocess.TimeoutExpired:
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            cli_main(args, standalone_mode=False)
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    except _Alarm:
         return Outcome("run_timeout", f"over {timeout_s} s")
-    if p.returncode in (0, 1, 2):
-        return Outcome(f"run_exit_{p.returncode}", p.stderr.strip().splitlines()[-1:].__str__())
-    return Outcome("run_bug", f"exit {p.returncode}: {p.stderr.strip()[-300:]}")
+    except MemoryError:
+        return Outcome("run_memory", "MemoryError past the address-space limit")
+    except Exception as exc:  # noqa: BLE001 - click usage errors and anything else
+        return Outcome("run_bug", f"{type(exc).__name__}: {str(exc)[:200]}")
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+        signal.signal(signal.SIGTERM, old_term)
+        for k, v in old_env.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+    last = (err.getvalue().strip().splitlines() or [""])[-1][:200]
+    if code not in (0, 1, 2):
+        return Outcome("run_bug", f"exit {code}: {err.getvalue()[-300:]}")
+    if code == 0:
+        doc = json.loads((out / "results.json").read_text(encoding="utf-8"))
+        found = _coercions(tomllib.loads(text), doc["case"]["input"])
+        if found:
+            return Outcome("run_coerced", "; ".join(found)[:300])
+    return Outcome(f"run_exit_{code}", last)
+
+
+# ----------------------------------------------------------------------------- measurement files
+BENCH_READERS = {"te_trace": "read_te_trace", "hysteresis": "read_hysteresis"}
+METROLOGY_READERS = {
+    "disc_profile": "read_disc_profiles",
+    "disc_pitch": "read_disc_pitch",
+    "pins": "read_pins",
+    "crank_eccentricity": "read_crank_eccentricity",
+    "disc_bores": "read_disc_bores",
+    "runout": "read_runout",
+    "bearing_clearance": "read_bearing_clearances",
+}
+HOSTILE_CELLS = [
+    "",
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "1e309",
+    "-1e309",
+    "1e-320",
+    "abc",
+    "1,5",
+    "0x10",
+    "1_000",
+    "true",
+    "9" * 400,
+    "-0",
+    '"',
+    "\x00",
+    "\u00a0",
+    "D-01",
+    "../../x",
+    "1e6",
+    "-1e6",
+]
+
+
+def measurement_corpus() -> dict[str, tuple[str, str]]:
+    """Base measurement files: ``name -> (reader, text)``; the bundled bench files and one file
+    of each metrology format written by its writer from seeded parts."""
+    import tempfile
+
+    import numpy as np
+
+    from gearte.cases import case_path
+    from gearte.io import metrology as mt
+
+    bench = case_path("synthetic_rv_bench").parent / "synthetic_rv_bench"
+    te = sorted((bench / "te").glob("*.csv"))[0]
+    files: dict[str, tuple[str, str]] = {
+        "te_trace": ("te_trace", _thin(te.read_text("utf-8"), 20)),
+        "hysteresis": ("hysteresis", _thin((bench / "hysteresis.csv").read_text("utf-8"), 10)),
+    }
+    rng = np.random.default_rng(13)
+    parts = {
+        "disc_profile": (
+            mt.write_disc_profiles,
+            {
+                "D-1": mt.DiscProfile(
+                    tuple(np.sort(rng.uniform(-3, 3, 5)) for _ in range(3)),
+                    tuple(rng.normal(0, 0.003, 5) for _ in range(3)),
+                )
+            },
+        ),
+        "disc_pitch": (mt.write_disc_pitch, {"D-1": rng.normal(0, 0.005, 3)}),
+        "pins": (
+            mt.write_pins,
+            {"H-7": mt.PinSet(rng.uniform(9.9, 10, 4), np.zeros(4), np.zeros(4))},
+        ),
+        "crank_eccentricity": (
+            mt.write_crank_eccentricity,
+            {"C-1": mt.CrankCams(rng.uniform(1.4, 1.6, 2), rng.normal(0, 0.01, 2))},
+        ),
+        "disc_bores": (mt.write_disc_bores, {"D-1": rng.normal(50, 0.01, (3, 2))}),
+        "runout": (mt.write_runout, {"P-1": mt.Runout(0.012, 1.3), "P-2": mt.Runout(0.004, -2)}),
+        "bearing_clearance": (
+            mt.write_bearing_clearances,
+            {"C-1": {"cam_1": 0.003, "cam_2": 0.004, "carrier": 0.002}},
+        ),
+    }
+    with tempfile.TemporaryDirectory() as d:
+        for fmt, (write, data) in parts.items():
+            path = Path(d) / f"{fmt}.csv"
+            write(path, data)
+            files[fmt] = (fmt, path.read_text("utf-8"))
+    return files
+
+
+def _thin(text: str, every: int) -> str:
+    """A bench file with every ``every``-th data row (a few hundred rows: fast to fuzz, still a
+    valid file covering the same range)."""
+    lines = text.splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln and not ln.startswith("#"))
+    rows = lines[head + 1 :]
+    kept = rows[::every] + ([rows[-1]] if (len(rows) - 1) % every else [])
+    return "\n".join([*lines[: head + 1], *kept]) + "\n"
+
+
+def mutate_csv(text: str, rng: random.Random) -> tuple[str, str]:
+    """One to three line/cell mutations of a measurement file's text, and what was done."""
+    lines = text.splitlines()
+    done = []
+    for _ in range(rng.choice([1, 1, 2, 3])):
+        if not lines:
+            lines = [""]
+        i = rng.randrange(len(lines))
+        op = rng.choice(["cell", "cell", "cell", "delete", "dup", "blow", "swap", "header", "meta"])
+        if op == "cell":
+            cells = re.split(r"([,;\t])", lines[i])
+            j = rng.randrange(0, len(cells), 2) if cells else 0
+            cells[j] = rng.choice(HOSTILE_CELLS).encode().decode("unicode_escape")
+            lines[i] = "".join(cells)
+        elif op == "delete":
+            del lines[i]
+        elif op == "dup":
+            lines.insert(i, lines[i])
+        elif op == "blow":
+            lines = lines[: i + 1] + lines[i:] * rng.choice([2, 50])
+        elif op == "swap":
+            k = rng.randrange(len(lines))
+            lines[i], lines[k] = lines[k], lines[i]
+        elif op == "header":
+            h = next((n for n, ln in enumerate(lines) if ln and not ln.startswith("#")), 0)
+            cells = re.split(r"([,;\t])", lines[h])
+            j = rng.randrange(0, len(cells), 2)
+            swap = rng.choice(["[um]", "[mm]", "[deg]", "[rad]", "[arcsec]", "[N·m]", "[kg]", ""])
+            cells[j] = rng.choice([re.sub(r"\[.*\]", swap, cells[j]), cells[j][:-1], "x"])
+            lines[h] = "".join(cells)
+            i = h
+        else:
+            lines.insert(0, rng.choice(["# sped_rpm: 1", "# format: pins", "# torque_Nm: x"]))
+        done.append(f"{op}@{i}")
+    out = "\n".join(lines) + "\n"
+    r = rng.random()
+    if r < 0.05:
+        cut = rng.randrange(len(out) + 1)
+        out, done = out[:cut], [*done, f"cut at {cut}"]
+    elif r < 0.1:
+        i = rng.randrange(len(out) + 1)
+        out = out[:i] + rng.choice(["\x00", "\ufeff", "\r", "\u2028", "\xff"]) + out[i:]
+        done.append(f"byte at {i}")
+    return out, "; ".join(done)
+
+
+def _finite(obj: Any) -> bool:
+    """Every number of a reader's result is finite (NaN never slips in as data)."""
+    import dataclasses
+
+    import numpy as np
+
+    if isinstance(obj, dict):
+        return all(_finite(v) for v in obj.values())
+    if isinstance(obj, list | tuple):
+        return all(_finite(v) for v in obj)
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return all(_finite(getattr(obj, f.name)) for f in dataclasses.fields(obj))
+    if isinstance(obj, np.ndarray) and obj.dtype.kind in "fc":
+        return bool(np.isfinite(obj).all())
+    if isinstance(obj, float):
+        return math.isfinite(obj)
+    return True
+
+
+def check_measurement(reader: str, text: str, tmp: Path) -> Outcome:
+    """Read one measurement file text with its reader and classify the outcome."""
+    from gearte.errors import BenchFileError, MeasurementFileError
+    from gearte.io import bench, metrology
+
+    path = tmp / "measured.csv"
+    path.write_text(text, encoding="utf-8", errors="surrogatepass")
+    module, name = (
+        (bench, BENCH_READERS[reader])
+        if reader in BENCH_READERS
+        else (metrology, METROLOGY_READERS[reader])
+    )
+    try:
+        got = getattr(module, name)(path)
+    except (BenchFileError, MeasurementFileError) as exc:
+        msg = str(exc)
+        if "\n" in msg or str(path) not in msg:
+            return Outcome("bad_message", msg[:300])
+        return Outcome("rejected", msg[:120])
+    except Exception as exc:  # noqa: BLE001 - what the harness looks for
+        return Outcome("crash", f"{type(exc).__name__}: {str(exc)[:200]}")
+    if not _finite(got):
+        return Outcome("nonfinite", "a reader returned NaN/inf")
+    return Outcome("accepted")
+
+
+def fuzz_measurements(count: int, seed: int, tmp: Path, verbose: bool = False) -> Counter[str]:
+    """Fuzz ``count`` mutated measurement files; the tally of outcomes (``file_*``)."""
+    rng = random.Random(seed)
+    bases = measurement_corpus()
+    names = sorted(bases)
+    tally: Counter[str] = Counter()
+    for i in range(count):
+        reader, text = bases[names[i % len(names)]]
+        mutant, done = mutate_csv(text, rng)
+        out = check_measurement(reader, mutant, tmp)
+        tally[f"file_{out.status}"] += 1
+        if verbose and out.status not in ("accepted", "rejected"):
+            print(f"[file {out.status}] {reader}: {done}\n    {out.detail}", file=sys.stderr)
+    return tally
 
 
 def run(
@@ -337,30 +596,44 @@ def run(
             tally["run_total"] += 1
             r = run_cli(text, tmp, run_timeout_s)
             tally[r.status] += 1
-            if verbose and r.status in ("run_bug", "run_timeout"):
+            if verbose and r.status in BAD_RUN:
                 print(f"[{r.status}] {name}: {done}\n    {r.detail}", file=sys.stderr)
     return tally
 
 
+#: Outcomes that fail the harness.
+BAD = ("crash", "coerced", "bad_message", "file_crash", "file_bad_message", "file_nonfinite")
+BAD_RUN = ("run_bug", "run_timeout", "run_memory", "run_coerced")
+
+
 def main(argv: list[str] | None = None) -> int:
+    import resource
     import tempfile
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--count", type=int, default=10_000)
+    ap.add_argument("--count", type=int, default=10_000, help="mutated case files")
+    ap.add_argument("--files", type=int, default=0, help="mutated measurement files")
     ap.add_argument("--seed", type=int, default=13)
     ap.add_argument("--quiet", action="store_true")
     ap.add_argument("--runs", type=int, default=0, help="accepted mutants also run (gearte run)")
     ap.add_argument("--run-timeout", type=float, default=120.0)
     a = ap.parse_args(argv)
+    if a.runs:
+        resource.setrlimit(resource.RLIMIT_AS, (RUN_MEMORY_LIMIT, RUN_MEMORY_LIMIT))
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as d:
         tally = run(a.count, a.seed, Path(d), not a.quiet, a.runs, a.run_timeout)
-    wall = time.perf_counter() - t0
+        t1 = time.perf_counter()
+        tally += fuzz_measurements(a.files, a.seed, Path(d), not a.quiet)
+    t2 = time.perf_counter()
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # kB -> GB
     print(
-        f"{a.count} fuzzed case files in {wall:.1f} s (seed {a.seed}): "
+        f"{a.count} fuzzed case files ({tally['run_total']} also run) in {t1 - t0:.1f} s, "
+        f"{a.files} fuzzed measurement files in {t2 - t1:.1f} s (seed {a.seed}); peak memory "
+        f"{peak:.2f} GB (bound {RUN_MEMORY_LIMIT / 2**30:.0f} GB when running): "
         f"{dict(sorted(tally.items()))}"
     )
-    bad = sum(tally[k] for k in ("crash", "coerced", "bad_message", "run_bug", "run_timeout"))
+    bad = sum(tally[k] for k in BAD + BAD_RUN)
     return 1 if bad else 0
 
 

@@ -28,6 +28,9 @@ def _small(name: str) -> dict:
             "monte_carlo": {"samples": 2000, "chunk_size": 500, "scenarios": ["random_assembly"]},
         }
         data["analyses"] = {k: v for k, v in data["analyses"].items() if v is not None}
+    elif name == "wang2013_2kh_eq9_yield":
+        y = data["analyses"]["yield"] | {"samples": 2000, "chunk_size": 250, "sobol_samples": 64}
+        data["analyses"] = {"yield": y}
     return data
 
 
@@ -35,9 +38,16 @@ _SAMPLES = {"jiang2024_spur_pair": 20_000, "jiang2024_shoulder_swing": 20_000}
 
 
 def _numbers(name: str, scheduler: str | None) -> str:
+    """The analyses of the small case on ``scheduler`` (2 workers); afterwards no worker process
+    of this run is left (the pool or cluster was shut down and its children reaped)."""
+    import multiprocessing
+
+    before = {p.pid for p in multiprocessing.active_children()}
     case = load_case_dict(_small(name))
     opts = RunOptions(progress=False, samples=_SAMPLES.get(name), scheduler=scheduler, workers=2)
     doc = json.loads(run_case(case, opts).to_json())
+    left = [p for p in multiprocessing.active_children() if p.pid not in before]
+    assert not left, f"{scheduler}: worker processes left after the run: {left}"
     return json.dumps(doc["analyses"], sort_keys=True)
 
 
@@ -80,12 +90,29 @@ def test_reproducer_processes_backend_runs_the_rv_dynamics_batch():
 @pytest.mark.parametrize("scheduler", ["processes", "local-cluster"])
 @pytest.mark.parametrize(
     "name",
-    ["jiang2024_spur_pair", "jiang2024_shoulder_swing", "wang2013_2kh_eq9", "li2023_rv_errors"],
+    [
+        "jiang2024_spur_pair",
+        "jiang2024_shoulder_swing",
+        "wang2013_2kh_eq9",
+        "li2023_rv_errors",
+        "wang2013_2kh_eq9_yield",
+    ],
 )
 def test_every_kind_sampled_analysis_on_every_backend(name, scheduler):
+    """Tolerance MC (gear pair, chain), planetary MC, RV dynamics batch and yield: bit-identical
+    on threads, processes and a Dask local cluster; no worker process left after each run."""
     pytest.importorskip("distributed")
     reference = _without_timing(_numbers(name, "threads"))
     assert _without_timing(_numbers(name, scheduler)) == reference
+
+
+@pytest.mark.slow
+def test_yield_on_processes_matches_threads_and_leaves_no_child():
+    """One corner of the backend matrix on its own (each worker process loads the compiled
+    kernels: ~15 s on 2 busy cores): the yield Monte-Carlo with its Sobol indices on a process
+    pool gives the threads' bits, and the pool's children are reaped."""
+    reference = _without_timing(_numbers("wang2013_2kh_eq9_yield", "threads"))
+    assert _without_timing(_numbers("wang2013_2kh_eq9_yield", "processes")) == reference
 
 
 def test_process_pool_shutdown_cannot_hang_and_reaps_its_children():

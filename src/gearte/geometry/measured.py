@@ -28,7 +28,15 @@ import numpy as np
 
 from gearte.errors import ParameterError
 
-__all__ = ["MeasuredDisc", "tooth_and_parameter", "apply_measurements", "measurements_of"]
+__all__ = [
+    "MeasuredDisc",
+    "tooth_and_parameter",
+    "apply_measurements",
+    "measurements_of",
+    "bore_errors",
+    "cam_errors",
+    "runout_errors",
+]
 
 
 def tooth_and_parameter(pin: np.ndarray, phase: np.ndarray, teeth: int):
@@ -183,6 +191,51 @@ def _rot2(v: np.ndarray, ang: np.ndarray | float) -> np.ndarray:
     return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
 
 
+def bore_errors(positions: np.ndarray, circle_radius: float) -> np.ndarray:
+    """Crank-bore errors in each bore's radial frame [mm] from measured centres.
+
+    Parameters
+    ----------
+    positions : numpy.ndarray
+        ``(..., M, 2)`` bore centres in the disc frame [mm] (bore ``i`` nominally at angle
+        ``2 pi i / M``).
+    circle_radius : float
+        Crank circle radius ``R_dc`` [mm].
+    """
+    m = positions.shape[-2]
+    ang = 2.0 * np.pi * np.arange(m) / m
+    nominal = circle_radius * np.stack([np.cos(ang), np.sin(ang)], -1)
+    return _rot2(positions - nominal, -ang)
+
+
+def cam_errors(eccentricity: np.ndarray, phase: np.ndarray, design: float) -> np.ndarray:
+    """Cam error vectors ``e u(phase) - a u(0)`` [mm] in the crank frame.
+
+    Parameters
+    ----------
+    eccentricity : numpy.ndarray
+        Measured eccentricities [mm].
+    phase : numpy.ndarray
+        Eccentric direction from the nominal one [rad].
+    design : float
+        Design eccentricity ``a`` [mm].
+    """
+    return np.stack([eccentricity * np.cos(phase) - design, eccentricity * np.sin(phase)], -1)
+
+
+def runout_errors(runout: np.ndarray) -> np.ndarray:
+    """Eccentricity vectors [mm] (run-out / 2 at the high point) from ``(..., 2)`` rows of
+    run-out [mm] and angle [rad].
+
+    Parameters
+    ----------
+    runout : numpy.ndarray
+        ``(..., 2)``: total indicator reading [mm], high-point angle [rad].
+    """
+    r = np.asarray(runout, dtype=float)
+    return 0.5 * r[..., :1] * np.stack([np.cos(r[..., 1]), np.sin(r[..., 1])], -1)
+
+
 def apply_measurements(
     reducer,
     *,
@@ -249,18 +302,13 @@ def apply_measurements(
         ch["measured_discs"] = tuple(discs)
     if disc_bores is not None:
         xy = np.asarray(disc_bores, dtype=float).reshape(n, m, 2)
-        ang = 2.0 * np.pi * np.arange(m) / m
-        nominal = reducer.cranks.circle_radius * np.stack([np.cos(ang), np.sin(ang)], -1)
-        ch["disc_bore"] = _rot2(xy - nominal[None], -ang[None, :])
+        ch["disc_bore"] = bore_errors(xy, reducer.cranks.circle_radius)
     if cam_eccentricity is not None:
         e = np.asarray(cam_eccentricity, dtype=float).reshape(m, n)
         ph = np.zeros((m, n)) if cam_phase is None else np.asarray(cam_phase, float).reshape(m, n)
-        ch["cam"] = np.stack(
-            [e * np.cos(ph) - reducer.cranks.eccentricity, e * np.sin(ph)], axis=-1
-        )
+        ch["cam"] = cam_errors(e, ph, reducer.cranks.eccentricity)
     if planet_runout is not None:
-        r = np.asarray(planet_runout, dtype=float).reshape(m, 2)
-        ch["planet"] = 0.5 * r[:, :1] * np.stack([np.cos(r[:, 1]), np.sin(r[:, 1])], -1)
+        ch["planet"] = runout_errors(np.asarray(planet_runout, dtype=float).reshape(m, 2))
     if sun_runout is not None:
         rs = np.asarray(sun_runout, dtype=float).reshape(2)
         ch["sun"] = 0.5 * rs[0] * np.array([np.cos(rs[1]), np.sin(rs[1])])

@@ -62,6 +62,9 @@ HEADLINE_KEYS: list[str] = [
     "mc_backlash_mean",
     "mc_backlash_sd",
     "out_of_spec_fraction",
+    "reducers_in_spec",
+    "reducers_in_spec_random_mean",
+    "reducers_in_spec_orientation_only",
     "torsional_rigidity",
     # loads and contact
     "max_contact_force",

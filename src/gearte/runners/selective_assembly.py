@@ -1,0 +1,718 @@
+"""Selective assembly of a lot of measured RV parts (issue 16): which disc set goes with which
+crank set, in which orientation, so that most reducers meet a TE spec — and pin grading.
+
+Method (``docs/selective-assembly.md``)
+---------------------------------------
+1. **Score every pairing with the model, linearised.** The loaded output angle error of the
+   one RV model (:func:`gearte.models.rv_load_sharing.load_sharing`) is solved once for the
+   design at the output angles ``theta``. At that equilibrium the tangent stiffness ``K_t``
+   (springs, bearings beyond their clearance, loaded pin contacts with the tangent of their
+   contact law) gives the sensitivity of the output angle to every spring offset and every pin
+   clearance: ``y = K_t⁻¹ e_out``, ``∂θ/∂e_s = −k_s B_s·y``, ``∂θ/∂g_c = k_c B_c·y``. A part's
+   errors change the offsets and clearances *exactly linearly* (they are built by the same
+   :func:`~gearte.models.rv_load_sharing.assemble`, from unit errors, and by
+   :meth:`~gearte.geometry.measured.MeasuredDisc.gap_change` for measured flanks), so each
+   oriented disc set and each oriented crank set has its own TE contribution ``t(θ)``, and a
+   pairing's TE trace is ``θ0(θ) + t_disc(θ) + t_crank(θ)`` — its peak-to-peak for every disc
+   set × orientation × crank set × orientation is one vectorised array operation.
+2. **Choose the orientation per pairing** (the best of disc slot order × disc indexing by
+   ``2π/M`` when ``z_c`` is a multiple of ``M`` × crank-to-bore indexing).
+3. **Solve the assignment** exactly: for the most reducers in spec,
+   :func:`scipy.optimize.linear_sum_assignment` on the cost ``pp/limit + BIG·[pp > limit]``
+   (``BIG`` larger than any sum of in-spec costs: the count is maximised first, then the total
+   TE); for the best worst reducer, a bottleneck assignment (bisection on the threshold with
+   :func:`scipy.sparse.csgraph.maximum_bipartite_matching`, then the sum at that threshold).
+4. **Verify** the chosen reducers with the full non-linear model (measured clearances
+   included).
+
+Pin grading: the backlash of each assembled reducer from the model's virtual torsion test
+(:func:`gearte.models.rv_catalogue.catalogue_values`) for each pin diameter grade; the grade
+whose backlash falls inside the window (nearest its centre) is chosen.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from gearte.errors import ParameterError
+from gearte.geometry.measured import (
+    MeasuredDisc,
+    apply_measurements,
+    bore_errors,
+    cam_errors,
+    runout_errors,
+)
+from gearte.geometry.rv import RVReducer
+from gearte.models.rv_load_sharing import (
+    RVSystem,
+    assemble,
+    load_sharing,
+    solver_law,
+)
+from gearte.solvers.rv_equilibrium import CLEARANCE_RESIDUAL, solve_positions
+
+__all__ = [
+    "Lot",
+    "Orientation",
+    "LinearTE",
+    "linear_te_model",
+    "ScoreTable",
+    "score_lot",
+    "score_lot_loop",
+    "Assembly",
+    "assign",
+    "brute_force",
+    "random_assemblies",
+    "orientation_only",
+    "assembled_reducer",
+    "full_model_te",
+    "pin_grades",
+]
+
+
+@dataclass(frozen=True, eq=False)  # holds arrays
+class Lot:
+    """A lot of measured parts: ``K_d`` disc sets and ``K_c`` crank sets.
+
+    Attributes
+    ----------
+    disc_serials : list of tuple of str
+        Per disc set, the serials of its ``N`` discs.
+    discs : list of tuple of MeasuredDisc
+        Per disc set, the measured flanks / pitch of each disc (None: design flank).
+    disc_bores : numpy.ndarray or None
+        ``(K_d, N, M, 2)`` crank-bore centres of each disc, disc frame [mm].
+    crank_serials : list of tuple of str
+        Per crank set, the serials of its ``M`` cranks (planet mounted on each).
+    cam_eccentricity, cam_phase : numpy.ndarray
+        ``(K_c, M, N)`` cam eccentricity [mm] and phase from nominal [rad].
+    planet_runout : numpy.ndarray or None
+        ``(K_c, M, 2)`` run-out [mm] and high-point angle [rad] of each crank's planet.
+    cam_clearance, carrier_clearance : numpy.ndarray or None
+        ``(K_c, M, N)`` and ``(K_c, M)`` measured bearing clearances [mm].
+    """
+
+    disc_serials: list[tuple[str, ...]]
+    discs: list[tuple[MeasuredDisc | None, ...]]
+    disc_bores: np.ndarray | None
+    crank_serials: list[tuple[str, ...]]
+    cam_eccentricity: np.ndarray
+    cam_phase: np.ndarray
+    planet_runout: np.ndarray | None = None
+    cam_clearance: np.ndarray | None = None
+    carrier_clearance: np.ndarray | None = None
+
+    @property
+    def disc_sets(self) -> int:
+        """``K_d`` [-]."""
+        return len(self.disc_serials)
+
+    @property
+    def crank_sets(self) -> int:
+        """``K_c`` [-]."""
+        return len(self.crank_serials)
+
+    def check(self, design: RVReducer) -> None:
+        """Shapes against the design; raises :class:`ParameterError` naming the array."""
+        m, n = design.cranks.count, design.discs.count
+        kd, kc = self.disc_sets, self.crank_sets
+        want = {
+            "disc_bores": (self.disc_bores, (kd, n, m, 2)),
+            "cam_eccentricity": (self.cam_eccentricity, (kc, m, n)),
+            "cam_phase": (self.cam_phase, (kc, m, n)),
+            "planet_runout": (self.planet_runout, (kc, m, 2)),
+            "cam_clearance": (self.cam_clearance, (kc, m, n)),
+            "carrier_clearance": (self.carrier_clearance, (kc, m)),
+        }
+        for name, (arr, shape) in want.items():
+            if arr is not None and np.shape(arr) != shape:
+                raise ParameterError(f"lot.{name}", np.shape(arr), f"must have shape {shape}")
+        for k, s in enumerate(self.disc_serials):
+            if len(s) != n or len(self.discs[k]) != n:
+                raise ParameterError(f"lot.disc_sets[{k}]", s, f"needs {n} discs")
+        for k, s in enumerate(self.crank_serials):
+            if len(s) != m:
+                raise ParameterError(f"lot.crank_sets[{k}]", s, f"needs {m} cranks")
+
+
+@dataclass(frozen=True)
+class Orientation:
+    """How the parts of one reducer are put together.
+
+    Attributes
+    ----------
+    disc_shift : int
+        Disc ``(j + disc_shift) mod N`` of the set goes into slot ``j`` (which disc on which
+        side) [-].
+    disc_index : int
+        Each disc turned by ``disc_index · 2π/M`` (its bore ``i`` on crank position ``i +
+        disc_index``; only when ``z_c`` is a multiple of ``M``) [-].
+    crank_shift : int
+        Crank ``(i − crank_shift) mod M`` of the set goes into carrier position ``i`` [-].
+    """
+
+    disc_shift: int = 0
+    disc_index: int = 0
+    crank_shift: int = 0
+
+
+def _disc_orientations(design: RVReducer) -> list[tuple[int, int]]:
+    m, n, zc = design.cranks.count, design.discs.count, design.cycloid_teeth
+    turns = m if zc % m == 0 else 1
+    return [(s, r) for s in range(n) for r in range(turns)]
+
+
+def _turned(disc: MeasuredDisc | None, shift: int) -> MeasuredDisc | None:
+    """The disc turned so that tooth ``t`` becomes tooth ``t + shift``."""
+    if disc is None or shift == 0:
+        return disc
+    z = disc.teeth
+
+    def roll(seq):
+        return None if seq is None else tuple(seq[(t - shift) % z] for t in range(z))
+
+    cp = None if disc.cumulative_pitch is None else np.roll(disc.cumulative_pitch, shift)
+    return MeasuredDisc(z, roll(disc.profile_phase), roll(disc.profile_deviation), cp, disc.serial)
+
+
+def _oriented_discs(lot: Lot, k: int, shift: int, index: int, design: RVReducer):
+    """``(discs per slot, bore centres (N, M, 2))`` of disc set ``k`` in an orientation."""
+    m, n, zc = design.cranks.count, design.discs.count, design.cycloid_teeth
+    slots = [(j + shift) % n for j in range(n)]
+    discs = tuple(_turned(lot.discs[k][s], index * zc // m) for s in slots)
+    bores = None
+    if lot.disc_bores is not None:
+        xy = lot.disc_bores[k][slots]  # (N, M, 2)
+        rho = 2.0 * np.pi * index / m
+        c, s_ = np.cos(rho), np.sin(rho)
+        turned = np.stack([c * xy[..., 0] - s_ * xy[..., 1], s_ * xy[..., 0] + c * xy[..., 1]], -1)
+        bores = np.roll(turned, index, axis=1)
+    return discs, bores
+
+
+def _oriented_cranks(lot: Lot, k: int, shift: int) -> dict[str, np.ndarray | None]:
+    def roll(a):
+        return None if a is None else np.roll(a[k], shift, axis=0)
+
+    return {
+        "cam_eccentricity": roll(lot.cam_eccentricity),
+        "cam_phase": roll(lot.cam_phase),
+        "planet_runout": roll(lot.planet_runout),
+        "cam_clearance": roll(lot.cam_clearance),
+        "carrier_clearance": roll(lot.carrier_clearance),
+    }
+
+
+def assembled_reducer(
+    design: RVReducer, lot: Lot, disc_set: int, crank_set: int, orientation: Orientation
+) -> RVReducer:
+    """The reducer assembled from disc set ``disc_set`` and crank set ``crank_set``.
+
+    Parameters
+    ----------
+    design : RVReducer
+        The design (nominal parts, pins, housing).
+    lot : Lot
+        The measured parts.
+    disc_set, crank_set : int
+        0-based indices into the lot [-].
+    orientation : Orientation
+        How the parts are put together.
+    """
+    discs, bores = _oriented_discs(
+        lot, disc_set, orientation.disc_shift, orientation.disc_index, design
+    )
+    cr = _oriented_cranks(lot, crank_set, orientation.crank_shift)
+    return apply_measurements(design, discs=list(discs), disc_bores=bores, **cr)
+
+
+# ---- the linearised model ------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class LinearTE:
+    """The loaded output angle error of the design and its sensitivities at ``P`` angles.
+
+    Attributes
+    ----------
+    theta : (P,) output angles [rad].
+    base : (P,) output angle error of the design [rad].
+    d_offset : (P, ns) ∂θ/∂e of every spring offset [rad/mm].
+    d_gap : (P, nc) ∂θ/∂g of every pin clearance [rad/mm].
+    system : RVSystem of the design at ``theta``.
+    d_cam_clearance : (M, N, P) ∂θ/∂c of each cam bearing's radial clearance [rad/mm].
+    d_carrier_clearance : (M, P) ∂θ/∂c of each crank's carrier bearing clearance [rad/mm].
+    """
+
+    theta: np.ndarray
+    base: np.ndarray
+    d_offset: np.ndarray
+    d_gap: np.ndarray
+    system: RVSystem
+    d_cam_clearance: np.ndarray
+    d_carrier_clearance: np.ndarray
+
+    def response(self, d_offset: np.ndarray, d_gap: np.ndarray) -> np.ndarray:
+        """Output angle change [rad] of offset changes ``(..., P, ns)`` and clearance changes
+        ``(..., P, nc)`` [mm]."""
+        return np.einsum("...ps,ps->...p", d_offset, self.d_offset) + np.einsum(
+            "...pc,pc->...p", d_gap, self.d_gap
+        )
+
+
+def linear_te_model(design: RVReducer, torque: float, theta: np.ndarray) -> LinearTE:
+    """The design's loaded TE and its tangent sensitivities (module docstring, step 1).
+
+    Parameters
+    ----------
+    design : RVReducer
+        The design the lot's parts were made to (its own errors, if any, included).
+    torque : float
+        Output torque [N·mm].
+    theta : numpy.ndarray
+        Output angles [rad].
+    """
+    system = assemble(design, theta)
+    law = solver_law(design, system, None)
+    sol = solve_positions(system, torque, law)
+    P, nd = sol.q.shape
+    out = system.layout.output_rotation
+    k, c = system.spring_k, system.spring_c if system.spring_c is not None else 0 * system.spring_k
+    w = np.einsum("psi,pi->ps", system.spring_B, sol.q) + system.spring_e
+    F = sol.contact_force
+    # tangent of the pin law δ = F (a0 − a1 ln F): dF/dδ = 1 / (a0 − a1 (ln F + 1))
+    kc = np.zeros_like(F)
+    act = F > 0
+    if law.kind == "secant_per_contact":
+        a0 = np.broadcast_to(np.asarray(law.a0, dtype=float), F.shape)
+        a1 = np.broadcast_to(np.asarray(law.a1, dtype=float), F.shape)
+        kc[act] = 1.0 / (a0[act] - a1[act] * (np.log(F[act]) + 1.0))
+    else:
+        assert sol.pin_stiffness is not None  # noqa: S101 - the solver fills it in
+        kc[act] = sol.pin_stiffness[act]
+    d_off = np.zeros((P, k.size))
+    d_gap = np.zeros_like(F)
+    lin = c == 0.0
+    first = np.flatnonzero(~lin)[::2]
+    for p in range(P):
+        B = system.spring_B[p]
+        K = (B[lin].T * k[lin]) @ B[lin]
+        T_pairs = []
+        for s in first:
+            wx, wy = w[p, s], w[p, s + 1]
+            r = np.hypot(wx, wy)
+            if r > c[s]:
+                nvec = np.array([wx, wy]) / r
+                T = k[s] * ((1 - c[s] / r) * np.eye(2) + (c[s] / r) * np.outer(nvec, nvec))
+            else:
+                T = CLEARANCE_RESIDUAL * k[s] * np.eye(2)
+            Bp = B[[s, s + 1]]
+            K += Bp.T @ T @ Bp
+            T_pairs.append(T)
+        Bc = system.contact_B[p]
+        K += (Bc.T * kc[p]) @ Bc
+        e = np.zeros(nd)
+        e[out] = 1.0
+        y = np.linalg.solve(K, e)
+        d_off[p, lin] = -k[lin] * (B[lin] @ y)
+        for s, T in zip(first, T_pairs, strict=True):
+            d_off[p, [s, s + 1]] = -(T @ (B[[s, s + 1]] @ y))
+        d_gap[p] = kc[p] * (Bc @ y)
+    base = sol.q[:, out].copy()
+    # a loaded bearing's radial clearance c acts as the offset -c n along its load direction n
+    # (k (|w| - c) n = k (w - c n)): linear in c
+    m, n = design.cranks.count, design.discs.count
+
+    def per_unit_clearance(rows: slice, shape: tuple[int, ...]) -> np.ndarray:
+        ww = w[:, rows].reshape(P, -1, 2)
+        nrm = ww / np.maximum(np.linalg.norm(ww, axis=-1, keepdims=True), 1e-300)
+        d = -np.sum(d_off[:, rows].reshape(P, -1, 2) * nrm, axis=-1)  # (P, bearings)
+        return np.moveaxis(d, 0, -1).reshape(*shape, P)
+
+    d_cam = per_unit_clearance(system.labels["cam_bearing"], (m, n))
+    d_car = per_unit_clearance(system.labels["carrier_bearing"], (m,))
+    return LinearTE(system.theta, base, d_off, d_gap, system, d_cam, d_car)
+
+
+def _unit_responses(design: RVReducer, model: LinearTE, field: str, shape: tuple) -> np.ndarray:
+    """Output angle change per unit error [rad/mm] of every component of error array
+    ``field``: ``shape + (P,)``; the offsets come from :func:`assemble` (exactly linear)."""
+    theta = model.system.theta
+    h = 1e-3  # mm; any value: the offsets are linear in the errors
+    changes: dict = {field: np.zeros(shape)}
+    zero = design.with_errors(dataclasses.replace(design.error_set, **changes))
+    sys0 = assemble(zero, theta)
+    out = np.zeros((*shape, theta.size))
+    for idx in itertools.product(*(range(s) for s in shape)):
+        arr = np.zeros(shape)
+        arr[idx] = h
+        changes[field] = arr
+        red = design.with_errors(dataclasses.replace(design.error_set, **changes))
+        s1 = assemble(red, theta)
+        out[idx] = model.response(
+            (s1.spring_e - sys0.spring_e) / h, (s1.contact_gap - sys0.contact_gap) / h
+        )
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class ScoreTable:
+    """TE peak-to-peak [rad] of every pairing and orientation.
+
+    Attributes
+    ----------
+    pp : (K_d, O_d, K_c, O_c) peak-to-peak of the loaded output angle error [rad].
+    disc_orientations : list of (disc_shift, disc_index).
+    crank_orientations : list of crank_shift.
+    """
+
+    pp: np.ndarray
+    disc_orientations: list[tuple[int, int]]
+    crank_orientations: list[int]
+
+    def best(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per pairing ``(K_d, K_c)``: the best peak-to-peak [rad] and its disc and crank
+        orientation indices."""
+        kd, od, kc, oc = self.pp.shape
+        flat = self.pp.transpose(0, 2, 1, 3).reshape(kd, kc, od * oc)
+        i = np.argmin(flat, axis=-1)
+        return np.take_along_axis(flat, i[..., None], -1)[..., 0], i // oc, i % oc
+
+    def orientation(self, od: int, oc: int) -> Orientation:
+        """The :class:`Orientation` of orientation indices ``od``, ``oc``."""
+        s, r = self.disc_orientations[od]
+        return Orientation(s, r, self.crank_orientations[oc])
+
+
+def _contributions(design: RVReducer, lot: Lot, model: LinearTE):
+    """TE contributions ``t_disc (K_d, O_d, P)`` and ``t_crank (K_c, O_c, P)`` [rad]."""
+    m, n, zc = design.cranks.count, design.discs.count, design.cycloid_teeth
+    zp = design.pins.count
+    sys0 = model.system
+    P = sys0.theta.size
+    d_orients = _disc_orientations(design)
+    c_orients = list(range(m))
+    u_bore = _unit_responses(design, model, "disc_bore", (n, m, 2))
+    u_cam = _unit_responses(design, model, "cam", (m, n, 2))
+    u_planet = _unit_responses(design, model, "planet", (m, 2))
+    # measured flanks: per disc, slot and turn
+    cache: dict[tuple[int, int, int, int], np.ndarray] = {}
+
+    def flank(k: int, disc: int, slot: int, index: int) -> np.ndarray:
+        key = (k, disc, slot, index)
+        if key not in cache:
+            md = _turned(lot.discs[k][disc], index * zc // m)
+            if md is None:
+                cache[key] = np.zeros(P)
+            else:
+                sl = slice(slot * zp, (slot + 1) * zp)
+                arm = sys0.contact_B[:, sl, sys0.layout.disc(slot) + 2]
+                assert sys0.contact_phase is not None  # noqa: S101 - assemble fills it in
+                dg = md.gap_change(
+                    np.arange(zp)[None, :], sys0.contact_phase[:, sl], arm,
+                    design.cranks.eccentricity * zc,
+                )  # fmt: skip
+                cache[key] = np.einsum("pc,pc->p", dg, model.d_gap[:, sl])
+        return cache[key]
+
+    t_disc = np.zeros((lot.disc_sets, len(d_orients), P))
+    for k in range(lot.disc_sets):
+        for o, (s, r) in enumerate(d_orients):
+            t = sum(flank(k, (j + s) % n, j, r) for j in range(n))
+            _, bores = _oriented_discs(lot, k, s, r, design)
+            if bores is not None:
+                err = bore_errors(bores, design.cranks.circle_radius)
+                t = t + np.einsum("jid,jidp->p", err, u_bore)
+            t_disc[k, o] = t
+    t_crank = np.zeros((lot.crank_sets, m, P))
+    for k in range(lot.crank_sets):
+        for o in c_orients:
+            cr = _oriented_cranks(lot, k, o)
+            ecc, phase = cr["cam_eccentricity"], cr["cam_phase"]
+            assert ecc is not None and phase is not None  # noqa: S101 - a lot always has cams
+            cam = cam_errors(ecc, phase, design.cranks.eccentricity)
+            t = np.einsum("ijd,ijdp->p", cam, u_cam)
+            if cr["planet_runout"] is not None:
+                t = t + np.einsum("id,idp->p", runout_errors(cr["planet_runout"]), u_planet)
+            if cr["cam_clearance"] is not None:
+                dc = cr["cam_clearance"] - design.cranks.cam_bearing_clearance
+                t = t + np.einsum("ij,ijp->p", dc, model.d_cam_clearance)
+            if cr["carrier_clearance"] is not None:
+                dc = cr["carrier_clearance"] - design.cranks.carrier_bearing_clearance
+                t = t + np.einsum("i,ip->p", dc, model.d_carrier_clearance)
+            t_crank[k, o] = t
+    return t_disc, t_crank, d_orients, c_orients
+
+
+def score_lot(design: RVReducer, lot: Lot, model: LinearTE) -> ScoreTable:
+    """TE peak-to-peak of every disc set × orientation × crank set × orientation (vectorised).
+
+    Parameters
+    ----------
+    design : RVReducer
+        The design.
+    lot : Lot
+        The measured parts.
+    model : LinearTE
+        :func:`linear_te_model` of the design.
+    """
+    lot.check(design)
+    t_disc, t_crank, d_or, c_or = _contributions(design, lot, model)
+    pp = np.empty((lot.disc_sets, len(d_or), lot.crank_sets, len(c_or)))
+    for k in range(lot.disc_sets):
+        x = model.base + t_disc[k][:, None, None, :] + t_crank[None]
+        pp[k] = x.max(axis=-1) - x.min(axis=-1)
+    return ScoreTable(pp, d_or, c_or)
+
+
+def score_lot_loop(design: RVReducer, lot: Lot, model: LinearTE) -> ScoreTable:
+    """The plain baseline of :func:`score_lot`: one linearised evaluation per pairing and
+    orientation, each building its reducer and its offsets with :func:`assemble` (what a user
+    of the model without the separation into part contributions would write).
+
+    Parameters
+    ----------
+    design : RVReducer
+        The design.
+    lot : Lot
+        The measured parts.
+    model : LinearTE
+        :func:`linear_te_model` of the design.
+    """
+    d_or = _disc_orientations(design)
+    c_or = list(range(design.cranks.count))
+    sys0 = model.system
+    pp = np.empty((lot.disc_sets, len(d_or), lot.crank_sets, len(c_or)))
+    for kd, (od, (s, r)), kc, oc in itertools.product(
+        range(lot.disc_sets), enumerate(d_or), range(lot.crank_sets), c_or
+    ):
+        red = assembled_reducer(design, lot, kd, kc, Orientation(s, r, oc))
+        err = red.error_set
+        red = red.with_errors(dataclasses.replace(err, cam_clearance=None, carrier_clearance=None))
+        s1 = assemble(red, sys0.theta)
+        x = model.base + model.response(
+            s1.spring_e - sys0.spring_e, s1.contact_gap - sys0.contact_gap
+        )
+        if err.cam_clearance is not None:
+            dc = err.cam_clearance - design.cranks.cam_bearing_clearance
+            x = x + np.einsum("ij,ijp->p", dc, model.d_cam_clearance)
+        if err.carrier_clearance is not None:
+            dc = err.carrier_clearance - design.cranks.carrier_bearing_clearance
+            x = x + np.einsum("i,ip->p", dc, model.d_carrier_clearance)
+        pp[kd, od, kc, oc] = x.max() - x.min()
+    return ScoreTable(pp, d_or, c_or)
+
+
+# ---- assignment ----------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Assembly:
+    """Which parts form each reducer.
+
+    Attributes
+    ----------
+    disc_set, crank_set : numpy.ndarray
+        ``(R,)`` 0-based indices of the reducers' disc and crank sets [-].
+    disc_orientation, crank_orientation : numpy.ndarray
+        ``(R,)`` orientation indices into the :class:`ScoreTable` lists [-].
+    pp : numpy.ndarray
+        ``(R,)`` TE peak-to-peak of each reducer [rad].
+    """
+
+    disc_set: np.ndarray
+    crank_set: np.ndarray
+    disc_orientation: np.ndarray
+    crank_orientation: np.ndarray
+    pp: np.ndarray
+
+    def in_spec(self, limit: float) -> int:
+        """Reducers with TE peak-to-peak ≤ ``limit`` [rad] [-]."""
+        return int(np.sum(self.pp <= limit))
+
+
+def _finish(table: ScoreTable, rows: np.ndarray, cols: np.ndarray) -> Assembly:
+    best, od, oc = table.best()
+    return Assembly(rows, cols, od[rows, cols], oc[rows, cols], best[rows, cols])
+
+
+def assign(table: ScoreTable, limit: float, objective: str = "count_in_spec") -> Assembly:
+    """The optimal assembly of the lot (module docstring, step 3).
+
+    Parameters
+    ----------
+    table : ScoreTable
+        Scores of every pairing and orientation.
+    limit : float
+        TE peak-to-peak spec [rad].
+    objective : {"count_in_spec", "worst"}
+        Most reducers with ``pp <= limit`` (then the least total TE), or the smallest largest
+        ``pp`` (then the least total TE).
+    """
+    from scipy.optimize import linear_sum_assignment
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import maximum_bipartite_matching
+
+    if not limit > 0:
+        raise ParameterError("limit", limit, "must be > 0 rad")
+    best, _, _ = table.best()
+    kd, kc = best.shape
+    r = min(kd, kc)
+    if objective == "count_in_spec":
+        x = best / limit
+        big = r * float(x.max()) + 1.0
+        cost = x + big * (best > limit)
+    elif objective == "worst":
+        values = np.unique(best)
+        lo, hi = 0, values.size - 1
+        while lo < hi:  # smallest threshold with a matching of all r reducers
+            mid = (lo + hi) // 2
+            graph = csr_matrix((best <= values[mid]).astype(np.int8))
+            match = maximum_bipartite_matching(graph, perm_type="column")
+            if np.sum(match >= 0) >= r:
+                hi = mid
+            else:
+                lo = mid + 1
+        cost = np.where(best <= values[lo], best, 1e6 * (1.0 + best.max()))
+    else:
+        raise ParameterError("objective", objective, "must be 'count_in_spec' or 'worst'")
+    rows, cols = linear_sum_assignment(cost)
+    return _finish(table, rows, cols)
+
+
+def brute_force(table: ScoreTable, limit: float, objective: str = "count_in_spec") -> float:
+    """The optimum by enumeration of every assignment *and every orientation* (tests; tiny
+    lots only): the largest count in spec, or the smallest worst peak-to-peak [rad].
+
+    Parameters
+    ----------
+    table : ScoreTable
+        Scores; ``K_d = K_c <= 6``.
+    limit : float
+        TE spec [rad].
+    objective : {"count_in_spec", "worst"}
+        As :func:`assign`.
+    """
+    kd, od, kc, oc = table.pp.shape
+    if kd != kc or kd > 6:
+        raise ParameterError("table", table.pp.shape, "brute force needs K_d = K_c <= 6")
+    flat = table.pp.transpose(0, 2, 1, 3).reshape(kd, kc, od * oc)
+    best_value = -np.inf if objective == "count_in_spec" else np.inf
+    combos = np.array(list(itertools.product(range(od * oc), repeat=kd)))  # (C, K)
+    for perm in itertools.permutations(range(kc)):
+        vals = flat[np.arange(kd), list(perm)]  # (K, O)
+        chosen = vals[np.arange(kd)[None, :], combos]  # (C, K)
+        if objective == "count_in_spec":
+            best_value = max(best_value, float(np.max(np.sum(chosen <= limit, axis=1))))
+        else:
+            best_value = min(best_value, float(np.min(np.max(chosen, axis=1))))
+    return best_value
+
+
+def random_assemblies(
+    table: ScoreTable, limit: float, count: int, rng: np.random.Generator
+) -> np.ndarray:
+    """Reducers in spec of ``count`` random assemblies (random pairing, random orientation).
+
+    Parameters
+    ----------
+    table : ScoreTable
+        Scores.
+    limit : float
+        TE spec [rad].
+    count : int
+        Number of random assemblies [-].
+    rng : numpy.random.Generator
+        Random source.
+    """
+    kd, od, kc, oc = table.pp.shape
+    r = min(kd, kc)
+    out = np.empty(count, dtype=np.int64)
+    for i in range(count):
+        rows = rng.permutation(kd)[:r]
+        cols = rng.permutation(kc)[:r]
+        pp = table.pp[rows, rng.integers(od, size=r), cols, rng.integers(oc, size=r)]
+        out[i] = np.sum(pp <= limit)
+    return out
+
+
+def orientation_only(table: ScoreTable) -> Assembly:
+    """The parts paired as they come (disc set ``k`` with crank set ``k``), each reducer in its
+    best orientation — the best rule that chooses orientation only.
+
+    Parameters
+    ----------
+    table : ScoreTable
+        Scores.
+    """
+    r = min(table.pp.shape[0], table.pp.shape[2])
+    idx = np.arange(r)
+    return _finish(table, idx, idx)
+
+
+# ---- full model and pin grading --------------------------------------------------------------
+def full_model_te(reducer: RVReducer, torque: float, theta: np.ndarray) -> float:
+    """Peak-to-peak [rad] of the loaded output angle error of the full non-linear model at
+    ``theta``.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        An assembled reducer.
+    torque : float
+        Output torque [N·mm].
+    theta : numpy.ndarray
+        Output angles [rad].
+    """
+    x = load_sharing(reducer, torque, theta).output_error
+    return float(x.max() - x.min())
+
+
+def pin_grades(
+    reducer: RVReducer, grades: np.ndarray, window: tuple[float, float]
+) -> tuple[int | None, np.ndarray]:
+    """The pin diameter grade that brings the reducer's backlash into ``window``.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        An assembled reducer (its pins' own radius errors are kept and the grade added).
+    grades : numpy.ndarray
+        Available pin diameter oversizes [mm].
+    window : (float, float)
+        Backlash window [rad].
+
+    Returns
+    -------
+    (int or None, numpy.ndarray)
+        Index of the chosen grade (backlash inside the window, nearest its centre; None when no
+        grade fits) and the backlash of every grade [rad] (the catalogue definition on the
+        model's virtual hysteresis loop, :func:`gearte.models.rv_catalogue.virtual_loop`; NaN
+        where the model finds no equilibrium).
+    """
+    from gearte.errors import ConvergenceError
+    from gearte.models.catalogue import hysteresis_values
+    from gearte.models.rv_catalogue import virtual_loop
+
+    lo, hi = window
+    if not 0 <= lo < hi:
+        raise ParameterError("window", window, "needs 0 <= lower < upper [rad]")
+    if reducer.rated_torque is None:
+        raise ParameterError("reducer.rated_torque_Nm", None, "needed by the pin grading")
+    backlash = np.full(len(grades), np.nan)
+    for g, over in enumerate(np.asarray(grades, dtype=float)):
+        pins = dataclasses.replace(
+            reducer.pins, radius_errors=reducer.pins.radius_errors + 0.5 * over
+        )
+        try:
+            loop, direction = virtual_loop(reducer.replace(pins=pins))
+        except ConvergenceError:  # no equilibrium (a grade far into interference): unusable
+            continue
+        hv = hysteresis_values(loop.torque, loop.angle, reducer.rated_torque, direction=direction)
+        backlash[g] = hv.backlash
+    ok = np.isfinite(backlash)
+    inside = np.flatnonzero(ok & (backlash >= lo) & (backlash <= hi))
+    if inside.size == 0:
+        return None, backlash
+    centre = 0.5 * (lo + hi)
+    return int(inside[np.argmin(np.abs(backlash[inside] - centre))]), backlash
