@@ -349,7 +349,7 @@ def sweep(
                 )
                 sys.exit(128 + exc.signum)
             raise
-        paths = write_sweep(result, target, plots=not no_plots)
+        paths = write_sweep(result, target, plots=not no_plots, workers=workers)
         click.echo(
             f"{result.name}: {len(result.points)} points × {len(result.columns)} scalar results "
             f"in {result.elapsed_s:.2f} s ({result.backend})"

@@ -28,10 +28,10 @@ Results (``selective_assembly``): ``reducers_in_spec`` (the optimiser's assembly
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
-from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.results import AnalysisResult, StudyResult
@@ -148,9 +148,22 @@ class Analyses(StrictModel):
 
 
 class Case(CaseBase):
+    _built: Any = PrivateAttr(default=None)
     reducer: ReducerRef
     lot: LotSection
     analyses: Analyses
+
+    @model_validator(mode="after")
+    def _measurements(self) -> Case:
+        """Read the measurement files now, so that ``gearte validate`` refuses a malformed file
+        (one line naming file, line and column) as ``run`` would; the parts are kept for run."""
+        from gearte.errors import GearteError
+
+        try:
+            self._built = build_lot(self)
+        except GearteError as exc:
+            raise ValueError(str(exc)) from None
+        return self
 
 
 def build_lot(case: Case):
@@ -271,7 +284,7 @@ def run(case: Case, options=None) -> StudyResult:
     from gearte.units import Nm_to_Nmm, arcmin_to_rad, arcsec_to_rad, rad_to_arcmin, rad_to_arcsec
 
     sec = case.analyses.selective_assembly
-    red, lot = build_lot(case)
+    red, lot = case._built if case._built is not None else build_lot(case)
     torque = float(Nm_to_Nmm(sec.torque_Nm))
     theta = output_positions(sec.positions)
     limit = float(arcsec_to_rad(sec.te_spec_arcsec))
