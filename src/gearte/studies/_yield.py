@@ -263,7 +263,7 @@ def _tolerances(
     # a family's tolerance stands for each of its instances (an instance may be given itself)
     expanded: dict[str, tuple[ToleranceEntry, str | None]] = {}
     for key, t in given.items():
-        if key in families:
+        if key in families and list(families[key]) != [key]:  # (a one-instance family is a key)
             for inst in families[key]:
                 if inst not in given:
                     expanded[inst] = (t, key)
