@@ -113,6 +113,13 @@ class SelectiveAssemblySection(StrictModel):
         default="count_in_spec",
         description="most reducers in spec, or the smallest worst TE (docs/selective-assembly.md)",
     )
+    planet_indexings: int = Field(
+        default=1,
+        ge=1,
+        le=360,
+        description="spline positions Q a planet can be mounted in on its crank (planet "
+        "phasing, the same for the reducer's planets); 1: as measured",
+    )
     random_assemblies: int = Field(
         default=200, ge=100, le=100000, description="random assemblies of the comparison"
     )
@@ -290,7 +297,7 @@ def run(case: Case, options=None) -> StudyResult:
     limit = float(arcsec_to_rad(sec.te_spec_arcsec))
     t0 = time.perf_counter()
     model = sa.linear_te_model(red, torque, theta)
-    table = sa.score_lot(red, lot, model)
+    table = sa.score_lot(red, lot, model, sec.planet_indexings)
     t_score = time.perf_counter() - t0
     best = sa.assign(table, limit, sec.objective)
     t_assign = time.perf_counter() - t0 - t_score
@@ -354,6 +361,8 @@ def run(case: Case, options=None) -> StudyResult:
         row["disc_bore_1_on_crank_position"] = 1 + o.disc_index
         for i in range(m):
             row[f"crank_position_{i + 1}"] = cs[(i - o.crank_shift) % m]
+        if sec.planet_indexings > 1:
+            row["planet_spline_index"] = o.planet_index
         row["te_peak_to_peak [arcsec]"] = round(float(rad_to_arcsec(best.pp[r])), 3)
         if sec.verify:
             row["te_peak_to_peak_full_model [arcsec]"] = round(float(rad_to_arcsec(full[r])), 3)
