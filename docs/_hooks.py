@@ -9,7 +9,8 @@
   PNGs are cached in ``.docs_cache/gallery/<hash of src/ and examples/>/``: an unchanged tree
   rebuilds in seconds. ``GEARTE_DOCS_GALLERY=0`` leaves the gallery out (a page says so).
 
-Run ``python docs/_hooks.py`` to fill the gallery cache without building the site.
+Run ``python docs/_hooks.py`` to fill the gallery cache without building the site. The cases run
+in parallel processes, one per core (``GEARTE_DOCS_JOBS``).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import hashlib
 import json
 import os
 import pkgutil
+import re
 import sys
 import time
 from pathlib import Path
@@ -111,14 +113,12 @@ def _tree_hash() -> str:
                 h.update(p.read_bytes())
     import inspect
 
-    h.update(f"{GALLERY!r} {GALLERY_SAMPLES} {inspect.getsource(run_gallery)}".encode())
+    h.update(f"{GALLERY!r} {GALLERY_SAMPLES} {inspect.getsource(run_case)}".encode())
     return h.hexdigest()[:16]
 
 
 def _short_ref(ref: str) -> str:
     """``"Jiang J., Zhong X., … (2024). Title"`` → ``"Jiang et al. 2024"``."""
-    import re
-
     surname = re.split(r"[ ,]", ref.strip(), maxsplit=1)[0]
     year = re.search(r"\((\d{4})\)", ref)
     return f"{surname} et al. {year.group(1)}" if year else ref.split(".")[0]
@@ -128,39 +128,61 @@ def _md_cell(text: str) -> str:
     return str(text).replace("|", "\\|")
 
 
-def run_gallery(out: Path) -> dict[str, Any]:
-    """Run the gallery cases, write their figures as PNG under ``out`` and return the manifest
-    (per case: title, headline rows, warnings, figures with title and caption, seconds)."""
+def run_case(case_name: str, paper: str, page: str, out: Path) -> dict[str, Any]:
+    """Run one gallery case, write its figures as PNG under ``out`` and return its manifest
+    entry (title, headline rows, warnings, figures with title and caption, seconds)."""
     from gearte.io.case_file import load_case
     from gearte.plotting import figures_for
     from gearte.report.summary import headlines, tradeoff_warnings
-    from gearte.studies import RunOptions, run_case
+    from gearte.studies import RunOptions
+    from gearte.studies import run_case as run
+
+    t0 = time.perf_counter()
+    result = run(load_case(case_name), RunOptions(samples=GALLERY_SAMPLES))
+    figs = figures_for(result)
+    entries = []
+    for i, f in enumerate(figs):
+        file = f"{case_name}_{i:02d}.png"
+        f.fig.savefig(out / file, dpi=80)
+        entries.append(
+            {"file": file, "title": f.title, "caption": f.caption, "analysis": f.analysis}
+        )
+    entry = {
+        "title": result.case.case.title or case_name,
+        "paper": paper,
+        "page": page,
+        "headlines": [[r.title, r.quantity, r.value, r.spec, r.status] for r in headlines(result)],
+        "warnings": list(result.warnings) + tradeoff_warnings(result),
+        "figures": entries,
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+    print(f"gallery: {case_name}: {len(figs)} figures, {entry['seconds']} s", flush=True)
+    return entry
+
+
+def run_gallery(out: Path) -> dict[str, Any]:
+    """Run every gallery case into ``out`` and return the manifest, case → entry. The cases run
+    as separate processes, as many at a time as there are cores (``GEARTE_DOCS_JOBS`` to
+    change it; 1 runs them in this process), each writing ``<case>.json`` beside its PNGs."""
+    import subprocess
+    from concurrent.futures import ThreadPoolExecutor
 
     out.mkdir(parents=True, exist_ok=True)
-    manifest: dict[str, Any] = {}
-    for case_name, paper, page in GALLERY:
-        t0 = time.perf_counter()
-        result = run_case(load_case(case_name), RunOptions(samples=GALLERY_SAMPLES))
-        figs = figures_for(result)
-        entries = []
-        for i, f in enumerate(figs):
-            file = f"{case_name}_{i:02d}.png"
-            f.fig.savefig(out / file, dpi=80)
-            entries.append(
-                {"file": file, "title": f.title, "caption": f.caption, "analysis": f.analysis}
-            )
-        manifest[case_name] = {
-            "title": result.case.case.title or case_name,
-            "paper": paper,
-            "page": page,
-            "headlines": [
-                [r.title, r.quantity, r.value, r.spec, r.status] for r in headlines(result)
-            ],
-            "warnings": list(result.warnings) + tradeoff_warnings(result),
-            "figures": entries,
-            "seconds": round(time.perf_counter() - t0, 1),
+    jobs = int(os.environ.get("GEARTE_DOCS_JOBS", os.cpu_count() or 1))
+    if jobs <= 1:
+        manifest = {c: run_case(c, paper, page, out) for c, paper, page in GALLERY}
+    else:
+        env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+
+        def one(case: tuple[str, str, str]) -> None:
+            cmd = [sys.executable, __file__, "--case", case[0], str(out)]
+            subprocess.run(cmd, check=True, env=env)
+
+        with ThreadPoolExecutor(min(jobs, len(GALLERY))) as pool:
+            list(pool.map(one, GALLERY))
+        manifest = {
+            c: json.loads((out / f"{c}.json").read_text(encoding="utf-8")) for c, _, _ in GALLERY
         }
-        print(f"gallery: {case_name}: {len(figs)} figures, {manifest[case_name]['seconds']} s")
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1), encoding="utf-8")
     return manifest
 
@@ -275,6 +297,21 @@ def on_files(files: Any, config: Any) -> Any:
     return files
 
 
+_ROLE = re.compile(r":(?:class|func|mod|data|meth|attr|exc|obj|const):(?=<code)")
+
+
+def on_page_content(html: str, **kwargs: Any) -> str:
+    """Docstrings use Sphinx roles (``:func:`x```); Markdown renders them as ``:func:<code>x
+    </code>``: drop the role, keep the code."""
+    return _ROLE.sub("", html)
+
+
 if __name__ == "__main__":
-    m, where = gallery()
-    print(f"gallery cached in {where} ({len(m or {})} cases)")
+    if sys.argv[1:2] == ["--case"]:  # one case, run by run_gallery in its own process
+        name, folder = sys.argv[2], Path(sys.argv[3])
+        paper, page = next((p, g) for c, p, g in GALLERY if c == name)
+        entry = run_case(name, paper, page, folder)
+        (folder / f"{name}.json").write_text(json.dumps(entry), encoding="utf-8")
+    else:
+        m, where = gallery()
+        print(f"gallery cached in {where} ({len(m or {})} cases)")

@@ -2,8 +2,8 @@
 tolerance, and the compensation tables as CSV.
 
 The central check re-imports the DXF with ezdxf and measures, on an independent sampling of the
-true profile 64 times denser than the polyline, the largest distance of the profile from the
-polyline: it must not exceed the tolerance asked for.
+true profile 16–64 times denser than the polyline (an even grid in φ), the largest distance of
+the profile from the polyline: it must not exceed the tolerance asked for.
 """
 
 from __future__ import annotations
@@ -60,15 +60,17 @@ def _true_profile(st: CycloidStage, n: int) -> np.ndarray:
     return np.column_stack(st.profile_xy(phi, flank=2))
 
 
-@pytest.mark.parametrize("tolerance_um", [1.0, 0.1])
-def test_exported_dxf_reimported_matches_hu2020_profile_to_the_tolerance(tmp_path, tolerance_um):
+@pytest.mark.parametrize("tolerance_um, density", [(1.0, 64), (0.1, 16)])
+def test_exported_dxf_reimported_matches_hu2020_profile_to_the_tolerance(
+    tmp_path, tolerance_um, density
+):
     """Issue 15 "must show": the DXF re-imported by ezdxf is within the chordal tolerance of the
     modified profile (Hu 2020 Table 3 stage: Δr_rp = −0.022, Δr_p = −0.0437 mm)."""
     paths = export_case("hu2020_rv80e_initial", tmp_path / "x", chordal_tolerance_um=tolerance_um)
     verts, closed, units = _polyline_from_dxf(paths["profile.dxf"])
     assert closed and units == 4  # closed polyline, millimetres
     st = stage_of("hu2020_rv80e_initial")
-    dense = _true_profile(st, 64 * len(verts))
+    dense = _true_profile(st, density * len(verts))  # an even grid in φ, not the export's
     dist = _distance_to_polyline(dense, verts)
     assert dist.max() <= tolerance_um * 1e-3
     # not needlessly fine either: the worst chord uses more than half of the tolerance
@@ -184,3 +186,13 @@ def test_compensation_tables_are_the_analysis_numbers(tmp_path):
     assert len(rows) == len(changes)
     got = sorted(float(r["change [um]"]) for r in rows)
     assert got == pytest.approx(sorted(changes.values()), rel=1e-12)
+
+
+@pytest.mark.parametrize("name", ["han2023_rv110e", "li2023_rv"])
+def test_rv_reducer_discs_within_tolerance(name):
+    """The discs of the Han 2023 and Li 2023 reducers (other radii and modifications than Hu
+    2020's) are exported within 1 µm too."""
+    o = profile_outline(name, 1.0)
+    verts = np.column_stack([o.x, o.y])
+    dense = _true_profile(stage_of(name), 32 * len(verts))
+    assert _distance_to_polyline(dense, verts).max() <= 1e-3

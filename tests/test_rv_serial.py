@@ -117,3 +117,23 @@ def test_serial_names_a_part_missing_from_its_file(tmp_path):
     serial.write_text(serial.read_text().replace('"P3"]', '"P9"]'))
     with pytest.raises(Exception, match="P9"):
         run_case(load_case(serial))
+
+
+def test_validate_refuses_a_malformed_measurement_file_naming_file_line_column(tmp_path):
+    """``gearte validate`` reads the measurement files: a NaN in one of them is one line naming
+    the file, the line and the column, exit code 2, no traceback."""
+    from click.testing import CliRunner
+
+    from gearte.cli import main
+
+    known, _ = _han_cases(tmp_path)
+    serial = _export(build_reducer(load_case(known).reducer), tmp_path)
+    p = tmp_path / "cranks.csv"
+    lines = p.read_text().splitlines()
+    cells = lines[3].split(",")
+    lines[3] = ",".join([cells[0], cells[1], "nan", cells[3]])
+    p.write_text("\n".join(lines) + "\n")
+    r = CliRunner().invoke(main, ["validate", str(serial)])
+    assert r.exit_code == 2
+    assert f"{p}, line 4, column 3 'eccentricity [mm]'" in r.output
+    assert "Traceback" not in r.output

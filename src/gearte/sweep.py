@@ -713,12 +713,17 @@ def _count(items: Sequence[str]) -> dict[str, int]:
 
 
 def write_sweep(
-    result: SweepResult, out_dir: str | os.PathLike[str], *, plots: bool = True
+    result: SweepResult,
+    out_dir: str | os.PathLike[str],
+    *,
+    plots: bool = True,
+    workers: int | None = None,
 ) -> dict[str, Any]:
     """Write ``sweep.csv``, ``sweep.json``, ``index.html`` and (unless ``plots=False``) under
     ``plots/`` one PNG per scalar result that varies over the sweep, with one panel per varied
     key. The index page links every figure and lists the points that were skipped as invalid or
-    failed, with their reasons. Figures are rendered before any file is written.
+    failed, with their reasons. Figures are rendered before any file is written, in ``workers``
+    forked processes (default: the cores this process may use).
 
     Parameters
     ----------
@@ -740,16 +745,20 @@ def write_sweep(
     rendered: dict[str, bytes] = {}
     listed: list[tuple[str, str, str]] = []
     if plots:
-        from gearte.plotting.sweep import figures
+        import base64
 
-        for stem, fig in figures(result):
+        from gearte.plotting.sweep import figures
+        from gearte.report.html import render_all
+
+        figs = figures(result)
+        # drawn in parallel (forked processes), the way the report draws its figures
+        pngs = render_all([f for _, f in figs], workers, polished=True)
+        for (stem, fig), png in zip(figs, pngs, strict=True):
             name, n = f"plots/{stem}.png", 1
             while name in rendered:  # two results with the same safe file name
                 n += 1
                 name = f"plots/{stem}_{n}.png"
-            buf = io.BytesIO()
-            fig.fig.savefig(buf, format="png", dpi=100)
-            rendered[name] = buf.getvalue()
+            rendered[name] = base64.b64decode(png.png)
             listed.append((name, fig.title, fig.caption))
     from gearte.report.outputs import write_file_set
 

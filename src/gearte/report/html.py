@@ -20,7 +20,13 @@ from dataclasses import dataclass
 from importlib import resources
 from typing import Any
 
-__all__ = ["render_report", "render_figures", "figure_to_png_base64", "RenderedFigure"]
+__all__ = [
+    "render_report",
+    "render_figures",
+    "render_all",
+    "figure_to_png_base64",
+    "RenderedFigure",
+]
 
 #: Resolution of the embedded PNGs (a 7-inch figure is 700 px wide, as it is shown).
 DPI = 100
@@ -58,10 +64,11 @@ def figure_to_png_base64(fig: Any, dpi: int = DPI) -> str:
     return base64.b64encode(buf.getvalue()).decode("ascii")
 
 
-def _render_one(f: Any) -> RenderedFigure:
+def _render_one(f: Any, polished: bool = False) -> RenderedFigure:
     from gearte.plotting.display import polish
 
-    polish(f.fig)
+    if not polished:
+        polish(f.fig)
     w, h = f.fig.get_size_inches()
     png = figure_to_png_base64(f.fig)
     return RenderedFigure(
@@ -107,11 +114,30 @@ def _cost(f: Any) -> float:
     return len(f.fig.axes) + min(points, 4 * 2400 * len(f.fig.axes)) / 5000.0
 
 
-def _render_all(figs: list[Any], workers: int) -> list[RenderedFigure]:
+def render_all(
+    figs: list[Any], workers: int | None = None, *, polished: bool = False
+) -> list[RenderedFigure]:
+    """Render the :class:`~gearte.plotting.Figure` objects ``figs`` to PNG, in order, in
+    ``workers`` forked processes (default: the cores this process may use) where that can help.
+
+    Parameters
+    ----------
+    figs : list of Figure
+        The figures.
+    workers : int, optional
+        Processes to render in (1: in this process).
+    polished : bool
+        The figures are already polished (:func:`gearte.plotting.display.polish`); by default
+        each is polished before it is drawn.
+    """
+    return _render_all(figs, _workers() if workers is None else workers, polished=polished)
+
+
+def _render_all(figs: list[Any], workers: int, *, polished: bool = False) -> list[RenderedFigure]:
     """Render ``figs`` in order, in ``workers`` processes (forked) where that can help."""
     workers = min(workers, len(figs))
     if workers < 2 or not hasattr(os, "fork"):
-        return [_render_one(f) for f in figs]
+        return [_render_one(f, polished) for f in figs]
     # share the figures out, largest first, to the least loaded worker
     load = [0.0] * workers
     share: list[list[int]] = [[] for _ in range(workers)]
@@ -127,7 +153,7 @@ def _render_all(figs: list[Any], workers: int) -> list[RenderedFigure]:
             code = 0
             try:
                 os.close(r)
-                data = pickle.dumps([_render_one(figs[i]) for i in idx])
+                data = pickle.dumps([_render_one(figs[i], polished) for i in idx])
                 with os.fdopen(w, "wb") as fh:
                     fh.write(data)
             except BaseException:  # noqa: BLE001 - the parent renders what a child could not
@@ -136,14 +162,14 @@ def _render_all(figs: list[Any], workers: int) -> list[RenderedFigure]:
                 os._exit(code)
         os.close(w)
         children.append((pid, r, idx))
-    done: dict[int, RenderedFigure] = {i: _render_one(figs[i]) for i in share[0]}
+    done: dict[int, RenderedFigure] = {i: _render_one(figs[i], polished) for i in share[0]}
     for pid, r, idx in children:
         with os.fdopen(r, "rb") as fh:
             data = fh.read()
         _, status = os.waitpid(pid, 0)
         got = pickle.loads(data) if status == 0 and data else None
         for k, i in enumerate(idx):
-            done[i] = got[k] if got else _render_one(figs[i])
+            done[i] = got[k] if got else _render_one(figs[i], polished)
     return [done[i] for i in range(len(figs))]
 
 

@@ -28,10 +28,10 @@ Results (``selective_assembly``): ``reducers_in_spec`` (the optimiser's assembly
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
-from pydantic import Field, ValidationInfo, field_validator, model_validator
+from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.results import AnalysisResult, StudyResult
@@ -113,6 +113,13 @@ class SelectiveAssemblySection(StrictModel):
         default="count_in_spec",
         description="most reducers in spec, or the smallest worst TE (docs/selective-assembly.md)",
     )
+    planet_indexings: int = Field(
+        default=1,
+        ge=1,
+        le=360,
+        description="spline positions Q a planet can be mounted in on its crank (planet "
+        "phasing, the same for the reducer's planets); 1: as measured",
+    )
     random_assemblies: int = Field(
         default=200, ge=100, le=100000, description="random assemblies of the comparison"
     )
@@ -148,9 +155,22 @@ class Analyses(StrictModel):
 
 
 class Case(CaseBase):
+    _built: Any = PrivateAttr(default=None)
     reducer: ReducerRef
     lot: LotSection
     analyses: Analyses
+
+    @model_validator(mode="after")
+    def _measurements(self) -> Case:
+        """Read the measurement files now, so that ``gearte validate`` refuses a malformed file
+        (one line naming file, line and column) as ``run`` would; the parts are kept for run."""
+        from gearte.errors import GearteError
+
+        try:
+            self._built = build_lot(self)
+        except GearteError as exc:
+            raise ValueError(str(exc)) from None
+        return self
 
 
 def build_lot(case: Case):
@@ -271,13 +291,13 @@ def run(case: Case, options=None) -> StudyResult:
     from gearte.units import Nm_to_Nmm, arcmin_to_rad, arcsec_to_rad, rad_to_arcmin, rad_to_arcsec
 
     sec = case.analyses.selective_assembly
-    red, lot = build_lot(case)
+    red, lot = case._built if case._built is not None else build_lot(case)
     torque = float(Nm_to_Nmm(sec.torque_Nm))
     theta = output_positions(sec.positions)
     limit = float(arcsec_to_rad(sec.te_spec_arcsec))
     t0 = time.perf_counter()
     model = sa.linear_te_model(red, torque, theta)
-    table = sa.score_lot(red, lot, model)
+    table = sa.score_lot(red, lot, model, sec.planet_indexings)
     t_score = time.perf_counter() - t0
     best = sa.assign(table, limit, sec.objective)
     t_assign = time.perf_counter() - t0 - t_score
@@ -341,6 +361,8 @@ def run(case: Case, options=None) -> StudyResult:
         row["disc_bore_1_on_crank_position"] = 1 + o.disc_index
         for i in range(m):
             row[f"crank_position_{i + 1}"] = cs[(i - o.crank_shift) % m]
+        if sec.planet_indexings > 1:
+            row["planet_spline_index"] = o.planet_index
         row["te_peak_to_peak [arcsec]"] = round(float(rad_to_arcsec(best.pp[r])), 3)
         if sec.verify:
             row["te_peak_to_peak_full_model [arcsec]"] = round(float(rad_to_arcsec(full[r])), 3)

@@ -26,7 +26,9 @@ File formats: ``docs/metrology.md``.
 
 from __future__ import annotations
 
-from pydantic import Field, ValidationInfo, field_validator, model_validator
+from typing import Any
+
+from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
 
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.results import AnalysisResult, StudyResult
@@ -137,9 +139,22 @@ class Analyses(StrictModel):
 
 
 class Case(CaseBase):
+    _built: Any = PrivateAttr(default=None)
     reducer: ReducerRef
     serial: SerialSection
     analyses: Analyses
+
+    @model_validator(mode="after")
+    def _measurements(self) -> Case:
+        """Read the measurement files now, so that ``gearte validate`` refuses a malformed file
+        (one line naming file, line and column) as ``run`` would; the parts are kept for run."""
+        from gearte.errors import GearteError
+
+        try:
+            self._built = build_serial(self)
+        except GearteError as exc:
+            raise ValueError(str(exc)) from None
+        return self
 
 
 def _pick(table: dict, serials: list[str], file: str, what: str) -> list:
@@ -266,7 +281,7 @@ def run(case: Case, options=None) -> StudyResult:
     options : gearte.studies.RunOptions, optional
         Passed to the ``rv_reducer`` analyses.
     """
-    design, red, measured = build_serial(case)
+    design, red, measured = case._built if case._built is not None else build_serial(case)
     a = case.analyses
     dcase = design.model_copy(
         update={

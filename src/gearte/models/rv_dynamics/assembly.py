@@ -223,6 +223,7 @@ class RVDynamicModel:
             np.ascontiguousarray(geo_m),
             np.ascontiguousarray(geo_n),
             np.ascontiguousarray(e.disc_rotation),
+            np.ascontiguousarray(e.bearing_clearances()),
         )
 
     # --- plain element model (readable twin) ------------------------------------------------
@@ -241,6 +242,7 @@ class RVDynamicModel:
         th_h = deg_to_rad(p.crank_phase_deg) + (1.0 - p.pair.pin_count) * th_o
         a_h = p.centre_distance_mm
         ecc = p.pair.eccentricity_mm
+        clear = e.bearing_clearances()
         out = []
 
         def row(entries):
@@ -362,7 +364,7 @@ class RVDynamicModel:
                     kind="bearing",
                     k=p.crank_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
                     g=(gx, gy),
-                    cl=e.crank_bearing_clearance_mm,
+                    cl=clear[i, n],
                     e=-polar(e.carrier_hole[i, 0], psi + e.carrier_hole[i, 1]),
                 )
             )
@@ -386,7 +388,7 @@ class RVDynamicModel:
                         kind="bearing",
                         k=p.turning_arm_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
                         g=(gx, gy),
-                        cl=e.turning_arm_clearance_mm,
+                        cl=clear[i, j],
                         e=cam - hole,
                     )
                 )

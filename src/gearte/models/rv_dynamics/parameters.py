@@ -185,6 +185,9 @@ class RVErrors:
       spring reads θ_j − Δθ_j(θ_o), linearly interpolated. None → no such errors.
     Clearances [mm]: turning-arm (crank–disc) bearings ε_c, crank support bearings in the output
     disc ε_oH, output main bearing ε_h; radial dead zone of the bearing spring.
+    cam_clearances_mm, carrier_clearances_mm: measured clearance of each turning-arm bearing
+      (shape (M, N), crank i in disc j) and of each crank's support bearing (shape (M,)) [mm];
+      None → the scalar ε_c / ε_oH for every bearing.
     """
 
     crank_count: int
@@ -201,6 +204,8 @@ class RVErrors:
     turning_arm_clearance_mm: float = 0.0
     crank_bearing_clearance_mm: float = 0.0
     output_bearing_clearance_mm: float = 0.0
+    cam_clearances_mm: np.ndarray | None = None
+    carrier_clearances_mm: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         m, n = self.crank_count, self.disc_count
@@ -242,6 +247,36 @@ class RVErrors:
             v = getattr(self, name)
             if not (np.isfinite(v) and v >= 0):
                 raise ParameterError(name, v, "must be finite and ≥ 0")
+        for name, shape in (("cam_clearances_mm", (m, n)), ("carrier_clearances_mm", (m,))):
+            v = getattr(self, name)
+            if v is None:
+                continue
+            arr = np.asarray(v, dtype=float)
+            if arr.shape != shape or not np.all(np.isfinite(arr)) or np.any(arr < 0):
+                raise ParameterError(
+                    name, arr.tolist(), f"must have shape {shape}, finite and ≥ 0 [mm]"
+                )
+            object.__setattr__(self, name, arr)
+
+    def bearing_clearances(self) -> np.ndarray:
+        """Clearance of every crank's bearings [mm], shape (M, N + 1).
+
+        Column j < N: turning-arm bearing of crank i in disc j; column N: crank i's support
+        bearing in the output disc. Measured values where given, else the scalar ones.
+        """
+        m, n = self.crank_count, self.disc_count
+        out = np.empty((m, n + 1))
+        out[:, :n] = (
+            self.turning_arm_clearance_mm
+            if self.cam_clearances_mm is None
+            else self.cam_clearances_mm
+        )
+        out[:, n] = (
+            self.crank_bearing_clearance_mm
+            if self.carrier_clearances_mm is None
+            else self.carrier_clearances_mm
+        )
+        return out
 
 
 # --- building the dynamic model from the shared RV description (gearte.geometry.rv) ----------
@@ -417,5 +452,9 @@ def errors_from_reducer(
         cam=polar(e.cam),
         turning_arm_clearance_mm=reducer.cranks.cam_bearing_clearance,
         crank_bearing_clearance_mm=reducer.cranks.carrier_bearing_clearance,
+        cam_clearances_mm=None if e.cam_clearance is None else np.asarray(e.cam_clearance),
+        carrier_clearances_mm=None
+        if e.carrier_clearance is None
+        else np.asarray(e.carrier_clearance),
         **paper004,
     )

@@ -61,7 +61,7 @@ PF_INDEX = {
             "m_p",
             "m_h",
             "m_c",
-            "cl_oh",
+            "cl_oh",  # scalar clearances (the kernel reads the per-bearing array ``clear``)
             "cl_c",
             "cl_h",
             "r_bp",
@@ -108,14 +108,15 @@ def rv_rhs(t, y, args, dydt, work):
 
     y = [q (6M+3N+6), q̇]; q per body (x [mm], y [mm], θ [rad]) in the order sun, planets 1..M,
     cranks 1..M, discs 1..N, output. ``args`` = (pf, inv_mass, fsp, fcr, err_g, err_m, err_mn,
-    err_n, geo_m, geo_n, rot_n) from :meth:`RVDynamicModel.kernel_args`; errors are given there as
-    body-fixed Cartesian offsets (E cos β, E sin β) and rotated here with the body, so the only
-    trigonometric calls per evaluation are the five nominal angles. ``work`` (``RHS_WORK_SIZE``
-    floats, NaN-filled, one per integration) memoises them and the mesh stiffnesses for the last
-    two times, so RK4 computes them twice per step instead of four times; pass
-    ``np.full(RHS_WORK_SIZE, np.nan)`` (a shorter array makes the call allocate its own).
+    err_n, geo_m, geo_n, rot_n, clear) from :meth:`RVDynamicModel.kernel_args` (``rot_n``: the
+    discs' rotation excitation, ``clear``: the clearance of every crank bearing); errors are given
+    there as body-fixed Cartesian offsets (E cos β, E sin β) and rotated here with the body, so the
+    only trigonometric calls per evaluation are the five nominal angles. ``work`` (``RHS_WORK_SIZE``
+    floats, NaN-filled, one per integration) memoises them and the mesh stiffnesses for the last two
+    times, so RK4 computes them twice per step instead of four times; pass ``np.full(RHS_WORK_SIZE,
+    np.nan)`` (a shorter array makes the call allocate its own).
     """
-    pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n, geo_m, geo_n, rot_n = args
+    pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n, geo_m, geo_n, rot_n, clear = args
     nm = int(pf[30])
     nn = int(pf[31])
     nd = 3 * (2 * nm + nn + 2)
@@ -267,7 +268,7 @@ def rv_rhs(t, y, args, dydt, work):
         dy = q[ih + 1] - (q[i_out + 1] + q[i_out + 2] * chx) - oy
         vx = v[ih] - (v[i_out] - v[i_out + 2] * chy)
         vy = v[ih + 1] - (v[i_out + 1] + v[i_out + 2] * chx)
-        fx, fy = _bearing(dx, dy, vx, vy, k, br * k, pf[26])
+        fx, fy = _bearing(dx, dy, vx, vy, k, br * k, clear[i, nn])
         f[ih] += fx
         f[ih + 1] += fy
         f[i_out] -= fx
@@ -314,7 +315,7 @@ def rv_rhs(t, y, args, dydt, work):
             dy = (q[ih + 1] + q[ih + 2] * ccx) - (q[ic + 1] + q[ic + 2] * chx) + amy - hoy
             vx = (v[ih] - v[ih + 2] * ccy) - (v[ic] - v[ic + 2] * chy)
             vy = (v[ih + 1] + v[ih + 2] * ccx) - (v[ic + 1] + v[ic + 2] * chx)
-            fx, fy = _bearing(dx, dy, vx, vy, k, br * k, pf[27])
+            fx, fy = _bearing(dx, dy, vx, vy, k, br * k, clear[i, j])
             f[ih] += fx
             f[ih + 1] += fy
             f[ih + 2] += ccx * fy - ccy * fx
