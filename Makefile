@@ -1,6 +1,6 @@
 # gearte — the two set-up commands of the README live here.
-#   make demo   creates .venv, installs gearte (runtime dependencies only), runs the bundled RV-80E
-#               case and writes out/demo/report.html
+#   make demo   creates .venv, installs gearte (runtime dependencies only), compiles its numba kernels
+#               (`gearte warm-cache`), runs the bundled RV-80E case and writes out/demo/report.html
 #   make test   creates .venv, installs gearte with its test tools, runs lint, type checks and tests
 # Both install the exact releases of requirements/constraints.txt, so a red run is told apart from
 # upstream drift. `make test-latest` tests the newest releases in a separate venv (.venv-latest);
@@ -33,7 +33,14 @@ $(DEV_STAMP): $(RUN_STAMP)
 	rm -f $(VENV)/.installed-dev-*
 	touch $(DEV_STAMP)
 
-demo: $(RUN_STAMP)
+# numba compiles each kernel on its first use and caches it (keyed by source path and mtime):
+# compile them all once now, with progress, so that the first run of any kind loads them.
+WARM_STAMP := $(VENV)/.numba-warm
+$(WARM_STAMP): $(RUN_STAMP) $(shell find src/gearte -name '*.py')
+	$(BIN)/gearte warm-cache
+	touch $(WARM_STAMP)
+
+demo: $(RUN_STAMP) $(WARM_STAMP)
 	$(BIN)/gearte run $(DEMO_CASE) --out out/demo
 	@echo "report: out/demo/report.html"
 

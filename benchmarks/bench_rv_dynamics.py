@@ -9,7 +9,12 @@
 2. Right-hand side alone (goal ≤ 2 µs per evaluation), timed in a compiled loop.
 3. Compile (or cache-load) time of the kernels, reported separately.
 4. Batch: ``--samples`` (64) random error realisations on 2 threads vs one after another;
-   aggregate simulated seconds per wall second (goal ≥ 50).
+   aggregate simulated seconds per wall second (goal ≥ 50); and a batch of 2 at the default chunk
+   size on 1 and 2 workers (issue 12 goal: ≥ 1.6× on 2 workers).
+5. Strong baselines (issue 12), same run, CPU seconds: a hand-written numba RK4 loop on the same
+   compiled right-hand side and step, reducing the DTE to its extremes (gearte's RK4 goal: within
+   1.5× of it), and ``solve_ivp`` (RK45 and DOP853, rtol 1e-6) on the compiled right-hand side
+   (on ``--baseline-span`` s, scaled).
 
 Run: ``PYTHONPATH=src python benchmarks/bench_rv_dynamics.py [--full-baseline]``.
 """
@@ -22,7 +27,7 @@ import time
 import numpy as np
 from numba import njit
 
-from gearte.models.rv_dynamics import RHS_WORK_SIZE, rv_rhs
+from gearte.models.rv_dynamics import RHS_WORK_SIZE, rv_dte, rv_rhs
 from gearte.runners.rv_dynamics_sim import default_step, dte_batch, ode_system
 from gearte.solvers.ode import integrate, kernels
 from gearte.studies._rv_dynamics import batch_tolerances
@@ -38,6 +43,40 @@ def _rhs_loop(n, y, args, out, work):
         rv_rhs(1e-6 * k, y, args, out, work)  # a new time every call: no memo hits
         acc += out[-1]
     return acc
+
+
+@njit(nogil=True)
+def _rk4_hand(y0, t0, dt, n_steps, settle_steps, args, work_size):
+    """The plainest RK4 a numba user writes on gearte's compiled rhs: fixed step, DTE extremes
+    after settling; returns (max - min) of the DTE [rad]."""
+    n = y0.size
+    work = np.full(work_size, np.nan)
+    y = y0.copy()
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    tmp = np.empty(n)
+    lo, hi = np.inf, -np.inf
+    for s in range(n_steps):
+        t = t0 + s * dt
+        rv_rhs(t, y, args, k1, work)
+        for i in range(n):
+            tmp[i] = y[i] + 0.5 * dt * k1[i]
+        rv_rhs(t + 0.5 * dt, tmp, args, k2, work)
+        for i in range(n):
+            tmp[i] = y[i] + 0.5 * dt * k2[i]
+        rv_rhs(t + 0.5 * dt, tmp, args, k3, work)
+        for i in range(n):
+            tmp[i] = y[i] + dt * k3[i]
+        rv_rhs(t0 + (s + 1) * dt, tmp, args, k4, work)
+        for i in range(n):
+            y[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+        if s + 1 >= settle_steps:
+            o = rv_dte(t0 + (s + 1) * dt, y, args)
+            lo = min(lo, o)
+            hi = max(hi, o)
+    return hi - lo
 
 
 def main() -> None:
@@ -94,6 +133,38 @@ def main() -> None:
         f"(goal ≤ 1 s), DTE p2p {p2p:.3f}″ (paper 17.25″)"
     )
 
+    # strong baselines: hand-written numba RK4, solve_ivp on the compiled rhs
+    n_steps = int(round((settle + span) / dt))
+    settle_steps = int(round(settle / dt))
+    _rk4_hand(y0, 0.0, dt, 10, 0, args, RHS_WORK_SIZE)  # compile
+    c0 = time.process_time()
+    p2p_hand = _rk4_hand(y0, 0.0, dt, n_steps, settle_steps, args, RHS_WORK_SIZE)
+    c_hand = time.process_time() - c0
+    c0 = time.process_time()
+    integrate(system, y0, (0.0, settle + span), method="rk4", dt=dt, t_settle=settle)
+    c_fast = time.process_time() - c0
+    print(
+        f"hand-written numba RK4, same rhs/step: {c_hand:8.3f} s CPU (gearte {c_fast:.3f} s CPU:"
+        f" {c_fast / c_hand:.2f}× of it, goal ≤ 1.5×), DTE p2p {p2p_hand * ARCSEC_PER_RAD:.3f}″"
+    )
+    from scipy.integrate import solve_ivp
+
+    w = np.full(RHS_WORK_SIZE, np.nan)
+
+    def f_numba(t, y):
+        d = np.empty_like(y)
+        rv_rhs(t, y, args, d, w)
+        return d
+
+    for meth in ("RK45", "DOP853"):
+        c0 = time.process_time()
+        sol = solve_ivp(f_numba, (0.0, a.baseline_span), y0, method=meth, rtol=1e-6, atol=1e-10)
+        c_ivp = (time.process_time() - c0) * (settle + span) / a.baseline_span
+        print(
+            f"solve_ivp {meth:6s} on the numba rhs : {c_ivp:8.1f} s CPU for the full span (scaled "
+            f"from {a.baseline_span:g} s, {sol.nfev} rhs calls): gearte {c_ivp / c_fast:.0f}×"
+        )
+
     # baseline: solve_ivp on the plain-Python rhs
     b_total = span + settle if a.full_baseline else a.baseline_span
     b_settle = settle if a.full_baseline else 0.25 * b_total
@@ -136,6 +207,13 @@ def main() -> None:
             f"{rr['simulated_s'] / rr['wall_s']:7.1f} sim-s/s (goal ≥ 50 aggregate)"
         )
     print(f"batch speed-up threads / sequential: {r1['wall_s'] / r2['wall_s']:.2f}×")
+    kw2 = {k: v for k, v in kw.items() if k != "chunk_size"}  # the default chunk size
+    b1 = dte_batch(model, 2, workers=1, **kw2)
+    b2 = dte_batch(model, 2, workers=2, **kw2)
+    print(
+        f"batch of 2, default chunks: 1 worker {b1['wall_s']:.2f} s, 2 workers {b2['wall_s']:.2f}"
+        f" s wall: {b1['wall_s'] / b2['wall_s']:.2f}× (goal ≥ 1.6×; needs 2 idle cores)"
+    )
     print(
         f"DTE p2p over realisations: mean {r2['peak_to_peak_mean']:.2f}″, sd "
         f"{r2['peak_to_peak_sd']:.2f}″, max {r2['peak_to_peak_max']:.2f}″"

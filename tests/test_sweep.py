@@ -280,3 +280,18 @@ def test_points_table_is_one_coupled_axis(tmp_path):
     table.write_text("demo.length_mm,demo.count\n1.0\n")
     r = CliRunner().invoke(main, ["sweep", str(case), "--points", str(table), "--out", str(out)])
     assert r.exit_code == 2 and "line 2" in r.output
+
+
+def test_index_page_groups_figures_by_analysis():
+    from gearte.report.sweep_page import sweep_index_html
+
+    r = run_sweep(DEMO, {"demo.length_mm": "1:2:2"}, progress=False)
+    figs = [
+        ("plots/a.png", "geometry.K1 vs x", "c"),
+        ("plots/b.png", "geometry.tip vs x", "c"),
+        ("plots/c.png", "compensation.change vs x", "c"),
+    ]
+    page = sweep_index_html(r, figs)
+    assert "<a href='#fig-geometry'>geometry</a> (2)" in page
+    assert page.index("id='fig-geometry'") < page.index("plots/b.png")
+    assert page.index("id='fig-compensation'") < page.index("plots/c.png")

@@ -463,6 +463,47 @@ def validate(cases: tuple[str, ...]) -> None:
     _guarded(_validate, False)
 
 
+@main.command("warm-cache")
+@click.option("--kind", "kinds", multiple=True, help="Warm this study kind only (repeatable).")
+@click.option(
+    "--processes",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Kinds compiled side by side (default: the machine's cores, at most 2).",
+)
+@click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
+def warm_cache_cmd(kinds: tuple[str, ...], processes: int | None, debug: bool) -> None:
+    """Compile the numba kernels of every study kind now (make demo runs this once), so that the
+    first `gearte run` of a kind loads them from the cache instead of compiling."""
+
+    def _warm() -> None:
+        import time
+
+        from gearte.warm import warm_cache, warm_cache_parallel
+
+        n = processes if processes is not None else min(2, os.cpu_count() or 1)
+        t0 = time.perf_counter()
+        click.echo(f"==> compiling gearte's numba kernels, one case group per kind ({n} at a time)")
+        if n == 1:
+            cpu = [0.0]
+
+            def report(kind: str, case: str, seconds: float) -> None:
+                if seconds < 0:
+                    cpu[0] = time.process_time()
+                    click.echo(f"  {kind:14s} {case:32s} ...", nl=False)
+                else:
+                    click.echo(f" {seconds:6.1f} s ({time.process_time() - cpu[0]:.1f} s CPU)")
+
+            list(warm_cache(list(kinds) or None, report=report))
+        else:
+            for kind, rows in warm_cache_parallel(list(kinds) or None, processes=n):
+                for case, wall, cpu_s in rows:
+                    click.echo(f"  {kind:14s} {case:32s} {wall:6.1f} s ({cpu_s:.1f} s CPU)")
+        click.echo(f"==> numba cache warm ({time.perf_counter() - t0:.1f} s)")
+
+    _guarded(_warm, debug)
+
+
 @main.command("cases")
 @click.option("--kinds", is_flag=True, help="List the study kinds instead.")
 def cases_cmd(kinds: bool) -> None:

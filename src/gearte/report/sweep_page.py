@@ -17,7 +17,8 @@ __all__ = ["sweep_index_html"]
 _CSS = """
 body{font-family:system-ui,-apple-system,"Segoe UI",sans-serif;margin:1.5rem auto;max-width:1200px;
 padding:0 1rem;color:#1a1a1a;line-height:1.4}
-h1{font-size:1.5rem;margin-bottom:.2rem}h2{font-size:1.15rem;margin-top:1.8rem;
+h1{font-size:1.5rem;margin-bottom:.2rem}h3{font-size:1rem;margin:1rem 0 .3rem}
+h2{font-size:1.15rem;margin-top:1.8rem;
 border-bottom:1px solid #ddd}
 .meta{color:#555}.warn{background:#fff4e5;border-left:4px solid #e69500;padding:.5rem .8rem}
 table{border-collapse:collapse;font-size:.85rem;margin:.5rem 0}
@@ -105,12 +106,26 @@ def sweep_index_html(
 
     out.append("<h2 id='figures'>Figures</h2>")
     if figures:
-        for href, title, caption in figures:
+        groups: dict[str, list[tuple[str, str, str]]] = {}
+        for fig in figures:  # by analysis: the part of the result name before the first dot
+            groups.setdefault(fig[1].split(".", 1)[0], []).append(fig)
+        if len(groups) > 1:
             out.append(
-                f"<figure><a href='{_e(href)}'><img src='{_e(href)}' alt='{_e(title)}' "
-                f"loading='lazy'></a><figcaption><b>{_e(title)}</b>. {_e(caption)}"
-                "</figcaption></figure>"
+                "<p>"
+                + " · ".join(
+                    f"<a href='#fig-{_e(g)}'>{_e(g)}</a> ({len(v)})" for g, v in groups.items()
+                )
+                + "</p>"
             )
+        for g, figs in groups.items():
+            if len(groups) > 1:
+                out.append(f"<h3 id='fig-{_e(g)}'>{_e(g)}</h3>")
+            for href, title, caption in figs:
+                out.append(
+                    f"<figure><a href='{_e(href)}'><img src='{_e(href)}' alt='{_e(title)}' "
+                    f"loading='lazy'></a><figcaption><b>{_e(title)}</b>. {_e(caption)}"
+                    "</figcaption></figure>"
+                )
     elif not plots:
         out.append("<p>No figures (written with <code>--no-plots</code>).</p>")
     else:

@@ -307,7 +307,7 @@ def dte_batch(
     duration_s: float = 0.5,
     settle_s: float = 0.1,
     dt: float | None = None,
-    chunk_size: int = 4,
+    chunk_size: int = 1,
     workers: int | None = None,
     scheduler=None,
     progress: bool = False,
@@ -317,8 +317,10 @@ def dte_batch(
 
     Chunks of ``chunk_size`` realisations each get their own generator from
     ``gearte.execution.spawn_generators(seed, n_chunks)``, so the result does not depend on the
-    worker count. The kernel reduces each run to (p2p, rms, mean) inside the time loop; nothing
-    else is stored. Returns the per-realisation rows and their summary.
+    worker count. A run takes seconds, so the default is one realisation per chunk: any batch
+    of >= 2 runs keeps every worker busy (with 4 per chunk, a batch of 2 ran on one worker).
+    The kernel reduces each run to (p2p, rms, mean) inside the time loop; nothing else is
+    stored. Returns the per-realisation rows and their summary.
 
     Parameters
     ----------
@@ -337,7 +339,7 @@ def dte_batch(
     dt : float, optional
         RK4 step [s]; default the model's.
     chunk_size : int
-        Realisations per chunk [-].
+        Realisations per chunk [-] (default 1; results depend on it and ``seed`` only).
     workers : int, optional
         Parallel workers.
     scheduler : optional

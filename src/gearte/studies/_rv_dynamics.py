@@ -115,7 +115,11 @@ class BatchOptions(StrictModel):
     settle_s: float = Field(0.1, ge=0, le=10, description="Settling time before recording [s].")
     seed: int = Field(0, ge=0, description="Seed of the random realisations.")
     chunk_size: int = Field(
-        4, ge=1, le=10000, description="Realisations per chunk of the execution layer."
+        1,
+        ge=1,
+        le=10000,
+        description="Realisations per chunk of the execution layer (1: any batch of >= 2 "
+        "realisations uses every worker).",
     )
     tolerance_scale: float = Field(1.0, gt=0, le=10, description="× Table 3 amplitudes")
 

@@ -28,6 +28,10 @@ Optional ``[compensation]``: stages compensated by their mean return error when 
 reverses; motor offset (eq. 33), residual per stage, joint and end error after it. It acts on
 the chain after the shim when there is one (the paper's order).
 
+Optional ``[analyses.yield]``: each stage's lost motion drawn from its distribution (its model's
+tolerance stack, or its min/mean/max, or constant), combined at the joint by eq. (30) by
+Monte-Carlo — the joint's distribution, yield, Cpk and contributions (``gearte.studies._yield``).
+
 Analyses: one group per stage (``<stage>_backlash`` …, see ``gear_pair``), ``chain``
 (``joint_lost_motion_max [arcmin]``, ``end_effector_error_max [mm]``), ``shim``
 (``shim_thickness [mm]`` …), ``compensation`` (``motor_compensation_angle [deg]``,
@@ -56,6 +60,7 @@ from gearte.models.lost_motion import (
 )
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies._drives import DriveSpec
+from gearte.studies._yield import YieldSection
 from gearte.studies.gear_pair import PairAnalysisSpec, PairSpec, analyse_pair
 from gearte.units import (
     Nmm_to_Nm,
@@ -329,11 +334,24 @@ class CompensationSpec(StrictModel):
     )
 
 
+class ChainAnalyses(StrictModel):
+    """``[analyses]`` of a chain: ``[analyses.yield]`` (gearte.studies._yield)."""
+
+    yield_: YieldSection | None = Field(
+        default=None,
+        alias="yield",
+        description="production yield of the chain: each stage's lost motion drawn from its "
+        "distribution, combined at the joint by eq. (30); tolerance keys are the stage names "
+        "(tolerance_arcmin, nominal_arcmin at the stage output)",
+    )
+
+
 class Case(CaseBase):
     chain: ChainSpec
     analysis: PairAnalysisSpec = PairAnalysisSpec()
     shim: ShimSpec | None = None
     compensation: CompensationSpec | None = None
+    analyses: ChainAnalyses | None = None
 
     @model_validator(mode="after")
     def _shim_target(self):
@@ -563,6 +581,71 @@ def _round_shim(x: float, step: float, how: str) -> float:
     return k * step
 
 
+def _stage_tolerances(case: Case, stages, drives: dict, backlash: dict) -> dict:
+    """Each stage's lost-motion law at its output [arcmin], as ``[analyses.yield]`` entries.
+
+    A stage whose model has a tolerance stack (a pair, a cycloid stage) is normal with the
+    stack's mean and σ (tolerance = 3σ); a stage given by min/mean/max values is normal about
+    its mean with σ = (max − min)/(2z) at the case's confidence (the reading of
+    ``joint_lost_motion_statistical_max``); a stage with a single value (a catalogue maximum, a
+    deterministic reducer) is constant at it.
+    """
+    from gearte.studies._yield import ToleranceEntry
+    from gearte.tolerance.stackup import z_for_confidence
+
+    conf = case.analysis.confidence
+    z = z_for_confidence(conf)
+    specs = {st.name: st for st in case.chain.stages}
+    out: dict[str, ToleranceEntry] = {}
+    for s in stages:
+        st = specs[s.name]
+        spread = None
+        if s.name in drives and st.lost_motion_max_arcmin is None:
+            spread = drives[s.name].lost_motion_spread(conf)
+        elif s.name in backlash and backlash[s.name][3] is not None:
+            spread = _pair_drive(st, backlash[s.name][3]).lost_motion_spread(conf)
+        if spread is not None:
+            out[s.name] = ToleranceEntry(
+                kind="normal",
+                tolerance_arcmin=float(rad_to_arcmin(3.0 * spread.sd)),
+                nominal_arcmin=float(rad_to_arcmin(spread.mean)),
+            )
+        elif s.mean is not None and s.min is not None and s.max > s.min:
+            out[s.name] = ToleranceEntry(
+                kind="normal",
+                tolerance_arcmin=float(rad_to_arcmin(3.0 * (s.max - s.min) / (2.0 * z))),
+                nominal_arcmin=float(rad_to_arcmin(s.mean)),
+            )
+        else:
+            out[s.name] = ToleranceEntry(
+                kind="constant", tolerance_arcmin=0.0, nominal_arcmin=float(rad_to_arcmin(s.max))
+            )
+    return out
+
+
+def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> AnalysisResult:
+    """``[analyses.yield]``: the stages' lost motions drawn from their laws (or the section's
+    tolerances), combined at the joint by eq. (30) — the joint's distribution and its yield
+    against ``[analyses.yield.spec]`` (``"joint_lost_motion [arcmin]"``)."""
+    from gearte.runners.yield_models import GearChainLostMotion
+    from gearte.studies._yield import yield_analysis
+
+    assert case.analyses is not None and case.analyses.yield_ is not None
+    defaults = _stage_tolerances(case, stages, drives, backlash)
+    model = GearChainLostMotion([s.name for s in stages], [s.ratio for s in stages])
+    units = {s.name: "arcmin" for s in stages}
+    nominal = {k: float(t.nominal_arcmin or 0.0) for k, t in defaults.items()}
+    return yield_analysis(
+        case.analyses.yield_,
+        model,
+        units,
+        nominal,
+        options=options,
+        references=["jiang2024"],
+        defaults=defaults,
+    )
+
+
 def run(case: Case, options) -> StudyResult:
     """Run a ``gear_chain`` case: each stage's lost motion, the joint and end-effector error,
     shim and motor compensation; no I/O, no plotting.
@@ -706,6 +789,8 @@ def run(case: Case, options) -> StudyResult:
 
     if case.chain.te_positions is not None:
         analyses.append(_chain_te(case, drives))
+    if case.analyses is not None and case.analyses.yield_ is not None:
+        analyses.append(_chain_yield(case, stages, drives, backlash, options))
 
     # -- shim (eq. 32) ---------------------------------------------------------------------------
     comp_stages = stages

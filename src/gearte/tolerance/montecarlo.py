@@ -9,10 +9,16 @@ sample count; percentiles come from that histogram (resolution: one bin, ``16σ/
 Linear stacks whose contributors the compiled kernel can draw (normal, uniform, Rayleigh,
 Rayleigh magnitude × uniform phase — as the exactly equivalent normal, or drawn in polar form —,
 empirical, constant) run in a numba kernel that draws from
-the chunk's Generator directly and reduces without storing samples. Its plain reference,
-:func:`linear_stack_reference`, is a per-sample Python loop making the same Generator calls in
-the same order: the two give bit-identical samples (tested). Everything else (function stacks,
-truncated distributions) runs vectorised in numpy, chunk by chunk.
+the chunk's Generator directly and reduces without storing samples. The independent normal
+contributors form one Gaussian group: their sum is drawn as *one* normal per sample (exact, a sum
+of independent normals is normal with the summed mean and variance); the others are drawn one
+by one. Its plain reference, :func:`linear_stack_reference`, is a per-sample Python loop making
+the same Generator calls in the same order: the two give bit-identical samples (tested), so a
+seed gives the same result on every backend. (Before issue 12 each normal contributor was drawn
+separately: the samples of a seed changed once then, the distribution did not.) Per-contributor
+values (contributions, variance shares) come from :mod:`gearte.tolerance.stackup`, not from
+these samples. Everything else (function stacks, truncated distributions) runs vectorised in
+numpy, contributor by contributor, chunk by chunk.
 """
 
 from __future__ import annotations
@@ -54,43 +60,51 @@ _BLOCK = 2048
 
 
 @njit(cache=True, nogil=True)
-def _fill(rng, out, m, codes, params, sens, const, pool):  # pragma: no cover - compiled
-    """Draw ``m`` samples of the stack into ``out[:m]``, sample by sample, contributor by
-    contributor (the order of :func:`linear_stack_reference`)."""
-    k = codes.shape[0]
-    # fast path when every contributor is a normal draw (codes 0 and 3): same arithmetic and the
-    # same Generator calls as the generic branch, so the samples stay bit-identical
-    mu = np.zeros(k)
-    sd = np.zeros(k)
-    normal_only = True
-    for i in range(k):
+def _normal_group(codes, params, sens):  # pragma: no cover - compiled
+    """Mean and standard deviation of the sum of the independent normal contributors (codes 0
+    and 3) with their sensitivities, and how many there are."""
+    gmu = 0.0
+    gv = 0.0
+    nn = 0
+    for i in range(codes.shape[0]):
         if codes[i] == 0:
-            mu[i] = params[i, 0]
-            sd[i] = params[i, 1]
+            gmu += sens[i] * params[i, 0]
+            t = sens[i] * params[i, 1]
+            gv += t * t
+            nn += 1
         elif codes[i] == 3:
-            sd[i] = params[i, 0]
-        else:
-            normal_only = False
-    if normal_only:
+            t = sens[i] * params[i, 0]
+            gv += t * t
+            nn += 1
+    return gmu, math.sqrt(gv), nn
+
+
+@njit(cache=True, nogil=True)
+def _fill(rng, out, m, codes, params, sens, const, pool):  # pragma: no cover - compiled
+    """Draw ``m`` samples of the stack into ``out[:m]``, sample by sample: one standard normal
+    for the sum of the independent normal contributors (exact: a sum of independent normals is
+    normal), then the other contributors in order (the order of
+    :func:`linear_stack_reference`)."""
+    k = codes.shape[0]
+    gmu, gsd, nn = _normal_group(codes, params, sens)
+    base = const + gmu
+    if nn == k:  # every contributor normal: one draw per sample
         for j in range(m):
-            y = const
-            for i in range(k):
-                y += sens[i] * (mu[i] + sd[i] * rng.standard_normal())
-            out[j] = y
+            out[j] = base + gsd * rng.standard_normal()
         return
     for j in range(m):
-        y = const
+        y = base
+        if nn > 0:
+            y += gsd * rng.standard_normal()
         for i in range(k):
             c = codes[i]
-            if c == 0:  # normal
-                v = params[i, 0] + params[i, 1] * rng.standard_normal()
+            if c == 0 or c == 3:  # in the normal group
+                continue
             elif c == 1:  # uniform
                 v = rng.uniform(params[i, 0], params[i, 1])
             elif c == 2:  # rayleigh
                 v = rng.rayleigh(params[i, 0])
-            elif c == 3:  # rayleigh magnitude x sin(uniform phase) == N(0, scale²), exactly
-                v = params[i, 0] * rng.standard_normal()
-            elif c == 6:  # the same drawn as magnitude and phase
+            elif c == 6:  # rayleigh magnitude x sin(uniform phase), drawn as magnitude and phase
                 r = rng.rayleigh(params[i, 0])
                 v = r * math.sin(rng.uniform(0.0, _TWO_PI))
             elif c == 4:  # empirical: pool[offset + integers(0, count)]
@@ -155,15 +169,45 @@ def linear_stack_reference(stack: LinearStack, rng: np.random.Generator, n: int)
 
     ``n`` samples [the stack's unit] of ``stack`` drawn from ``rng``.
 
-    Makes the same Generator calls in the same order as the kernel (contributor by contributor
-    within a sample), so its samples are identical to the kernel's for the same Generator state.
+    Makes the same Generator calls in the same order as the kernel — per sample one standard
+    normal for the sum of the independent normal contributors (mean ``Σ s_i μ_i``, standard
+    deviation ``sqrt(Σ (s_i σ_i)²)``), then each other contributor in order — so its samples
+    are identical to the kernel's for the same Generator state. A stack the kernel cannot draw
+    is drawn contributor by contributor.
     """
     out = np.empty(n)
     contributors = stack.contributors
+    arrays = stack.kernel_arrays()
+    if arrays is None:
+        for j in range(n):
+            y = stack.constant
+            for c in contributors:
+                y += c.sensitivity * c.distribution.draw_one(rng)
+            out[j] = y
+        return out
+    codes, params, sens, _ = arrays
+    gmu = 0.0
+    gv = 0.0
+    others = []
+    for i, c in enumerate(contributors):
+        if codes[i] == 0:
+            gmu += float(sens[i]) * float(params[i, 0])
+            t = float(sens[i]) * float(params[i, 1])
+            gv += t * t
+        elif codes[i] == 3:
+            t = float(sens[i]) * float(params[i, 0])
+            gv += t * t
+        else:
+            others.append((float(sens[i]), c.distribution))
+    gsd = math.sqrt(gv)
+    grouped = len(others) < len(contributors)
+    base = stack.constant + gmu
     for j in range(n):
-        y = stack.constant
-        for c in contributors:
-            y += c.sensitivity * c.distribution.draw_one(rng)
+        y = base
+        if grouped:
+            y += gsd * rng.standard_normal()
+        for si, d in others:
+            y += si * d.draw_one(rng)
         out[j] = y
     return out
 
