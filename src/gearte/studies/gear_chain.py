@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
@@ -56,6 +56,7 @@ from gearte.models.lost_motion import (
 )
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies._drives import DriveSpec
+from gearte.studies._yield import ToleranceEntry, YieldSection
 from gearte.studies.gear_pair import PairAnalysisSpec, PairSpec, analyse_pair
 from gearte.units import (
     Nmm_to_Nm,
@@ -329,9 +330,23 @@ class CompensationSpec(StrictModel):
     )
 
 
+class ChainAnalysesSpec(StrictModel):
+    """``[analyses]`` of a chain: optional production yield (:mod:`gearte.runners.chain_yield`)."""
+
+    yield_: YieldSection | None = Field(
+        default=None,
+        alias="yield",
+        description="production yield of the joint (gearte.studies._yield): tolerance keys "
+        "<stage slug>.<contributor> [µm] of a pair stage (e.g. spur_pair.centre_distance, "
+        "spur_pair.driven_gear_eccentricity: grade = N gives ISO 1328-2 F_i″), "
+        "<stage slug>.lost_motion [deg] of any other stage",
+    )
+
+
 class Case(CaseBase):
     chain: ChainSpec
     analysis: PairAnalysisSpec = PairAnalysisSpec()
+    analyses: ChainAnalysesSpec | None = None
     shim: ShimSpec | None = None
     compensation: CompensationSpec | None = None
 
@@ -493,6 +508,106 @@ def _drive_stage(st: StageSpec, drive, confidence: float):
         notes=notes,
     )
     return StageLostMotion(st.name, st.ratio, mx, mean, lo, st.compensate), result
+
+
+def _chain_yield(case: Case, sec: YieldSection, drives: dict, options) -> AnalysisResult:
+    """``[analyses.yield]``: each sample one assembled joint — every pair stage's backlash stack
+    drawn contributor by contributor, every other stage's lost motion drawn from its drive's
+    spread (constant where its model is deterministic) — combined at the joint by eq. (30)
+    sample by sample; yield against ``[analyses.yield.spec]``, contributions per tolerance."""
+    from gearte.models.backlash import SpurPair
+    from gearte.runners.chain_yield import ChainStage, GearChainYield, stack_terms
+    from gearte.studies._yield import yield_analysis
+    from gearte.tolerance.iso1328 import radial_composite_tolerances
+
+    conf = case.analysis.confidence
+    z = _z(conf)
+    stages, units, nominal = [], {}, {}
+    defaults: dict[str, ToleranceEntry] = {}
+    pairs: dict[str, tuple[Any, str]] = {}
+    for st in case.chain.stages:
+        slug = _slug(st.name)
+        drive = drives.get(st.name)
+        pair = getattr(drive, "pair", None) if drive is not None else None
+        if st.pair is not None:
+            pair = st.pair.build()
+        if pair is not None:
+            terms, laws = stack_terms(slug, pair.backlash_stack())
+            stages.append(
+                ChainStage(
+                    st.name, slug, st.ratio, terms, pair.output_diameter, pair.pressure_angle
+                )
+            )
+            for key, (kind, tol, mu) in laws.items():
+                units[key], nominal[key] = "um", mu
+                defaults[key] = ToleranceEntry(
+                    kind=kind,
+                    tolerance_um=tol,
+                    nominal_um=mu,
+                    sigmas=6.0 if kind == "rayleigh" else None,
+                    phase=kind == "rayleigh",
+                )
+                pairs[key] = (pair, "driving" if ".driving_gear" in key else "driven")
+            continue
+        stage = ChainStage(st.name, slug, st.ratio)
+        key = stage.lost_motion_key
+        stages.append(stage)
+        units[key] = "deg"
+        spread = None
+        if st.lost_motion_max_arcmin is not None:  # the maker's value: held at its maximum
+            mean, sd = float(arcmin_to_rad(st.lost_motion_max_arcmin)), 0.0
+        elif drive is not None:
+            spread = drive.lost_motion_spread(conf)
+            if spread is None:
+                mean, sd = float(drive.lost_motion()), 0.0
+            else:
+                mean, sd = spread.mean, spread.sd
+        else:  # backlash values given: normal about the mean, σ = (max − min) / (2z)
+            trio, d, alpha, _ = _stage_backlash_mm(st, conf)
+            lo, mean, mx = (float(return_error(max(b, 0.0), d, alpha)) for b in trio)
+            sd = (mx - lo) / (2.0 * z)
+        nominal[key] = float(rad_to_deg(mean))
+        defaults[key] = ToleranceEntry(
+            kind="normal" if sd > 0 else "constant",
+            tolerance_deg=float(rad_to_deg(3.0 * sd)),
+            nominal_deg=nominal[key],
+        )
+
+    def grade_um(key: str, grade: int) -> float | None:
+        """A spur gear's eccentricity: its ISO 1328-2 total radial composite tolerance F_i″."""
+        if not key.endswith("_gear_eccentricity") or key not in pairs:
+            return None
+        pair, which = pairs[key]
+        if not isinstance(pair, SpurPair):
+            return None
+        teeth = getattr(pair, which).teeth
+        return radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
+
+    model = GearChainYield(stages, nominal, case.chain.lever_length_mm)
+    res = yield_analysis(
+        sec,
+        model,
+        units,
+        nominal,
+        options=options,
+        references=["jiang2024"],
+        defaults=defaults,
+        grade_um=grade_um,
+    )
+    res.notes.append(
+        "Chain yield: pair stages from their backlash stack drawn contributor by contributor "
+        "(eccentricities and run-outs: Rayleigh magnitude, σx = t/6 as Jiang 2024, uniform "
+        "direction, entering as r sin φ); other stages' lost motion normal from the drive's "
+        "spread (constant where the model is deterministic or only a maximum is given); "
+        "joint = Σ stage lost motion / downstream ratios (eq. 30), sample by sample."
+    )
+    return res
+
+
+def _z(confidence: float) -> float:
+    from gearte.tolerance.stackup import z_for_confidence
+
+    return float(z_for_confidence(confidence))
 
 
 def _chain_te(case: Case, drives: dict) -> AnalysisResult:
@@ -706,6 +821,8 @@ def run(case: Case, options) -> StudyResult:
 
     if case.chain.te_positions is not None:
         analyses.append(_chain_te(case, drives))
+    if case.analyses is not None and case.analyses.yield_ is not None:
+        analyses.append(_chain_yield(case, case.analyses.yield_, drives, options))
 
     # -- shim (eq. 32) ---------------------------------------------------------------------------
     comp_stages = stages
