@@ -8,9 +8,9 @@ Each stage of a ``gear_chain`` is one of
   (tooth thicknesses, centre distance, bearing clearance [µm]; eccentricities and run-outs as a
   magnitude [µm] with a uniform direction, entering as ``r sin φ``), then turned into the return
   error at the driven gear by eq. (14)/(29), ``Δφ = 2 max(jn, 0) / (d cos α)``;
-* a **lost-motion stage** (any other drive, or a stage given by its lost motion): its lost
-  motion [deg at the stage output] is itself the drawn error (normal from the drive's
-  ``lost_motion_spread``, or constant at the drive's deterministic lost motion).
+* a **lost-motion stage** (any other drive, a stage given by its lost motion or backlash
+  values, or a pair whose whole law the user gives): its lost motion [arcmin at the stage
+  output, key: the stage name] is itself the drawn error.
 
 The joint's lost motion is Jiang et al. (2024) eq. (30), ``Δφ_joint = Σₖ Δφₖ / Πⱼ₍ⱼ>ₖ₎ iⱼ``,
 sample by sample (the distribution, not only the sum of maxima), and the end-effector error
@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gearte.errors import ParameterError
-from gearte.units import deg_to_rad, rad_to_arcmin, um_to_mm
+from gearte.units import arcmin_to_rad, rad_to_arcmin, um_to_mm
 
 __all__ = ["StageTerm", "ChainStage", "GearChainYield", "stack_terms"]
 
@@ -70,7 +70,7 @@ class ChainStage:
         Reduction ratio [-], > 0.
     terms : tuple of StageTerm
         Backlash stage: the stack's contributors. Empty: a lost-motion stage whose error key is
-        ``"<slug>.lost_motion"`` [deg].
+        its name [arcmin at its output].
     diameter : float
         Driven-gear pitch (bevel: mean) diameter d [mm] of eq. (14)/(29) (backlash stage).
     pressure_angle : float
@@ -83,10 +83,6 @@ class ChainStage:
     terms: tuple[StageTerm, ...] = ()
     diameter: float = 0.0
     pressure_angle: float = 0.0
-
-    @property
-    def lost_motion_key(self) -> str:
-        return f"{self.slug}.lost_motion"
 
 
 def stack_terms(slug: str, stack) -> tuple[tuple[StageTerm, ...], dict[str, tuple]]:
@@ -133,7 +129,8 @@ class GearChainYield:
     stages : sequence of ChainStage
         Motor to joint.
     nominal : mapping
-        Error key → value used where a batch does not draw it ([µm]; lost motion [deg]).
+        Error key → value used where a batch does not draw it ([µm]; a stage's lost motion
+        [arcmin]).
     lever_length : float
         Joint axis to end effector L [mm] (eq. 31).
 
@@ -179,7 +176,7 @@ class GearChainYield:
                     jn += t.sensitivity * x
                 lm = 2.0 * np.maximum(jn, 0.0) / (st.diameter * np.cos(st.pressure_angle))
             else:
-                lm = np.maximum(deg_to_rad(self._get(errors, st.lost_motion_key, n)), 0.0)
+                lm = np.maximum(arcmin_to_rad(self._get(errors, st.name, n)), 0.0)
             out[f"{st.slug}.lost_motion [arcmin]"] = np.asarray(rad_to_arcmin(lm), dtype=float)
             joint += lm * f
         out["joint_lost_motion [arcmin]"] = np.asarray(rad_to_arcmin(joint), dtype=float)
