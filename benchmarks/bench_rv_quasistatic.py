@@ -1,26 +1,48 @@
-"""Benchmark: quasi-static RV load sharing at 360 output positions.
+"""Benchmark: quasi-static RV load sharing at 360 output positions (issue 12).
 
-gearte: compiled active-set Newton kernel, warm-started from position to position, contact
-stiffness fixed point inside the kernel. Baseline, measured in the same run: a plain
-``scipy.optimize.fsolve`` per position (cold start) on the same residual, inside the same
-contact-stiffness fixed point. Both solve the han2023_rv110e case (with its measured errors) at
-rated torque; the script checks they agree and prints both times and the ratio.
+Part 1 (Hu 2020's per-disc law, the scheme the weak baseline codes): gearte's per-case compiled
+active-set Newton kernel (warm-started from position to position, contact-stiffness fixed point
+inside the kernel) against a plain ``scipy.optimize.fsolve`` per position (cold start) on the
+same residual inside the same fixed point — the weak baseline.
+
+Part 2 (the default textbook line-contact law, each contact its own stiffness): the strong
+baseline, a numpy active-set Newton vectorised over all 360 positions at once (dense rows,
+batched ``np.matmul`` Hessians and ``np.linalg.solve``, masks for the positions still iterating;
+``benchmarks/_numpy_rv.py``), with the per-contact secant fixed point (the per-case algorithm)
+and with Newton on the exact law (the batched kernel's algorithm); against gearte's per-case
+solver (:func:`gearte.solvers.rv_equilibrium.solve_positions`) and gearte's batched kernel
+(:func:`gearte.solvers.rv_batch.solve_batch`: condensed onto the disc degrees of freedom, exact
+law, warm-started along the positions). All solve han2023_rv110e (with its measured errors) at
+rated torque; the script checks they agree and prints the times and ratios. BLAS runs
+single-threaded (``OPENBLAS_NUM_THREADS=1`` unless set).
 
     PYTHONPATH=src python benchmarks/bench_rv_quasistatic.py
 """
 
 from __future__ import annotations
 
-import time
-import warnings
+import os
 
-import numpy as np
-from scipy.optimize import fsolve
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from gearte.io.case_file import load_case
-from gearte.models.rv_load_sharing import assemble, contact_law, output_positions
-from gearte.solvers.rv_equilibrium import _law_delta, _linear_parts, solve_positions
-from gearte.studies.rv_reducer import build_reducer
+import time  # noqa: E402
+import warnings  # noqa: E402
+
+import numpy as np  # noqa: E402
+from scipy.optimize import fsolve  # noqa: E402
+
+from _numpy_rv import Systems, dense_rows  # noqa: E402
+from _numpy_rv import solve as numpy_solve  # noqa: E402
+from gearte.io.case_file import load_case  # noqa: E402
+from gearte.models.rv_load_sharing import assemble, contact_law, output_positions  # noqa: E402
+from gearte.solvers.rv_batch import problem_from_system, solve_batch  # noqa: E402
+from gearte.solvers.rv_equilibrium import (  # noqa: E402
+    _law_delta,
+    _linear_parts,
+    solve_positions,
+)
+from gearte.studies.rv_reducer import build_reducer  # noqa: E402
 
 
 def baseline(system, torque, law):
@@ -64,6 +86,57 @@ def baseline(system, torque, law):
     return out
 
 
+def _best(fn, reps: int) -> float:
+    best = np.inf
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def part2(red, system, T) -> None:
+    """Strong baselines on the line-contact law (see the module docstring)."""
+    law = contact_law(red).for_system(system)
+    P = system.theta.size
+    sol = solve_positions(system, T, law)  # also compiles / loads the cache
+    prob, h, en, gap = problem_from_system(system, law)
+    steps = np.arange(P)
+    cold = steps == 0
+
+    def batched():
+        return solve_batch(prob, h, en, gap, steps, np.full(P, T), cold)
+
+    bsol = batched()
+    t_case = _best(lambda: solve_positions(system, T, law), 3)
+    t_batch = _best(batched, 5)
+    load = T * system.unit_load[None, :]
+    K0, f0 = _linear_parts(system.spring_B, system.spring_e, system.spring_k, load)
+    nd = K0.shape[1]
+    Bd = dense_rows(prob.contacts, nd)
+    coef = law.coefficients(P, system.contact_gap.shape[1])
+    s = Systems(K0, Bd, f0, system.contact_gap, coef[..., 0], coef[..., 1])
+    out = system.layout.output_rotation
+    res = {}
+    for scheme in ("secant", "exact"):
+        t0 = time.perf_counter()
+        with np.errstate(over="ignore", invalid="ignore"):
+            q, _ = numpy_solve(s, np.zeros((P, nd)), scheme=scheme, kstart=law.stiffness)
+        res[scheme] = (time.perf_counter() - t0, np.max(np.abs(q[:, out] - sol.q[:, out])))
+    d_batch = np.max(np.abs(bsol.output[0] - sol.q[:, out]))
+    print("Part 2: line-contact law (per-contact secant), 360 positions, strong baselines")
+    print(f"  gearte per-case solver (secant fixed point):   {t_case * 1e3:9.2f} ms")
+    print(f"  gearte batched kernel (exact-law Newton):      {t_batch * 1e3:9.2f} ms"
+          f"   (|Δ output angle| {d_batch:.1e} rad)")  # fmt: skip
+    for scheme, (t, d) in res.items():
+        print(f"  numpy active-set Newton, {scheme:6s}, vectorised: {t * 1e3:9.2f} ms"
+              f"   (|Δ output angle| {d:.1e} rad)")  # fmt: skip
+    for scheme, (t, _) in res.items():
+        print(f"  ratio numpy ({scheme}) / gearte per-case: {t / t_case:7.1f}x;"
+              f"  / gearte batched: {t / t_batch:7.1f}x")  # fmt: skip
+    print("  issue 12 goal: quasi-static >= 8x the numpy active-set Newton")
+
+
 def main() -> None:
     red = build_reducer(load_case("han2023_rv110e").reducer)
     T = red.rated_torque
@@ -83,11 +156,12 @@ def main() -> None:
 
     out = system.layout.output_rotation
     diff = np.max(np.abs(sol.q[:, out] - q_ref[:, out]))
-    print("RV quasi-static load sharing, han2023_rv110e with errors, 360 output positions")
+    print("Part 1: RV quasi-static load sharing, han2023_rv110e with errors, 360 output positions")
     print(f"  gearte (numba active-set Newton, warm start): {t_gearte * 1e3:9.2f} ms")
     print(f"  baseline (scipy fsolve per position, cold):    {t_base * 1e3:9.2f} ms")
     print(f"  ratio baseline/gearte: {t_base / t_gearte:8.1f}x")
     print(f"  max |output angle difference|: {diff:.2e} rad")
+    part2(red, system, T)
 
 
 if __name__ == "__main__":

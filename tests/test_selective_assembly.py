@@ -71,8 +71,9 @@ def test_part_contributions_equal_the_plain_loop_over_pairings(small):
     so equal to round-off — this also checks every orientation's bookkeeping."""
     design, lot4, model, table = small
     lot2 = _subset(lot4, [0, 1], [2, 3])
-    fast = sa.score_lot(design, lot2, model)
-    loop = sa.score_lot_loop(design, lot2, model)
+    fast = sa.score_lot(design, lot2, model, planet_indexings=2)
+    loop = sa.score_lot_loop(design, lot2, model, planet_indexings=2)
+    assert fast.pp.shape == (2, 6, 2, 6)
     np.testing.assert_allclose(fast.pp, loop.pp, rtol=1e-9, atol=1e-15)
 
 

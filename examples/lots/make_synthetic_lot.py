@@ -136,6 +136,7 @@ torque_Nm = 1078.0
 positions = 360
 te_spec_arcsec = 15.0
 objective = "count_in_spec"
+planet_indexings = 4     # ASSUMED: a planet can be mounted in 4 spline positions on its crank
 random_assemblies = 200
 seed = 1
 

@@ -25,6 +25,19 @@ def plot_stem(column: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", column).strip("_")
 
 
+def _readable(column: str) -> str:
+    """``"analysis.value [unit]"`` as people read it (``gearte.labels``), wrapped for an axis."""
+    import textwrap
+
+    from gearte.labels import label_with_unit
+
+    analysis, _, rest = column.partition(".")
+    text = label_with_unit(rest) if rest and "." not in rest else column
+    if rest and "." not in rest:
+        text = f"{text} ({analysis})"
+    return "\n".join(textwrap.wrap(text, 38)) or column
+
+
 def _num(v: Any) -> float:
     if v is None:
         return math.nan
@@ -83,7 +96,7 @@ def _panel(ax: Any, result: Any, column: str, key: str) -> str:
         if e:  # failed or invalid (skipped) points
             ax.axvline(x_pos[i], color="0.8", lw=0.8, ls=":")
     ax.set_xlabel(key if len(coupled) == 1 else f"{key} (with {', '.join(coupled[1:])})")
-    ax.set_ylabel(column)
+    ax.set_ylabel(_readable(column))
     ax.grid(True, alpha=0.3)
     return how
 

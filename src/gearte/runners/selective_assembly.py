@@ -16,7 +16,8 @@ Method (``docs/selective-assembly.md``)
    pairing's TE trace is ``θ0(θ) + t_disc(θ) + t_crank(θ)`` — its peak-to-peak for every disc
    set × orientation × crank set × orientation is one vectorised array operation.
 2. **Choose the orientation per pairing** (the best of disc slot order × disc indexing by
-   ``2π/M`` when ``z_c`` is a multiple of ``M`` × crank-to-bore indexing).
+   ``2π/M`` when ``z_c`` is a multiple of ``M`` × crank-to-bore indexing × planet indexing on
+   the crank splines, ``Q`` positions, the same for the reducer's planets).
 3. **Solve the assignment** exactly: for the most reducers in spec,
    :func:`scipy.optimize.linear_sum_assignment` on the cost ``pp/limit + BIG·[pp > limit]``
    (``BIG`` larger than any sum of in-spec costs: the count is maximised first, then the total
@@ -71,6 +72,7 @@ __all__ = [
     "assembled_reducer",
     "full_model_te",
     "pin_grades",
+    "check_reducer",
 ]
 
 
@@ -153,11 +155,18 @@ class Orientation:
         disc_index``; only when ``z_c`` is a multiple of ``M``) [-].
     crank_shift : int
         Crank ``(i − crank_shift) mod M`` of the set goes into carrier position ``i`` [-].
+    planet_index : int
+        Every planet turned on its crank's spline by ``planet_index · 2π/Q`` (planet phasing;
+        ``Q`` indexings, the same for the reducer's planets) [-].
+    planet_indexings : int
+        ``Q`` [-] (1: planets mounted as measured).
     """
 
     disc_shift: int = 0
     disc_index: int = 0
     crank_shift: int = 0
+    planet_index: int = 0
+    planet_indexings: int = 1
 
 
 def _disc_orientations(design: RVReducer) -> list[tuple[int, int]]:
@@ -194,14 +203,19 @@ def _oriented_discs(lot: Lot, k: int, shift: int, index: int, design: RVReducer)
     return discs, bores
 
 
-def _oriented_cranks(lot: Lot, k: int, shift: int) -> dict[str, np.ndarray | None]:
+def _oriented_cranks(
+    lot: Lot, k: int, shift: int, planet_turn: float = 0.0
+) -> dict[str, np.ndarray | None]:
     def roll(a):
         return None if a is None else np.roll(a[k], shift, axis=0)
 
+    planets = roll(lot.planet_runout)
+    if planets is not None and planet_turn:
+        planets = planets + np.array([0.0, planet_turn])  # high point turned with the planet
     return {
         "cam_eccentricity": roll(lot.cam_eccentricity),
         "cam_phase": roll(lot.cam_phase),
-        "planet_runout": roll(lot.planet_runout),
+        "planet_runout": planets,
         "cam_clearance": roll(lot.cam_clearance),
         "carrier_clearance": roll(lot.carrier_clearance),
     }
@@ -226,7 +240,8 @@ def assembled_reducer(
     discs, bores = _oriented_discs(
         lot, disc_set, orientation.disc_shift, orientation.disc_index, design
     )
-    cr = _oriented_cranks(lot, crank_set, orientation.crank_shift)
+    turn = 2.0 * np.pi * orientation.planet_index / orientation.planet_indexings
+    cr = _oriented_cranks(lot, crank_set, orientation.crank_shift, turn)
     return apply_measurements(design, discs=list(discs), disc_bores=bores, **cr)
 
 
@@ -365,12 +380,15 @@ class ScoreTable:
     ----------
     pp : (K_d, O_d, K_c, O_c) peak-to-peak of the loaded output angle error [rad].
     disc_orientations : list of (disc_shift, disc_index).
-    crank_orientations : list of crank_shift.
+    crank_orientations : list of (crank_shift, planet_index).
+    planet_indexings : int
+        ``Q`` of the planet indexing [-].
     """
 
     pp: np.ndarray
     disc_orientations: list[tuple[int, int]]
-    crank_orientations: list[int]
+    crank_orientations: list[tuple[int, int]]
+    planet_indexings: int = 1
 
     def best(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per pairing ``(K_d, K_c)``: the best peak-to-peak [rad] and its disc and crank
@@ -383,17 +401,19 @@ class ScoreTable:
     def orientation(self, od: int, oc: int) -> Orientation:
         """The :class:`Orientation` of orientation indices ``od``, ``oc``."""
         s, r = self.disc_orientations[od]
-        return Orientation(s, r, self.crank_orientations[oc])
+        c, q = self.crank_orientations[oc]
+        return Orientation(s, r, c, q, self.planet_indexings)
 
 
-def _contributions(design: RVReducer, lot: Lot, model: LinearTE):
+def _contributions(design: RVReducer, lot: Lot, model: LinearTE, planet_indexings: int = 1):
     """TE contributions ``t_disc (K_d, O_d, P)`` and ``t_crank (K_c, O_c, P)`` [rad]."""
     m, n, zc = design.cranks.count, design.discs.count, design.cycloid_teeth
     zp = design.pins.count
     sys0 = model.system
     P = sys0.theta.size
     d_orients = _disc_orientations(design)
-    c_orients = list(range(m))
+    q_max = planet_indexings if lot.planet_runout is not None else 1
+    c_orients = [(c, q) for c in range(m) for q in range(q_max)]
     u_bore = _unit_responses(design, model, "disc_bore", (n, m, 2))
     u_cam = _unit_responses(design, model, "cam", (m, n, 2))
     u_planet = _unit_responses(design, model, "planet", (m, 2))
@@ -426,10 +446,10 @@ def _contributions(design: RVReducer, lot: Lot, model: LinearTE):
                 err = bore_errors(bores, design.cranks.circle_radius)
                 t = t + np.einsum("jid,jidp->p", err, u_bore)
             t_disc[k, o] = t
-    t_crank = np.zeros((lot.crank_sets, m, P))
+    t_crank = np.zeros((lot.crank_sets, len(c_orients), P))
     for k in range(lot.crank_sets):
-        for o in c_orients:
-            cr = _oriented_cranks(lot, k, o)
+        for o, (c, q) in enumerate(c_orients):
+            cr = _oriented_cranks(lot, k, c, 2.0 * np.pi * q / planet_indexings)
             ecc, phase = cr["cam_eccentricity"], cr["cam_phase"]
             assert ecc is not None and phase is not None  # noqa: S101 - a lot always has cams
             cam = cam_errors(ecc, phase, design.cranks.eccentricity)
@@ -446,7 +466,9 @@ def _contributions(design: RVReducer, lot: Lot, model: LinearTE):
     return t_disc, t_crank, d_orients, c_orients
 
 
-def score_lot(design: RVReducer, lot: Lot, model: LinearTE) -> ScoreTable:
+def score_lot(
+    design: RVReducer, lot: Lot, model: LinearTE, planet_indexings: int = 1
+) -> ScoreTable:
     """TE peak-to-peak of every disc set × orientation × crank set × orientation (vectorised).
 
     Parameters
@@ -457,17 +479,23 @@ def score_lot(design: RVReducer, lot: Lot, model: LinearTE) -> ScoreTable:
         The measured parts.
     model : LinearTE
         :func:`linear_te_model` of the design.
+    planet_indexings : int
+        Spline indexings ``Q`` of the planets on their cranks to choose from [-] (1: none).
     """
+    if int(planet_indexings) != planet_indexings or not 1 <= planet_indexings <= 360:
+        raise ParameterError("planet_indexings", planet_indexings, "must be an integer 1..360")
     lot.check(design)
-    t_disc, t_crank, d_or, c_or = _contributions(design, lot, model)
+    t_disc, t_crank, d_or, c_or = _contributions(design, lot, model, planet_indexings)
     pp = np.empty((lot.disc_sets, len(d_or), lot.crank_sets, len(c_or)))
     for k in range(lot.disc_sets):
         x = model.base + t_disc[k][:, None, None, :] + t_crank[None]
         pp[k] = x.max(axis=-1) - x.min(axis=-1)
-    return ScoreTable(pp, d_or, c_or)
+    return ScoreTable(pp, d_or, c_or, planet_indexings)
 
 
-def score_lot_loop(design: RVReducer, lot: Lot, model: LinearTE) -> ScoreTable:
+def score_lot_loop(
+    design: RVReducer, lot: Lot, model: LinearTE, planet_indexings: int = 1
+) -> ScoreTable:
     """The plain baseline of :func:`score_lot`: one linearised evaluation per pairing and
     orientation, each building its reducer and its offsets with :func:`assemble` (what a user
     of the model without the separation into part contributions would write).
@@ -480,15 +508,18 @@ def score_lot_loop(design: RVReducer, lot: Lot, model: LinearTE) -> ScoreTable:
         The measured parts.
     model : LinearTE
         :func:`linear_te_model` of the design.
+    planet_indexings : int
+        As :func:`score_lot` [-].
     """
     d_or = _disc_orientations(design)
-    c_or = list(range(design.cranks.count))
+    q_max = planet_indexings if lot.planet_runout is not None else 1
+    c_or = [(c, q) for c in range(design.cranks.count) for q in range(q_max)]
     sys0 = model.system
     pp = np.empty((lot.disc_sets, len(d_or), lot.crank_sets, len(c_or)))
-    for kd, (od, (s, r)), kc, oc in itertools.product(
-        range(lot.disc_sets), enumerate(d_or), range(lot.crank_sets), c_or
+    for kd, (od, (s, r)), kc, (oc, (c, q)) in itertools.product(
+        range(lot.disc_sets), enumerate(d_or), range(lot.crank_sets), enumerate(c_or)
     ):
-        red = assembled_reducer(design, lot, kd, kc, Orientation(s, r, oc))
+        red = assembled_reducer(design, lot, kd, kc, Orientation(s, r, c, q, planet_indexings))
         err = red.error_set
         red = red.with_errors(dataclasses.replace(err, cam_clearance=None, carrier_clearance=None))
         s1 = assemble(red, sys0.theta)
@@ -502,7 +533,7 @@ def score_lot_loop(design: RVReducer, lot: Lot, model: LinearTE) -> ScoreTable:
             dc = err.carrier_clearance - design.cranks.carrier_bearing_clearance
             x = x + np.einsum("i,ip->p", dc, model.d_carrier_clearance)
         pp[kd, od, kc, oc] = x.max() - x.min()
-    return ScoreTable(pp, d_or, c_or)
+    return ScoreTable(pp, d_or, c_or, planet_indexings)
 
 
 # ---- assignment ----------------------------------------------------------------------------
@@ -716,3 +747,27 @@ def pin_grades(
         return None, backlash
     centre = 0.5 * (lo + hi)
     return int(inside[np.argmin(np.abs(backlash[inside] - centre))]), backlash
+
+
+def check_reducer(task: tuple) -> tuple[float, int | None, np.ndarray | None]:
+    """Full-model TE and pin grade of one assembled reducer (a task of
+    :func:`gearte.execution.map_chunks`; module level, so any backend can run it).
+
+    Parameters
+    ----------
+    task : tuple
+        ``(reducer, torque [N·mm], theta [rad], verify, grades [mm] or None, window [rad] or
+        None)``.
+
+    Returns
+    -------
+    (float, int or None, numpy.ndarray or None)
+        TE peak-to-peak of the full model [rad] (NaN when ``verify`` is false), the chosen grade
+        and the backlash of every grade [rad] (None without grades).
+    """
+    reducer, torque, theta, verify, grades, window = task
+    te = full_model_te(reducer, torque, theta) if verify else float("nan")
+    if grades is None or window is None:
+        return te, None, None
+    g, backlash = pin_grades(reducer, grades, window)
+    return te, g, backlash

@@ -44,6 +44,7 @@ __all__ = [
     "RVReducerYield",
     "RV_VECTOR_PARTS",
     "RV_PIN_FAMILIES",
+    "MODIFICATION_FAMILIES",
     "rv_error_keys",
     "GearChainLostMotion",
     "chain_tolerances",
@@ -185,6 +186,11 @@ RV_VECTOR_PARTS: tuple[str, ...] = (
     "disc_crank_bore",
     "cam",
     "carrier_crank_bore",
+    "disc_radial_runout",
+    "disc_cumulative_pitch",
+    "sun_eccentricity",
+    "sun_assembly",
+    "output_assembly",
 )
 #: Pin error families (``[reducer.pins]`` ``*_errors_um``), one value per pin [µm].
 RV_PIN_FAMILIES: tuple[str, ...] = (
@@ -192,23 +198,38 @@ RV_PIN_FAMILIES: tuple[str, ...] = (
     "radial_position_errors",
     "tangential_position_errors",
 )
+#: Per-disc modification error families (``[reducer.discs]`` ``*_modification_errors_um``), one
+#: value per disc [µm]: ``discs.equidistant_modification_errors.d<j>`` …
+MODIFICATION_FAMILIES: tuple[str, ...] = (
+    "discs.equidistant_modification_errors",
+    "discs.shift_modification_errors",
+)
 
 
 def rv_error_keys(reducer) -> dict[str, list[str]]:
     """Error family → the keys of its instances for this reducer.
 
     ``planet_base_circle.c<i>``, ``disc_crank_bore.c<i>.d<j>``, ``cam.c<i>.d<j>``,
-    ``carrier_crank_bore.c<i>`` (crank ``i``, disc ``j``, 1-based as in the case file) and
-    ``pins.radius_errors.p<k>`` … for every pin ``k`` (families ``pins.radius_errors`` …).
+    ``carrier_crank_bore.c<i>``, ``disc_radial_runout.d<j>``, ``disc_cumulative_pitch.d<j>``
+    (crank ``i``, disc ``j``, 1-based as in the case file), ``sun_eccentricity``,
+    ``sun_assembly``, ``output_assembly`` (one instance: the family key itself; the part names
+    of ``[[reducer.errors]]``), ``pins.radius_errors.p<k>`` … for every pin ``k`` (families
+    ``pins.radius_errors`` …) and ``discs.equidistant_modification_errors.d<j>``,
+    ``discs.shift_modification_errors.d<j>`` (the per-disc modification errors of
+    ``[reducer.discs]``).
     """
     m, n, zp = reducer.cranks.count, reducer.discs.count, reducer.pins.count
-    cr = range(1, m + 1)
+    cr, dr = range(1, m + 1), range(1, n + 1)
     return {
         "planet_base_circle": [f"planet_base_circle.c{i}" for i in cr],
-        "disc_crank_bore": [f"disc_crank_bore.c{i}.d{j}" for i in cr for j in range(1, n + 1)],
-        "cam": [f"cam.c{i}.d{j}" for i in cr for j in range(1, n + 1)],
+        "disc_crank_bore": [f"disc_crank_bore.c{i}.d{j}" for i in cr for j in dr],
+        "cam": [f"cam.c{i}.d{j}" for i in cr for j in dr],
         "carrier_crank_bore": [f"carrier_crank_bore.c{i}" for i in cr],
+        "disc_radial_runout": [f"disc_radial_runout.d{j}" for j in dr],
+        "disc_cumulative_pitch": [f"disc_cumulative_pitch.d{j}" for j in dr],
+        **{k: [k] for k in ("sun_eccentricity", "sun_assembly", "output_assembly")},
         **{f"pins.{f}": [f"pins.{f}.p{k}" for k in range(1, zp + 1)] for f in RV_PIN_FAMILIES},
+        **{f: [f"{f}.d{j}" for j in dr] for f in MODIFICATION_FAMILIES},
     }
 
 
@@ -228,13 +249,17 @@ class RVReducerYield:
         The unloaded (geometric) TE is solved at this fraction of ``te_torque``.
     lost_motion_fraction : float
         Lost motion read at ± this fraction of the rated torque (catalogue: 0.03).
+    batched : bool
+        Solve a batch of samples in one compiled call (:mod:`gearte.runners.rv_yield_batch`,
+        :mod:`gearte.solvers.rv_batch`; the same physics and algorithm, equal to round-off);
+        ``False``: each sample on its own through :meth:`one`.
 
     Notes
     -----
     A drawn error replaces the reducer's value of that instance; an error not drawn keeps it.
-    Each sample is solved on its own (the quasi-static solver of
-    :mod:`gearte.solvers.rv_equilibrium`): 14 torque levels for the catalogue values and
-    ``2 × positions`` positions for the TE.
+    Per sample: the 16 torque levels of the catalogue's virtual loop and ``2 × positions``
+    positions for the TE (the quasi-static load-sharing equilibrium of
+    :mod:`gearte.models.rv_load_sharing`).
 
     Outputs: ``"lost_motion [arcmin]"``, ``"torsional_rigidity [Nm/arcmin]"``,
     ``"backlash [arcmin]"``, ``"hysteresis_loss [arcmin]"``, ``"angular_te [arcmin]"``
@@ -256,6 +281,7 @@ class RVReducerYield:
         te_torque: float | None = None,
         zero_load_fraction: float = 1e-3,
         lost_motion_fraction: float = 0.03,
+        batched: bool = True,
     ) -> None:
         from gearte.errors import ParameterError
         from gearte.models.rv_load_sharing import output_positions
@@ -268,17 +294,19 @@ class RVReducerYield:
         self.zero_load_fraction = float(zero_load_fraction)
         self.lost_motion_fraction = float(lost_motion_fraction)
         self.keys = rv_error_keys(reducer)
+        self.batched = bool(batched)
+        self.vector_parts = RV_VECTOR_PARTS
+        self.modification_families = MODIFICATION_FAMILIES
 
     def reducer_for(self, errors: Mapping[str, float]):
         """The assembled reducer of one sample (errors [µm], phases [rad])."""
-        from gearte.geometry.rv import ManufacturingErrors
+        import dataclasses
 
         red = self.reducer
         e0 = red.errors
-        planet = e0.planet.copy()
-        disc = e0.disc_bore.copy()
-        cam = e0.cam.copy()
-        carrier = e0.carrier_bore.copy()
+        names = ("planet", "disc_bore", "cam", "carrier_bore", "sun", "sun_seat", "output_seat",
+                 "disc_runout", "disc_pitch", "disc_modification")  # fmt: skip
+        arr = {n: np.array(getattr(e0, n), dtype=float, copy=True) for n in names}
 
         def vec(key: str) -> np.ndarray | None:
             if key not in errors:
@@ -287,27 +315,42 @@ class RVReducerYield:
             ph = float(errors.get(f"{key}_phase_rad", 0.0))
             return r * np.array([np.cos(ph), np.sin(ph)])
 
+        for name, key in (
+            ("sun", "sun_eccentricity"),
+            ("sun_seat", "sun_assembly"),
+            ("output_seat", "output_assembly"),
+        ):
+            if (v := vec(key)) is not None:
+                arr[name][:] = v
         for i in range(red.cranks.count):
             if (v := vec(f"planet_base_circle.c{i + 1}")) is not None:
-                planet[i] = v
+                arr["planet"][i] = v
             if (v := vec(f"carrier_crank_bore.c{i + 1}")) is not None:
-                carrier[i] = v
+                arr["carrier_bore"][i] = v
             for j in range(red.discs.count):
                 if (v := vec(f"disc_crank_bore.c{i + 1}.d{j + 1}")) is not None:
-                    disc[j, i] = v
+                    arr["disc_bore"][j, i] = v
                 if (v := vec(f"cam.c{i + 1}.d{j + 1}")) is not None:
-                    cam[i, j] = v
-        red = red.with_errors(ManufacturingErrors(planet, disc, cam, carrier))
+                    arr["cam"][i, j] = v
+        for j in range(red.discs.count):
+            if (v := vec(f"disc_radial_runout.d{j + 1}")) is not None:
+                arr["disc_runout"][j] = v
+            if (v := vec(f"disc_cumulative_pitch.d{j + 1}")) is not None:
+                arr["disc_pitch"][j] = v
+            for col, fam in enumerate(MODIFICATION_FAMILIES):
+                if (key := f"{fam}.d{j + 1}") in errors:
+                    arr["disc_modification"][j, col] = float(um_to_mm(errors[key]))
+        red = red.with_errors(dataclasses.replace(e0, **arr))
         pins = red.pins
         changed = {}
         for f in RV_PIN_FAMILIES:
             keys = self.keys[f"pins.{f}"]
             if any(k in errors for k in keys):
-                arr = np.asarray(getattr(pins, f), dtype=float).copy()
+                a = np.asarray(getattr(pins, f), dtype=float).copy()
                 for k, key in enumerate(keys):
                     if key in errors:
-                        arr[k] = float(um_to_mm(errors[key]))
-                changed[f] = arr
+                        a[k] = float(um_to_mm(errors[key]))
+                changed[f] = a
         if changed:
             from dataclasses import replace
 
@@ -351,6 +394,10 @@ class RVReducerYield:
 
     def __call__(self, errors: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         n = _n(errors)
+        if self.batched and errors and n > 0:
+            from gearte.runners.rv_yield_batch import batch_quantities
+
+            return batch_quantities(self, errors, n)
         rows = []
         for s in range(n):
             e = {k: float(v[s]) for k, v in errors.items()}

@@ -70,6 +70,12 @@ class ToleranceEntry(StrictModel):
     tolerance_deg: float | None = Field(
         default=None, ge=0, le=360, description="Tolerance of an angle error [deg]."
     )
+    tolerance_arcmin: float | None = Field(
+        default=None,
+        ge=0,
+        le=21_600,
+        description="Tolerance of an angle in arcmin (a gear_chain stage's lost motion) [arcmin].",
+    )
     grade: int | None = Field(
         default=None,
         ge=1,
@@ -89,6 +95,12 @@ class ToleranceEntry(StrictModel):
         le=360,
         description="Mean of an angle error [deg]; default: the case's value of that error.",
     )
+    nominal_arcmin: float | None = Field(
+        default=None,
+        ge=-21_600,
+        le=21_600,
+        description="Mean of an angle in arcmin [arcmin]; default: the case's value.",
+    )
     sigmas: float | None = Field(
         default=None,
         gt=0,
@@ -107,9 +119,11 @@ class ToleranceEntry(StrictModel):
 
     @model_validator(mode="after")
     def _one_unit(self) -> ToleranceEntry:
-        given = [self.tolerance_um, self.tolerance_deg, self.grade]
+        given = [self.tolerance_um, self.tolerance_deg, self.tolerance_arcmin, self.grade]
         if sum(v is not None for v in given) != 1:
-            raise ValueError("give exactly one of tolerance_um, tolerance_deg and grade")
+            raise ValueError(
+                "give exactly one of tolerance_um, tolerance_deg, tolerance_arcmin and grade"
+            )
         if self.phase and self.kind != "rayleigh":
             raise ValueError("phase = true goes with kind = 'rayleigh' only")
         if self.kind == "empirical" and self.values_um is None:
@@ -118,7 +132,9 @@ class ToleranceEntry(StrictModel):
 
     @property
     def unit(self) -> str:
-        return "deg" if self.tolerance_deg is not None else "um"
+        if self.tolerance_deg is not None:
+            return "deg"
+        return "arcmin" if self.tolerance_arcmin is not None else "um"
 
 
 class GroupEntry(StrictModel):
@@ -263,7 +279,7 @@ def _tolerances(
     # a family's tolerance stands for each of its instances (an instance may be given itself)
     expanded: dict[str, tuple[ToleranceEntry, str | None]] = {}
     for key, t in given.items():
-        if key in families:
+        if key in families and list(families[key]) != [key]:  # (a one-instance family is a key)
             for inst in families[key]:
                 if inst not in given:
                     expanded[inst] = (t, key)
@@ -284,7 +300,7 @@ def _tolerances(
                 t.unit,
                 f"this error is in {units[ukey]}: give tolerance_{units[ukey]}",
             )
-        tol = t.tolerance_um if t.unit == "um" else t.tolerance_deg
+        tol = {"um": t.tolerance_um, "deg": t.tolerance_deg, "arcmin": t.tolerance_arcmin}[t.unit]
         if t.grade is not None:
             tol = None if grade_um is None else grade_um(ukey, t.grade)
             if tol is None:
@@ -293,7 +309,7 @@ def _tolerances(
                     t.grade,
                     "this error is not a gear's eccentricity: give tolerance_um",
                 )
-        nom = t.nominal_um if t.unit == "um" else t.nominal_deg
+        nom = {"um": t.nominal_um, "deg": t.nominal_deg, "arcmin": t.nominal_arcmin}[t.unit]
         tols.append(
             Tolerance(
                 key,

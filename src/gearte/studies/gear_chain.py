@@ -28,6 +28,10 @@ Optional ``[compensation]``: stages compensated by their mean return error when 
 reverses; motor offset (eq. 33), residual per stage, joint and end error after it. It acts on
 the chain after the shim when there is one (the paper's order).
 
+Optional ``[analyses.yield]``: each stage's lost motion drawn from its distribution (its model's
+tolerance stack, or its min/mean/max, or constant), combined at the joint by eq. (30) by
+Monte-Carlo — the joint's distribution, yield, Cpk and contributions (``gearte.studies._yield``).
+
 Analyses: one group per stage (``<stage>_backlash`` …, see ``gear_pair``), ``chain``
 (``joint_lost_motion_max [arcmin]``, ``end_effector_error_max [mm]``), ``shim``
 (``shim_thickness [mm]`` …), ``compensation`` (``motor_compensation_angle [deg]``,
@@ -38,7 +42,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
@@ -56,6 +60,7 @@ from gearte.models.lost_motion import (
 )
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies._drives import DriveSpec
+from gearte.studies._yield import YieldSection
 from gearte.studies.gear_pair import PairAnalysisSpec, PairSpec, analyse_pair
 from gearte.units import (
     Nmm_to_Nm,
@@ -329,11 +334,27 @@ class CompensationSpec(StrictModel):
     )
 
 
+class ChainAnalyses(StrictModel):
+    """``[analyses]`` of a chain: ``[analyses.yield]`` (gearte.studies._yield)."""
+
+    yield_: YieldSection | None = Field(
+        default=None,
+        alias="yield",
+        description="production yield of the chain: each stage's lost motion drawn from its "
+        "distribution, combined at the joint by eq. (30); tolerance keys are the stage names "
+        "(tolerance_arcmin, nominal_arcmin at the stage output) and, for a pair stage, its "
+        "backlash stack's contributors <stage slug>.<contributor> [µm] (e.g. "
+        "spur_pair.centre_distance; spur_pair.driven_gear_eccentricity takes grade = N: "
+        "ISO 1328-2 F_i″)",
+    )
+
+
 class Case(CaseBase):
     chain: ChainSpec
     analysis: PairAnalysisSpec = PairAnalysisSpec()
     shim: ShimSpec | None = None
     compensation: CompensationSpec | None = None
+    analyses: ChainAnalyses | None = None
 
     @model_validator(mode="after")
     def _shim_target(self):
@@ -563,6 +584,124 @@ def _round_shim(x: float, step: float, how: str) -> float:
     return k * step
 
 
+def _stage_tolerances(case: Case, stages, drives: dict, backlash: dict) -> dict:
+    """Each stage's lost-motion law at its output [arcmin], as ``[analyses.yield]`` entries.
+
+    A stage whose model has a tolerance stack (a pair, a cycloid stage) is normal with the
+    stack's mean and σ (tolerance = 3σ); a stage given by min/mean/max values is normal about
+    its mean with σ = (max − min)/(2z) at the case's confidence (the reading of
+    ``joint_lost_motion_statistical_max``); a stage with a single value (a catalogue maximum, a
+    deterministic reducer) is constant at it.
+    """
+    from gearte.studies._yield import ToleranceEntry
+    from gearte.tolerance.stackup import z_for_confidence
+
+    conf = case.analysis.confidence
+    z = z_for_confidence(conf)
+    specs = {st.name: st for st in case.chain.stages}
+    out: dict[str, ToleranceEntry] = {}
+    for s in stages:
+        st = specs[s.name]
+        spread = None
+        if s.name in drives and st.lost_motion_max_arcmin is None:
+            spread = drives[s.name].lost_motion_spread(conf)
+        elif s.name in backlash and backlash[s.name][3] is not None:
+            spread = _pair_drive(st, backlash[s.name][3]).lost_motion_spread(conf)
+        if spread is not None:
+            out[s.name] = ToleranceEntry(
+                kind="normal",
+                tolerance_arcmin=float(rad_to_arcmin(3.0 * spread.sd)),
+                nominal_arcmin=float(rad_to_arcmin(spread.mean)),
+            )
+        elif s.mean is not None and s.min is not None and s.max > s.min:
+            out[s.name] = ToleranceEntry(
+                kind="normal",
+                tolerance_arcmin=float(rad_to_arcmin(3.0 * (s.max - s.min) / (2.0 * z))),
+                nominal_arcmin=float(rad_to_arcmin(s.mean)),
+            )
+        else:
+            out[s.name] = ToleranceEntry(
+                kind="constant", tolerance_arcmin=0.0, nominal_arcmin=float(rad_to_arcmin(s.max))
+            )
+    return out
+
+
+def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> AnalysisResult:
+    """``[analyses.yield]``: each sample one assembled chain, combined at the joint by eq. (30).
+
+    A pair stage (``[pair]`` or a ``gear_pair`` drive) draws every contributor of its own
+    backlash stack (keys ``<stage slug>.<contributor>`` [µm]; gearte.runners.chain_yield) unless
+    the section gives a law for the whole stage by its name; every other stage draws its lost
+    motion from its law (:func:`_stage_tolerances`, key: the stage name [arcmin]). Yield against
+    ``[analyses.yield.spec]`` (``"joint_lost_motion [arcmin]"``, ``"<slug>.lost_motion
+    [arcmin]"``, ``"end_effector_error [mm]"``), contributions per tolerance.
+    """
+    from gearte.models.backlash import SpurPair
+    from gearte.runners.chain_yield import ChainStage, GearChainYield, stack_terms
+    from gearte.studies._yield import ToleranceEntry, yield_analysis
+    from gearte.tolerance.iso1328 import radial_composite_tolerances
+
+    sec = case.analyses.yield_ if case.analyses is not None else None
+    assert sec is not None
+    defaults = _stage_tolerances(case, stages, drives, backlash)
+    units = {s.name: "arcmin" for s in stages}
+    nominal = {k: float(t.nominal_arcmin or 0.0) for k, t in defaults.items()}
+    chain: list[ChainStage] = []
+    pairs: dict[str, tuple[Any, str]] = {}
+    for s in stages:
+        slug = _slug(s.name)
+        pair = getattr(drives.get(s.name), "pair", None)
+        if s.name in backlash and backlash[s.name][3] is not None:
+            pair = backlash[s.name][3]
+        if pair is None or s.name in sec.tolerances:
+            chain.append(ChainStage(s.name, slug, s.ratio))
+            continue
+        del defaults[s.name], units[s.name], nominal[s.name]
+        terms, laws = stack_terms(slug, pair.backlash_stack())
+        chain.append(
+            ChainStage(s.name, slug, s.ratio, terms, pair.output_diameter, pair.pressure_angle)
+        )
+        for key, (kind, tol, mu) in laws.items():
+            units[key], nominal[key] = "um", mu
+            defaults[key] = ToleranceEntry(
+                kind=kind,
+                tolerance_um=tol,
+                nominal_um=mu,
+                sigmas=6.0 if kind == "rayleigh" else None,
+                phase=kind == "rayleigh",
+            )
+            pairs[key] = (pair, "driving" if ".driving_gear" in key else "driven")
+
+    def grade_um(key: str, grade: int) -> float | None:
+        """A spur gear's eccentricity: its ISO 1328-2 total radial composite tolerance F_i″."""
+        if not key.endswith("_gear_eccentricity") or key not in pairs:
+            return None
+        pair, which = pairs[key]
+        if not isinstance(pair, SpurPair):
+            return None
+        teeth = getattr(pair, which).teeth
+        return radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
+
+    res = yield_analysis(
+        sec,
+        GearChainYield(chain, nominal, case.chain.lever_length_mm),
+        units,
+        nominal,
+        options=options,
+        references=["jiang2024"],
+        defaults=defaults,
+        grade_um=grade_um,
+    )
+    res.notes.append(
+        "Chain yield: a pair stage draws its backlash stack contributor by contributor "
+        "(eccentricities and run-out: Rayleigh magnitude, σx = t/6 as Jiang 2024, uniform "
+        "direction, entering as r sin φ) → eq. (14)/(29), clipped at 0; other stages' lost "
+        "motion from their law (drive spread, min/mean/max, or constant); joint = Σ stage lost "
+        "motion / downstream ratios (eq. 30), sample by sample."
+    )
+    return res
+
+
 def run(case: Case, options) -> StudyResult:
     """Run a ``gear_chain`` case: each stage's lost motion, the joint and end-effector error,
     shim and motor compensation; no I/O, no plotting.
@@ -706,6 +845,8 @@ def run(case: Case, options) -> StudyResult:
 
     if case.chain.te_positions is not None:
         analyses.append(_chain_te(case, drives))
+    if case.analyses is not None and case.analyses.yield_ is not None:
+        analyses.append(_chain_yield(case, stages, drives, backlash, options))
 
     # -- shim (eq. 32) ---------------------------------------------------------------------------
     comp_stages = stages

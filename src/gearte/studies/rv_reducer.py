@@ -600,10 +600,13 @@ class ToothContactSection(StrictModel):
 
 class RVYieldSection(YieldSection):
     """``[analyses.yield]`` of an RV reducer (gearte.studies._yield): tolerance keys are the
-    error families ``planet_base_circle``, ``disc_crank_bore``, ``cam``, ``carrier_crank_bore``
-    (magnitude [µm], ``kind = "rayleigh"``, ``phase = true`` for a uniform direction),
-    ``pins.radius_errors``, ``pins.radial_position_errors``, ``pins.tangential_position_errors``
-    [µm], or one instance (``cam.c1.d2``, ``pins.radius_errors.p7``)."""
+    error families ``planet_base_circle``, ``disc_crank_bore``, ``cam``, ``carrier_crank_bore``,
+    ``disc_radial_runout``, ``disc_cumulative_pitch``, ``sun_eccentricity``, ``sun_assembly``,
+    ``output_assembly`` (magnitude [µm], ``kind = "rayleigh"``, ``phase = true`` for a uniform
+    direction), ``pins.radius_errors``, ``pins.radial_position_errors``,
+    ``pins.tangential_position_errors``, ``discs.equidistant_modification_errors``,
+    ``discs.shift_modification_errors`` [µm], or one instance (``cam.c1.d2``,
+    ``pins.radius_errors.p7``, ``disc_radial_runout.d1``)."""
 
     positions: int = Field(default=36, ge=2, le=3600, description="TE output positions")
     te_torque_Nm: float | None = Field(
@@ -1164,7 +1167,13 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
     """``[analyses.yield]``: each sample one assembled reducer (errors drawn from the
     tolerances; errors without a tolerance keep the case's values) → catalogue test, angular TE
     over one output revolution, peak pin load; yield against ``[analyses.yield.spec]``."""
-    from gearte.runners.yield_models import RV_PIN_FAMILIES, RVReducerYield, rv_error_keys
+    from gearte.runners.yield_models import (
+        MODIFICATION_FAMILIES,
+        RV_PIN_FAMILIES,
+        RV_VECTOR_PARTS,
+        RVReducerYield,
+        rv_error_keys,
+    )
     from gearte.studies._yield import yield_analysis
 
     model = RVReducerYield(
@@ -1178,21 +1187,29 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
     def worst_case(errors):
         d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
         entries = {(e["part"], e.get("crank"), e.get("disc")): e for e in d["reducer"]["errors"]}
-        for part in ("planet_base_circle", "disc_crank_bore", "cam", "carrier_crank_bore"):
+        for part in RV_VECTOR_PARTS:
             for key in families[part]:
                 if key not in errors:
                     continue
-                idx = key.split(".")[1:]
-                crank = int(idx[0][1:])
-                disc = int(idx[1][1:]) if len(idx) > 1 else None
+                idx = {i[0]: int(i[1:]) for i in key.split(".")[1:]}  # c<i>, d<j>
+                crank, disc = idx.get("c"), idx.get("d")
                 name = "planet_eccentricity" if part == "planet_base_circle" else part
-                entry = {"part": name, "crank": crank, "value_um": float(errors[key])}
+                entry = {"part": name, "value_um": float(errors[key])}
+                if crank is not None:
+                    entry["crank"] = crank
                 if disc is not None:
                     entry["disc"] = disc
                 phase = float(errors.get(f"{key}_phase_rad", 0.0))
                 entry["angle_deg"] = float(np.mod(rad_to_deg(phase) + 180.0, 360.0) - 180.0)
                 entries[(name, crank, disc)] = entry
         d["reducer"]["errors"] = list(entries.values())
+        discs = d["reducer"]["discs"]
+        for fam in MODIFICATION_FAMILIES:
+            keys = families[fam]
+            if any(k in errors for k in keys):
+                name = fam.split(".")[1] + "_um"
+                old = discs.get(name) or [0.0] * len(keys)
+                discs[name] = [float(errors.get(k, old[i])) for i, k in enumerate(keys)]
         pins = d["reducer"]["pins"]
         for f in RV_PIN_FAMILIES:
             keys = families[f"pins.{f}"]

@@ -1,0 +1,258 @@
+"""Plain numpy baselines of the RV quasi-static equilibrium, for the benchmarks.
+
+What a competent numpy user would write for the same physics as
+:mod:`gearte.solvers.rv_equilibrium` / :mod:`gearte.solvers.rv_batch` (linear springs and
+unilateral pin contacts with the log law ``δ(F) = F (a0 − a1 ln F)``; clearance bearings are not
+coded, the benchmarked case has none): an active-set Newton method with a backtracking line
+search on the potential, **vectorised over a batch of independent systems** (samples of a
+yield study at one step, or all output positions of one reducer): dense rows, batched
+``np.matmul`` for the Hessians, batched ``np.linalg.solve``, masks for the systems still
+iterating. Two contact-stiffness schemes:
+
+* ``"exact"``: Newton on the exact law (tangent ``1/δ'(F)``, forces from a vectorised scalar
+  Newton) — the algorithm of gearte's batched kernel;
+* ``"secant"``: the per-contact secant fixed point around the active-set Newton with frozen
+  stiffness — the algorithm of gearte's per-case solver.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def law_force(d, a0, a1, guess=None):
+    """F with F (a0 − a1 ln F) = d > 0, elementwise (vectorised monotone Newton on the entries
+    not yet converged)."""
+    d, a0, a1 = np.broadcast_arrays(d, a0, a1)
+    F = d / np.maximum(a0 - a1 * np.log(np.maximum(d / a0, 1e-300)), 1e-300)
+    if guess is not None:
+        F = np.where(guess > 0, guess, F)
+    F = F.ravel().copy()
+    d, a0, a1 = d.ravel(), a0.ravel(), a1.ravel()
+    idx = np.arange(F.size)
+    for _ in range(100):
+        if idx.size == 0:
+            break
+        f, dd, b0, b1 = F[idx], d[idx], a0[idx], a1[idx]
+        lf = np.log(f)
+        gp = b0 - b1 * lf - b1
+        fn = np.where(gp > 0, f - (f * (b0 - b1 * lf) - dd) / np.where(gp > 0, gp, 1.0), 0.5 * f)
+        fn = np.where(fn > 0, fn, 0.1 * f)
+        F[idx] = fn
+        idx = idx[np.abs(fn - f) > 1e-15 * f]
+    return F.reshape(d.shape) if d.ndim == 1 else F
+
+
+class Systems:
+    """A batch of ``B`` systems: ``K0`` (B, nd, nd) or one shared (nd, nd), ``Bc`` (B, nc, nd)
+    or shared (nc, nd), ``f0`` (B, nd), ``gap`` (B, nc), ``a0, a1`` (B, nc) or shared (nc,).
+    Shared matrices go through single BLAS products (``q @ K0``, ``w @ (B ⊗ B)``)."""
+
+    def __init__(self, K0, Bc, f0, gap, a0, a1):
+        self.K0, self.Bc, self.f0, self.gap, self.a0, self.a1 = K0, Bc, f0, gap, a0, a1
+        self.shared = K0.ndim == 2
+        if self.shared:
+            nc, nd = Bc.shape
+            self.BB = np.einsum("ca,cb->cab", Bc, Bc).reshape(nc, nd * nd)
+            self.reg = 1e-13 * np.abs(np.diag(K0)).max()
+        else:
+            self.reg = 1e-13 * np.abs(np.diagonal(K0, axis1=1, axis2=2)).max(axis=1)
+
+    def take(self, i):
+        s = Systems.__new__(Systems)
+        s.shared = self.shared
+        names = ("f0", "gap") if self.shared else ("K0", "Bc", "f0", "gap", "a0", "a1", "reg")
+        for k in ("K0", "Bc", "f0", "gap", "a0", "a1", "reg", "BB"):
+            if hasattr(self, k):
+                setattr(s, k, getattr(self, k)[i] if k in names else getattr(self, k))
+        return s
+
+    def Kq(self, q):
+        return q @ self.K0 if self.shared else np.matmul(self.K0, q[..., None])[..., 0]
+
+    def Bq(self, q):
+        return q @ self.Bc.T if self.shared else np.matmul(self.Bc, q[..., None])[..., 0]
+
+    def BtF(self, F):
+        return F @ self.Bc if self.shared else np.matmul(F[:, None, :], self.Bc)[:, 0]
+
+    def hessian(self, w):
+        nd = self.f0.shape[1]
+        if self.shared:
+            return self.K0 + (w @ self.BB).reshape(-1, nd, nd) + self.reg * np.eye(nd)
+        H = self.K0 + np.matmul(self.Bc.transpose(0, 2, 1) * w[:, None, :], self.Bc)
+        return H + self.reg[:, None, None] * np.eye(nd)
+
+
+def _approach(s, q):
+    return s.Bq(q) - s.gap
+
+
+def _energy_exact(s, q, F):
+    d = _approach(s, q)
+    act = d > 0
+    a0 = np.broadcast_to(s.a0, d.shape)[act]
+    a1 = np.broadcast_to(s.a1, d.shape)[act]
+    dd = d[act]
+    dmax = a1 * np.exp(np.minimum((a0 - a1) / a1, 700.0))  # the law's range ends at δ(F*)
+    inside = dd < dmax
+    f = np.ones(dd.shape)
+    f[inside] = law_force(dd[inside], a0[inside], a1[inside], F[act][inside])
+    Fn = np.zeros(d.shape)
+    Fn[act] = f
+    phi = np.zeros(d.shape)
+    phi[act] = np.where(inside, f * f * (0.5 * a0 - 0.5 * a1 * np.log(f) - 0.25 * a1), np.inf)
+    e = np.sum(q * (0.5 * s.Kq(q) - s.f0), axis=1)
+    return e + phi.sum(axis=1), Fn, d
+
+
+def _energy_secant(s, q, kc):
+    d = _approach(s, q)
+    dp = np.maximum(d, 0.0)
+    e = np.sum(q * (0.5 * s.Kq(q) - s.f0), axis=1)
+    return e + 0.5 * np.sum(kc * dp * dp, axis=1), d
+
+
+def newton(s, q, F=None, kc=None, scheme="exact", tol=1e-13, maxit=100):
+    """Active-set Newton for every system of ``s`` from ``q`` (B, nd); returns (q, F, kc)."""
+    B, nd = q.shape
+    q = q.copy()
+    F = np.zeros(s.gap.shape) if F is None else F.copy()
+    live = np.arange(B)
+    if scheme == "exact":
+        e0, F, d = _energy_exact(s, q, F)
+    else:
+        e0, d = _energy_secant(s, q, kc)
+    for _ in range(maxit):
+        if live.size == 0:
+            break
+        t = s.take(live)
+        ql, dl, el = q[live], d[live], e0[live]
+        if scheme == "exact":
+            Fl = F[live]
+            act = dl > 0
+            Fs = np.where(act, Fl, 1.0)
+            w = np.where(act, 1.0 / (t.a0 - t.a1 * np.log(Fs) - t.a1), 0.0)
+            force = Fl
+        else:
+            act = dl > 0
+            w = np.where(act, kc[live], 0.0)
+            force = w * dl
+        H = t.hessian(w)
+        g = t.Kq(ql) - t.f0 + t.BtF(force)
+        dq = -np.linalg.solve(H, g[..., None])[..., 0]
+        step = np.ones(live.size)
+        accepted = np.zeros(live.size, bool)
+        qn, e1 = ql + dq, el.copy()
+        Fn, dn = (Fl.copy() if scheme == "exact" else None), dl.copy()
+        pend = np.arange(live.size)
+        for _ls in range(60):
+            tt = t.take(pend)
+            qt = ql[pend] + step[pend, None] * dq[pend]
+            if scheme == "exact":
+                with np.errstate(over="ignore", invalid="ignore"):
+                    et, Ft, dt = _energy_exact(tt, qt, Fl[pend])
+            else:
+                et, dt = _energy_secant(tt, qt, kc[live][pend])
+            ok = et <= el[pend] + 1e-12 * np.abs(el[pend])
+            idx = pend[ok]
+            accepted[idx] = True
+            qn[idx], e1[idx], dn[idx] = qt[ok], et[ok], dt[ok]
+            if scheme == "exact":
+                Fn[idx] = Ft[ok]
+            pend = pend[~ok]
+            if pend.size == 0:
+                break
+            step[pend] *= 0.5
+        stalled = el - e1 <= 1e-14 * np.abs(el)
+        same = np.all((dn > 0) == (dl > 0), axis=1)
+        big = np.max(np.abs(step[:, None] * dq), axis=1)
+        q[live] = np.where(accepted[:, None], qn, ql)
+        d[live] = np.where(accepted[:, None], dn, dl)
+        e0[live] = np.where(accepted, e1, el)
+        if scheme == "exact":
+            F[live] = np.where(accepted[:, None], Fn, Fl)
+            done = ~accepted | (big < tol) | (same & (step == 1.0) & (big < 1e-9))
+        else:
+            done = ~accepted | (big < tol) | (same & (step == 1.0)) | (same & stalled)
+        live = live[~done]
+    if scheme == "exact":
+        F = np.where(d > 0, F, 0.0)
+    return q, F, d
+
+
+def solve(s, q0, scheme="exact", kstart=2.0e5, tol=1e-9):
+    """Equilibrium of every system; ``"secant"`` iterates the per-contact secant stiffness to a
+    relative change below ``tol``. Returns (q, F)."""
+    if scheme == "exact":
+        q, F, _ = newton(s, q0, F=None, scheme="exact")
+        return q, F
+    B = q0.shape[0]
+    kc = np.full(s.gap.shape, kstart)
+    q = q0.copy()
+    live = np.arange(B)
+    F = np.zeros(s.gap.shape)
+    for _ in range(200):
+        if live.size == 0:
+            break
+        t = s.take(live)
+        ql, _, d = newton(t, q[live], kc=kc[live], scheme="secant")
+        q[live] = ql
+        f = kc[live] * np.maximum(d, 0.0)
+        F[live] = f
+        fs = np.where(f > 0, f, 1.0)
+        knew = np.where(f > 0, 1.0 / (t.a0 - t.a1 * np.log(fs)), kc[live])
+        change = np.max(np.abs(knew / kc[live] - 1.0), axis=1)
+        kc[live] = knew
+        live = live[change >= tol]
+    return q, F
+
+
+def dense_rows(sparse, nd):
+    """Dense (G, R, nd) rows from :class:`gearte.solvers.rv_batch.SparseRows`."""
+    G, R, W = sparse.value.shape
+    out = np.zeros((G, R, nd))
+    for r in range(R):
+        for w in range(W):
+            out[:, r, sparse.index[r, w]] += sparse.value[:, r, w]
+    return out
+
+
+def solve_batch_numpy(problem, h, en, gap, step_g, step_T, cold, record, exact=True, **_):
+    """Drop-in for :func:`gearte.solvers.rv_batch.solve_batch`: every step solved for all
+    samples at once (vectorised over samples), warm-started along each sequence like gearte."""
+    from gearte.solvers.rv_batch import BatchSolution
+
+    if problem.bearing_k.size:
+        raise NotImplementedError("the numpy baseline codes no clearance bearings")
+    S = h.shape[0]
+    nd = problem.unit_load.size
+    Bd = dense_rows(problem.contacts, nd)
+    nc = Bd.shape[1]
+    K = len(step_g)
+    rot = np.zeros((S, K))
+    rec = np.flatnonzero(record)
+    forces = np.zeros((S, rec.size, nc))
+    q = np.zeros((S, nd))
+    F = np.zeros((S, nc))
+    for t in range(K):
+        g = step_g[t]
+        if cold[t]:
+            q[:] = 0.0
+            F[:] = 0.0
+        s = Systems(
+            problem.K0[g],
+            Bd[g],
+            step_T[t] * problem.unit_load[None] - h[:, g],
+            gap[:, g],
+            problem.coef[g, :, 0],
+            problem.coef[g, :, 1],
+        )
+        if exact:
+            q, F, _ = newton(s, q, F=F, scheme="exact")
+        else:
+            q, F = solve(s, q, scheme="secant", kstart=problem.start_stiffness)
+        rot[:, t] = q[:, problem.output]
+        if record[t]:
+            forces[:, int(np.searchsorted(rec, t))] = F
+    return BatchSolution(rot, forces, np.zeros((S, K), np.int64))
