@@ -15,6 +15,7 @@ from gearte.cases import case_path
 from gearte.errors import CaseFileError, ParameterError
 from gearte.geometry.planetary import EccentricityError, SunPlanetErrors
 from gearte.io.case_file import load_case_dict
+from gearte.models.planetary_errors import derive_terms, first_stage_keys
 from gearte.studies._rv_dynamics import build_dynamic_model
 from gearte.studies.planetary import build_terms, first_stage_errors
 from gearte.studies.rv_reducer import build_reducer
@@ -166,3 +167,14 @@ def test_rv_error_set_takes_the_object_back():
     fs = red.error_set.first_stage
     again = red.error_set.scaled(0.0).with_first_stage(fs).first_stage
     _assert_same(again, fs)
+
+
+def test_object_sets_the_planetary_models_own_term_keys():
+    pcase = load_case_dict(_planetary_data())
+    terms = derive_terms(pcase.gearset.build(), "mean")
+    mags, angs = first_stage_keys(first_stage_errors(pcase))
+    assert set(mags) == {"E_s", "A_s", "E_p1", "E_p2", "E_p3"} <= set(terms.magnitudes)
+    assert set(angs) <= set(terms.angles)
+    assert mags["E_p3"] == pytest.approx(7e-3) and angs["beta_p3"] == pytest.approx(
+        deg_to_rad(150.0)
+    )

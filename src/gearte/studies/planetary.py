@@ -29,6 +29,7 @@ from gearte.models.planetary_errors import (
     TermSet,
     coupled_te,
     derive_terms,
+    first_stage_keys,
     frequency_basis,
     terms_from_table,
 )
@@ -355,16 +356,6 @@ def first_stage_errors(case: Case) -> SunPlanetErrors:
     return _first_stage(mags, angs, n)
 
 
-def _wang_keys(fs: SunPlanetErrors) -> tuple[dict[str, float], dict[str, float]]:
-    """Wang's magnitudes [mm] and angles [rad] of the sun and planet eccentricities."""
-    mags = {"E_s": fs.sun.amplitude, "A_s": fs.sun_assembly.amplitude}
-    angs = {"beta_s": fs.sun.phase, "gamma_s": fs.sun_assembly.phase}
-    for i, p in enumerate(fs.planets, start=1):
-        mags[f"E_p{i}"] = p.amplitude
-        angs[f"beta_p{i}"] = p.phase
-    return mags, angs
-
-
 def build_terms(case: Case) -> tuple[TermSet, dict[str, float], dict[str, float]]:
     """The term set, magnitudes [mm] and angles [rad] of a case (keys checked)."""
     pset = case.gearset.build()
@@ -417,7 +408,7 @@ def build_terms(case: Case) -> tuple[TermSet, dict[str, float], dict[str, float]
     if e.source == "derived":
         # the sun and planet eccentricities reach the model through the object the RV first
         # stage shares (the keys given stay the keys read: a missing angle stays free)
-        fs_mags, fs_angs = _wang_keys(_first_stage(mags, angs, pset.n_planets))
+        fs_mags, fs_angs = first_stage_keys(_first_stage(mags, angs, pset.n_planets))
         mags_mm.update({k: v for k, v in fs_mags.items() if k in mags_mm})
         angs_rad.update({k: v for k, v in fs_angs.items() if k in angs_rad})
     return terms, mags_mm, angs_rad
