@@ -105,3 +105,19 @@ def test_chain_yield_model_interfering_pair_has_zero_lost_motion_not_negative():
     assert out["end_effector_error [mm]"][1] == pytest.approx(
         2 * 0.010 / (100.0 * math.cos(math.radians(20))) * 500.0
     )
+
+
+def test_chain_yield_worst_sample_case_file_reproduces_that_sample(tmp_path):
+    """The worst chain is written as a case file (every error constant at its drawn value, a
+    radial one as r sin φ); run on its own it gives that sample's joint lost motion."""
+    data = _spur_and_given(samples=2000, keep_worst=1)
+    res = gearte.run_case(load_case_dict(data, name="chain_worst"), OPTS)
+    worst = res["yield"].values["worst_samples"][0]
+    text = res["yield"].files["worst_sample_1.toml"]
+    again = gearte.run_case(load_case_dict(tomllib.loads(text), name="again"), OPTS)
+    q = again["yield"].values["quantities"]["joint_lost_motion [arcmin]"]
+    assert (
+        q["min"]
+        == q["max"]
+        == pytest.approx(worst["values"]["joint_lost_motion [arcmin]"], rel=1e-12)
+    )

@@ -682,12 +682,40 @@ def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> A
         teeth = getattr(pair, which).teeth
         return radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
 
+    radial = {t.key for st in chain for t in st.terms if t.radial}
+
+    def worst_case(errors) -> dict:
+        """This chain with every drawn error held constant at the sample's value (a radial
+        error as its projection r sin φ): ``gearte run`` on it gives that sample's outputs."""
+        import math
+
+        d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
+        for st, sd in zip(case.chain.stages, d["chain"]["stages"], strict=True):
+            if st.drive is not None and st.drive.case is not None:
+                sd["drive"]["case"] = st.drive.source  # absolute: the file moves
+        tols = {}
+        for key, unit in units.items():
+            v = float(errors.get(key, nominal.get(key, 0.0)))
+            if key in radial and f"{key}_phase_rad" in errors:
+                v *= math.sin(float(errors[f"{key}_phase_rad"]))
+            tols[key] = {"kind": "constant", f"tolerance_{unit}": 0.0, f"nominal_{unit}": v}
+        d["analyses"] = {
+            "yield": {
+                "samples": 1,
+                "keep_worst": 0,
+                "tolerances": tols,
+                "spec": d["analyses"]["yield"].get("spec", {}),
+            }
+        }
+        return d
+
     res = yield_analysis(
         sec,
         GearChainYield(chain, nominal, case.chain.lever_length_mm),
         units,
         nominal,
         options=options,
+        worst_case=worst_case,
         references=["jiang2024"],
         defaults=defaults,
         grade_um=grade_um,
