@@ -159,6 +159,25 @@ def test_sobol_of_a_linear_model_equals_the_variance_shares():
         assert r.total[k] == pytest.approx(share, abs=0.03)
 
 
+class OffsetLinear:
+    """y = 2 a + 3 b + 1000: a mean ~10⁵ σ away from zero (a joint's lost motion beside its
+    small spread)."""
+
+    def __call__(self, e):
+        return {"y": 2.0 * e["a"] + 3.0 * e["b"] + 1000.0}
+
+
+def test_sobol_first_order_does_not_depend_on_the_quantitys_mean():
+    """The first-order estimator is centred (Saltelli 2010): adding 1000 to a linear model with
+    σ_y ≈ 0.02 changes its indices by round-off only, not by the mean's sampling noise."""
+    ts = _lin_set()
+    r0 = sobol_tolerances(Linear(), ts, ["y"], n=2000, seed=3, bootstrap=0)["y"]
+    r1 = sobol_tolerances(OffsetLinear(), ts, ["y"], n=2000, seed=3, bootstrap=0)["y"]
+    for k in ("a", "b"):
+        assert r1.first[k] == pytest.approx(r0.first[k], abs=1e-6)
+        assert r1.total[k] == pytest.approx(r0.total[k], abs=1e-6)
+
+
 def test_sobol_of_a_product_is_all_interaction():
     r = sobol_tolerances(Product(), _lin_set(0.03, 0.03), ["y"], n=4000, seed=2)["y"]
     for k in ("a", "b"):

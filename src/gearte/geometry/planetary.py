@@ -21,7 +21,14 @@ import numpy as np
 
 from gearte.errors import ParameterError
 
-__all__ = ["MEMBERS", "PlanetarySet", "SunPlanets", "willis_speeds"]
+__all__ = [
+    "MEMBERS",
+    "EccentricityError",
+    "PlanetarySet",
+    "SunPlanetErrors",
+    "SunPlanets",
+    "willis_speeds",
+]
 
 Member = Literal["sun", "ring", "carrier"]
 MEMBERS: tuple[str, ...] = ("sun", "ring", "carrier")
@@ -193,6 +200,156 @@ class SunPlanets:
     def centre_distance(self) -> float:
         """Sun–planet centre distance a = m (z_s + z_p) / 2 [mm]."""
         return 0.5 * self.module * (self.z_sun + self.z_planet)
+
+
+@dataclass(frozen=True)
+class EccentricityError:
+    """One eccentricity (position) error: a vector of length ``amplitude`` at angle ``phase``.
+
+    The one eccentricity value of the ``planetary`` kind (Wang 2013's ``E, beta`` and
+    ``A, gamma``) and of the RV first stage (``[[reducer.errors]]`` ``value_um, angle_deg``).
+    Turning with its part, the offset at part angle ``theta`` is
+    ``amplitude (cos(theta + phase), sin(theta + phase))``.
+
+    Parameters
+    ----------
+    amplitude : float
+        Magnitude E [mm], finite and >= 0.
+    phase : float
+        Angle of the error in the part's frame [rad], finite.
+    name : str
+        Key named in the error message (not compared).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name``: negative or non-finite amplitude, non-finite phase.
+
+    References
+    ----------
+    Wang C. et al. (2013), Trans. CSAM 44(8), 287-292, Table 1.
+    doi:10.6041/j.issn.1000-1298.2013.08.049
+    """
+
+    amplitude: float = 0.0
+    phase: float = 0.0
+    name: str = field(default="eccentricity", compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.amplitude) and self.amplitude >= 0.0):
+            raise ParameterError(
+                self.name, self.amplitude, "amplitude must be finite and >= 0 [mm]"
+            )
+        if not np.isfinite(self.phase):
+            raise ParameterError(self.name, self.phase, "phase must be finite [rad]")
+        object.__setattr__(self, "amplitude", float(self.amplitude))
+        object.__setattr__(self, "phase", float(self.phase))
+
+    @classmethod
+    def from_vector(cls, vector: np.ndarray, name: str = "eccentricity") -> EccentricityError:
+        """The error of a vector ``(x, y)`` [mm] (amplitude = its length, phase = its angle)."""
+        v = np.asarray(vector, dtype=float)
+        return cls(float(np.hypot(v[0], v[1])), float(np.arctan2(v[1], v[0])), name)
+
+    @property
+    def vector(self) -> np.ndarray:
+        """``amplitude (cos phase, sin phase)`` [mm], shape ``(2,)``."""
+        return self.amplitude * np.array([np.cos(self.phase), np.sin(self.phase)])
+
+    def offset(self, angle: np.ndarray | float) -> np.ndarray:
+        """Offset [mm], shape ``(..., 2)``, when its part has turned by ``angle`` [rad]."""
+        a = np.asarray(angle, dtype=float) + self.phase
+        return self.amplitude * np.stack([np.cos(a), np.sin(a)], axis=-1)
+
+
+@dataclass(frozen=True)
+class SunPlanetErrors:
+    """The eccentricity errors of a sun and its planets, shared by the ``planetary`` kind and
+    the RV first stage (:attr:`gearte.geometry.rv.ManufacturingErrors.first_stage`).
+
+    Parameters
+    ----------
+    planets : tuple of EccentricityError
+        Manufacturing eccentricity of each planet (Wang ``E_p<i>, beta_p<i>``; RV
+        ``planet_eccentricity``) [mm, rad], turning with the planet, in the planet frame.
+    sun : EccentricityError
+        Manufacturing eccentricity of the sun (Wang ``E_s, beta_s``) [mm, rad], turning with it.
+    sun_assembly : EccentricityError
+        Assembly error of the sun (Wang ``A_s, gamma_s``; Li ``E_sa``) [mm, rad], fixed in
+        the housing.
+
+    Raises
+    ------
+    ParameterError
+        An entry that is not an :class:`EccentricityError`; :meth:`check_planets` names the
+        planet count that does not match.
+
+    References
+    ----------
+    Wang C. et al. (2013), Trans. CSAM 44(8), 287-292, Table 1.
+    doi:10.6041/j.issn.1000-1298.2013.08.049
+    """
+
+    planets: tuple[EccentricityError, ...]
+    sun: EccentricityError = EccentricityError(name="sun_eccentricity")
+    sun_assembly: EccentricityError = EccentricityError(name="sun_assembly")
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "planets", tuple(self.planets))
+        for name, v in (("sun_eccentricity", self.sun), ("sun_assembly", self.sun_assembly)):
+            if not isinstance(v, EccentricityError):
+                raise ParameterError(name, v, "must be an EccentricityError")
+        for i, v in enumerate(self.planets):
+            if not isinstance(v, EccentricityError):
+                raise ParameterError(
+                    f"planet_eccentricity[{i + 1}]", v, "must be an EccentricityError"
+                )
+
+    @classmethod
+    def none(cls, n_planets: int) -> SunPlanetErrors:
+        """No errors on a sun and ``n_planets`` planets."""
+        return cls(
+            tuple(EccentricityError(name=f"planet_eccentricity[{i + 1}]") for i in range(n_planets))
+        )
+
+    @classmethod
+    def from_vectors(
+        cls, sun: np.ndarray, sun_assembly: np.ndarray, planets: np.ndarray
+    ) -> SunPlanetErrors:
+        """From error vectors [mm]: sun ``(2,)``, sun assembly ``(2,)``, planets ``(N, 2)``."""
+        pl = np.asarray(planets, dtype=float).reshape(-1, 2)
+        return cls(
+            tuple(
+                EccentricityError.from_vector(v, f"planet_eccentricity[{i + 1}]")
+                for i, v in enumerate(pl)
+            ),
+            EccentricityError.from_vector(sun, "sun_eccentricity"),
+            EccentricityError.from_vector(sun_assembly, "sun_assembly"),
+        )
+
+    def check_planets(self, n_planets: int, field_name: str = "planet_eccentricity") -> None:
+        """Raise :class:`ParameterError` naming ``field_name`` unless there are ``n_planets``."""
+        if len(self.planets) != n_planets:
+            raise ParameterError(
+                field_name,
+                len(self.planets),
+                f"needs one eccentricity per planet: {n_planets} planets",
+            )
+
+    def vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Error vectors [mm]: sun ``(2,)``, sun assembly ``(2,)``, planets ``(N, 2)``."""
+        pl = np.array([p.vector for p in self.planets]).reshape(-1, 2)
+        return self.sun.vector, self.sun_assembly.vector, pl
+
+    def sun_offset(self, sun_angle: np.ndarray | float) -> np.ndarray:
+        """Displacement of the sun's tooth centre [mm], ``(..., 2)``, at sun angle [rad]:
+        its eccentricity turned by ``sun_angle`` plus the fixed assembly error."""
+        return self.sun.offset(sun_angle) + self.sun_assembly.vector
+
+    def planet_offsets(self, planet_angle: np.ndarray | float) -> np.ndarray:
+        """Displacement of each planet's tooth centre from its pin [mm], ``(..., N, 2)``, in the
+        planet frame after the planet turned by ``planet_angle`` [rad] relative to it."""
+        return np.stack([p.offset(planet_angle) for p in self.planets], axis=-2)
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gearte.errors import ParameterError
-from gearte.geometry.planetary import SunPlanets
+from gearte.geometry.planetary import EccentricityError, SunPlanetErrors, SunPlanets
 from gearte.units import um_to_mm
 
 __all__ = [
@@ -429,6 +429,7 @@ ERROR_PARTS = (
 """Parts that carry an eccentricity error, in the order of the power flow."""
 
 _DISC_ONLY = ("disc_radial_runout", "disc_cumulative_pitch")
+_FIRST_STAGE = ("sun_eccentricity", "sun_assembly", "planet_eccentricity")
 _NO_CRANK = ("sun_eccentricity", "sun_assembly", "output_assembly", *_DISC_ONLY)
 _NEEDS_DISC = ("disc_crank_bore", "cam", *_DISC_ONLY)
 
@@ -552,7 +553,10 @@ class ManufacturingErrors:
             if key in seen:
                 raise ParameterError(f, key, "error given twice for the same part and index")
             seen.add(key)
-            vec = e.value * np.array([np.cos(e.angle), np.sin(e.angle)])
+            if e.part in _FIRST_STAGE:  # the eccentricity object of the planetary kind
+                vec = EccentricityError(e.value, e.angle, f"{f}.value").vector
+            else:
+                vec = e.value * np.array([np.cos(e.angle), np.sin(e.angle)])
             ci = -1 if e.crank is None else e.crank - 1  # checked above where required
             dj = -1 if e.disc is None else e.disc - 1
             if e.part == "sun_eccentricity":
@@ -574,6 +578,24 @@ class ManufacturingErrors:
             else:
                 out.cam[ci, dj] = vec
         return out
+
+    @property
+    def first_stage(self) -> SunPlanetErrors:
+        """Sun eccentricity, sun assembly error and each planet's eccentricity as the
+        eccentricity-error object of the ``planetary`` kind [mm, rad]."""
+        return SunPlanetErrors.from_vectors(self.sun, self.sun_seat, self.planet)
+
+    def with_first_stage(self, errors: SunPlanetErrors) -> ManufacturingErrors:
+        """Copy with the first-stage errors of ``errors`` (one planet entry per crank).
+
+        Raises
+        ------
+        ParameterError
+            Naming ``planet_eccentricity`` when the planet count differs from the cranks.
+        """
+        errors.check_planets(self.planet.shape[0])
+        sun, seat, planet = errors.vectors()
+        return dataclasses.replace(self, sun=sun, sun_seat=seat, planet=planet)
 
     def scaled(self, factor: float) -> ManufacturingErrors:
         """All errors multiplied by ``factor`` (0 removes them)."""

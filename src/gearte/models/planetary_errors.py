@@ -42,7 +42,7 @@ import numpy as np
 from numba import njit
 
 from gearte.errors import ParameterError
-from gearte.geometry.planetary import PlanetarySet
+from gearte.geometry.planetary import PlanetarySet, SunPlanetErrors
 from gearte.solvers.trig_extremes import (
     SINCOS_MAX_ARG,
     exact_extremes,
@@ -60,6 +60,7 @@ __all__ = [
     "TermSet",
     "CoupledTE",
     "derive_terms",
+    "first_stage_keys",
     "terms_from_table",
     "frequency_basis",
     "group_phasors",
@@ -226,6 +227,34 @@ def derive_terms(pset: PlanetarySet, planet_model: str = "reference") -> TermSet
         ]
     ref = "beta_r" if w["ring"] == 0 else "beta_s"
     return TermSet(tuple(terms), pset.output_scale(), reference_angle=ref)
+
+
+def first_stage_keys(errors: SunPlanetErrors) -> tuple[dict[str, float], dict[str, float]]:
+    """The sun and planet eccentricities of the shared error object under the term keys of
+    :func:`derive_terms`.
+
+    Parameters
+    ----------
+    errors : SunPlanetErrors
+        Sun eccentricity, sun assembly error, one eccentricity per planet [mm, rad] (the object
+        the RV first stage holds too).
+
+    Returns
+    -------
+    tuple of dict
+        Magnitudes ``E_s, A_s, E_p<i>`` [mm] and angles ``beta_s, gamma_s, beta_p<i>`` [rad].
+
+    References
+    ----------
+    Wang C., Chen X., Li Y., Chen H. (2013). Trans. CSAM 44(8), 287-292, Table 1.
+    doi:10.6041/j.issn.1000-1298.2013.08.049
+    """
+    mags = {"E_s": errors.sun.amplitude, "A_s": errors.sun_assembly.amplitude}
+    angs = {"beta_s": errors.sun.phase, "gamma_s": errors.sun_assembly.phase}
+    for i, p in enumerate(errors.planets, start=1):
+        mags[f"E_p{i}"] = p.amplitude
+        angs[f"beta_p{i}"] = p.phase
+    return mags, angs
 
 
 def _parse_fraction(value: float | str | Fraction, field_name: str) -> Fraction:

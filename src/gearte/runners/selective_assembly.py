@@ -72,6 +72,7 @@ __all__ = [
     "assembled_reducer",
     "full_model_te",
     "pin_grades",
+    "check_reducer",
 ]
 
 
@@ -746,3 +747,27 @@ def pin_grades(
         return None, backlash
     centre = 0.5 * (lo + hi)
     return int(inside[np.argmin(np.abs(backlash[inside] - centre))]), backlash
+
+
+def check_reducer(task: tuple) -> tuple[float, int | None, np.ndarray | None]:
+    """Full-model TE and pin grade of one assembled reducer (a task of
+    :func:`gearte.execution.map_chunks`; module level, so any backend can run it).
+
+    Parameters
+    ----------
+    task : tuple
+        ``(reducer, torque [N·mm], theta [rad], verify, grades [mm] or None, window [rad] or
+        None)``.
+
+    Returns
+    -------
+    (float, int or None, numpy.ndarray or None)
+        TE peak-to-peak of the full model [rad] (NaN when ``verify`` is false), the chosen grade
+        and the backlash of every grade [rad] (None without grades).
+    """
+    reducer, torque, theta, verify, grades, window = task
+    te = full_model_te(reducer, torque, theta) if verify else float("nan")
+    if grades is None or window is None:
+        return te, None, None
+    g, backlash = pin_grades(reducer, grades, window)
+    return te, g, backlash

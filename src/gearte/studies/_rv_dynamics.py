@@ -171,8 +171,8 @@ def build_dynamic_model(case, red: RVReducer):
 
     errors = errors_from_reducer(
         red,
-        sun_eccentricity=polar(e.sun),
-        sun_assembly=polar(e.sun_seat),
+        sun_eccentricity=(e.first_stage.sun.amplitude, e.first_stage.sun.phase),
+        sun_assembly=(e.first_stage.sun_assembly.amplitude, e.first_stage.sun_assembly.phase),
         output_assembly=polar(e.output_seat),
         output_bearing_clearance_mm=red.supports.main_bearing_clearance,
         output_torque_Nm=op.output_torque_Nm,

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
@@ -342,7 +342,10 @@ class ChainAnalyses(StrictModel):
         alias="yield",
         description="production yield of the chain: each stage's lost motion drawn from its "
         "distribution, combined at the joint by eq. (30); tolerance keys are the stage names "
-        "(tolerance_arcmin, nominal_arcmin at the stage output)",
+        "(tolerance_arcmin, nominal_arcmin at the stage output) and, for a pair stage, its "
+        "backlash stack's contributors <stage slug>.<contributor> [µm] (e.g. "
+        "spur_pair.centre_distance; spur_pair.driven_gear_eccentricity takes grade = N: "
+        "ISO 1328-2 F_i″)",
     )
 
 
@@ -624,26 +627,107 @@ def _stage_tolerances(case: Case, stages, drives: dict, backlash: dict) -> dict:
 
 
 def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> AnalysisResult:
-    """``[analyses.yield]``: the stages' lost motions drawn from their laws (or the section's
-    tolerances), combined at the joint by eq. (30) — the joint's distribution and its yield
-    against ``[analyses.yield.spec]`` (``"joint_lost_motion [arcmin]"``)."""
-    from gearte.runners.yield_models import GearChainLostMotion
-    from gearte.studies._yield import yield_analysis
+    """``[analyses.yield]``: each sample one assembled chain, combined at the joint by eq. (30).
 
-    assert case.analyses is not None and case.analyses.yield_ is not None
+    A pair stage (``[pair]`` or a ``gear_pair`` drive) draws every contributor of its own
+    backlash stack (keys ``<stage slug>.<contributor>`` [µm]; gearte.runners.chain_yield) unless
+    the section gives a law for the whole stage by its name; every other stage draws its lost
+    motion from its law (:func:`_stage_tolerances`, key: the stage name [arcmin]). Yield against
+    ``[analyses.yield.spec]`` (``"joint_lost_motion [arcmin]"``, ``"<slug>.lost_motion
+    [arcmin]"``, ``"end_effector_error [mm]"``), contributions per tolerance.
+    """
+    from gearte.models.backlash import SpurPair
+    from gearte.runners.chain_yield import ChainStage, GearChainYield, stack_terms
+    from gearte.studies._yield import ToleranceEntry, yield_analysis
+    from gearte.tolerance.iso1328 import radial_composite_tolerances
+
+    sec = case.analyses.yield_ if case.analyses is not None else None
+    assert sec is not None
     defaults = _stage_tolerances(case, stages, drives, backlash)
-    model = GearChainLostMotion([s.name for s in stages], [s.ratio for s in stages])
     units = {s.name: "arcmin" for s in stages}
     nominal = {k: float(t.nominal_arcmin or 0.0) for k, t in defaults.items()}
-    return yield_analysis(
-        case.analyses.yield_,
-        model,
+    chain: list[ChainStage] = []
+    pairs: dict[str, tuple[Any, str]] = {}
+    for s in stages:
+        slug = _slug(s.name)
+        pair = getattr(drives.get(s.name), "pair", None)
+        if s.name in backlash and backlash[s.name][3] is not None:
+            pair = backlash[s.name][3]
+        if pair is None or s.name in sec.tolerances:
+            chain.append(ChainStage(s.name, slug, s.ratio))
+            continue
+        del defaults[s.name], units[s.name], nominal[s.name]
+        terms, laws = stack_terms(slug, pair.backlash_stack())
+        chain.append(
+            ChainStage(s.name, slug, s.ratio, terms, pair.output_diameter, pair.pressure_angle)
+        )
+        for key, (kind, tol, mu) in laws.items():
+            units[key], nominal[key] = "um", mu
+            defaults[key] = ToleranceEntry(
+                kind=kind,
+                tolerance_um=tol,
+                nominal_um=mu,
+                sigmas=6.0 if kind == "rayleigh" else None,
+                phase=kind == "rayleigh",
+            )
+            pairs[key] = (pair, "driving" if ".driving_gear" in key else "driven")
+
+    def grade_um(key: str, grade: int) -> float | None:
+        """A spur gear's eccentricity: its ISO 1328-2 total radial composite tolerance F_i″."""
+        if not key.endswith("_gear_eccentricity") or key not in pairs:
+            return None
+        pair, which = pairs[key]
+        if not isinstance(pair, SpurPair):
+            return None
+        teeth = getattr(pair, which).teeth
+        return radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
+
+    radial = {t.key for st in chain for t in st.terms if t.radial}
+
+    def worst_case(errors) -> dict:
+        """This chain with every drawn error held constant at the sample's value (a radial
+        error as its projection r sin φ): ``gearte run`` on it gives that sample's outputs."""
+        import math
+
+        d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
+        for st, sd in zip(case.chain.stages, d["chain"]["stages"], strict=True):
+            if st.drive is not None and st.drive.case is not None:
+                sd["drive"]["case"] = st.drive.source  # absolute: the file moves
+        tols = {}
+        for key, unit in units.items():
+            v = float(errors.get(key, nominal.get(key, 0.0)))
+            if key in radial and f"{key}_phase_rad" in errors:
+                v *= math.sin(float(errors[f"{key}_phase_rad"]))
+            tols[key] = {"kind": "constant", f"tolerance_{unit}": 0.0, f"nominal_{unit}": v}
+        d["analyses"] = {
+            "yield": {
+                "samples": 1,
+                "keep_worst": 0,
+                "tolerances": tols,
+                "spec": d["analyses"]["yield"].get("spec", {}),
+            }
+        }
+        return d
+
+    res = yield_analysis(
+        sec,
+        GearChainYield(chain, nominal, case.chain.lever_length_mm),
         units,
         nominal,
         options=options,
+        worst_case=worst_case,
         references=["jiang2024"],
         defaults=defaults,
+        grade_um=grade_um,
     )
+    res.notes.append(
+        "Chain yield: a pair stage draws its backlash stack contributor by contributor "
+        "(eccentricities and run-out: Rayleigh magnitude, σx = t/6 as Jiang 2024, uniform "
+        "direction, entering as r sin φ) → eq. (14)/(29), clipped at 0; other stages' lost "
+        "motion from their law (drive spread, min/mean/max, or constant); joint = Σ stage lost "
+        "motion / downstream ratios (eq. 30), sample by sample."
+    )
+    return res
 
 
 def run(case: Case, options) -> StudyResult:

@@ -23,12 +23,13 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from gearte.errors import ParameterError
-from gearte.geometry.planetary import PlanetarySet
+from gearte.geometry.planetary import EccentricityError, PlanetarySet, SunPlanetErrors
 from gearte.io.schema import CaseBase, Sign, StrictModel
 from gearte.models.planetary_errors import (
     TermSet,
     coupled_te,
     derive_terms,
+    first_stage_keys,
     frequency_basis,
     terms_from_table,
 )
@@ -287,6 +288,74 @@ def _expand_planet_keys(values: dict[str, float], n: int, prefixes: tuple[str, .
     return out
 
 
+def _first_stage(mags_um: dict[str, float], angs_deg: dict[str, float], n: int) -> SunPlanetErrors:
+    """Wang's named sun/planet magnitudes [µm] and angles [deg] (planet keys expanded) as the
+    shared :class:`SunPlanetErrors` [mm, rad]; a missing angle is 0, a missing magnitude 0."""
+    for k in list(mags_um) + list(angs_deg):
+        base = k.rstrip("0123456789")
+        if (
+            base in ("E_p", "A_p", "beta_p", "gamma_p")
+            and base != k
+            and not 1 <= int(k[len(base) :]) <= n
+        ):
+            where = "magnitudes_um" if k in mags_um else "angles_deg"
+            raise ParameterError(
+                f"errors.{where}.{k}",
+                mags_um.get(k, angs_deg.get(k)),
+                f"no such planet: one eccentricity per planet, gearset.n_planets = {n}",
+            )
+
+    def ecc(mag: str, ang: str) -> EccentricityError:
+        return EccentricityError(
+            float(um_to_mm(mags_um.get(mag, 0.0))),
+            float(deg_to_rad(angs_deg.get(ang, 0.0))),
+            f"errors.magnitudes_um.{mag}",
+        )
+
+    return SunPlanetErrors(
+        tuple(ecc(f"E_p{i}", f"beta_p{i}") for i in range(1, n + 1)),
+        ecc("E_s", "beta_s"),
+        ecc("A_s", "gamma_s"),
+    )
+
+
+def first_stage_errors(case: Case) -> SunPlanetErrors:
+    """The sun and planet eccentricities of a ``planetary`` case as the eccentricity-error object
+    shared with the RV first stage.
+
+    Parameters
+    ----------
+    case : Case
+        A ``planetary`` case with ``errors.source = "derived"``; reads ``E_s, beta_s`` (sun),
+        ``A_s, gamma_s`` (sun assembly) and ``E_p<i>, beta_p<i>`` (or ``E_p, beta_p`` for every
+        planet) [µm, deg].
+
+    Returns
+    -------
+    SunPlanetErrors
+        Amplitudes [mm] and phases [rad]; one planet entry per ``gearset.n_planets``.
+
+    Raises
+    ------
+    ParameterError
+        ``errors.source`` is not ``"derived"`` (terms as given name no parts), or a planet key
+        beyond ``gearset.n_planets``.
+
+    References
+    ----------
+    Wang C. et al. (2013), Trans. CSAM 44(8), 287-292, Table 1.
+    doi:10.6041/j.issn.1000-1298.2013.08.049
+    """
+    if case.errors.source != "derived":
+        raise ParameterError(
+            "errors.source", case.errors.source, "first-stage errors need source = 'derived'"
+        )
+    n = case.gearset.n_planets
+    mags = _expand_planet_keys(case.errors.magnitudes_um, n, ("E_p", "A_p"))
+    angs = _expand_planet_keys(case.errors.angles_deg, n, ("beta_p", "gamma_p"))
+    return _first_stage(mags, angs, n)
+
+
 def build_terms(case: Case) -> tuple[TermSet, dict[str, float], dict[str, float]]:
     """The term set, magnitudes [mm] and angles [rad] of a case (keys checked)."""
     pset = case.gearset.build()
@@ -336,6 +405,12 @@ def build_terms(case: Case) -> tuple[TermSet, dict[str, float], dict[str, float]
         raise ParameterError("errors.magnitudes_um", sorted(mags), f"missing keys {missing}")
     mags_mm = {k: float(um_to_mm(v)) for k, v in mags.items() if k in terms.magnitudes}
     angs_rad = {k: float(deg_to_rad(v)) for k, v in angs.items() if k in terms.angles}
+    if e.source == "derived":
+        # the sun and planet eccentricities reach the model through the object the RV first
+        # stage shares (the keys given stay the keys read: a missing angle stays free)
+        fs_mags, fs_angs = first_stage_keys(_first_stage(mags, angs, pset.n_planets))
+        mags_mm.update({k: v for k, v in fs_mags.items() if k in mags_mm})
+        angs_rad.update({k: v for k, v in fs_angs.items() if k in angs_rad})
     return terms, mags_mm, angs_rad
 
 

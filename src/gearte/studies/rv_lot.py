@@ -306,14 +306,32 @@ def run(case: Case, options=None) -> StudyResult:
     random_counts = sa.random_assemblies(table, limit, sec.random_assemblies, rng)
     orient = sa.orientation_only(table)
     n_red = best.disc_set.size
-    reducers = []
-    full = np.full(n_red, np.nan)
+    from gearte.execution import map_chunks
+    from gearte.units import um_to_mm
+
+    grading = case.analyses.pin_grading
+    grades = window = None
+    if grading is not None:
+        grades = np.asarray(grading.grades_um, dtype=float)
+        window = tuple(float(arcmin_to_rad(v)) for v in grading.backlash_window_arcmin)
+    tasks = []
     for r in range(n_red):
         o = table.orientation(int(best.disc_orientation[r]), int(best.crank_orientation[r]))
         reducer = sa.assembled_reducer(red, lot, int(best.disc_set[r]), int(best.crank_set[r]), o)
-        reducers.append(reducer)
-        if sec.verify:
-            full[r] = sa.full_model_te(reducer, torque, theta)
+        tasks.append(
+            (
+                reducer,
+                torque,
+                theta,
+                sec.verify,
+                None if grades is None else um_to_mm(grades),
+                window,
+            )
+        )
+    # the full-model check and the pin grading of every reducer, on the local cores (or the
+    # scheduler of the run options)
+    checked = map_chunks(sa.check_reducer, tasks, options=options, description="reducers")
+    full = np.array([c[0] for c in checked])
     values: dict = {
         "reducers": n_red,
         "te_spec [arcsec]": sec.te_spec_arcsec,
@@ -337,18 +355,10 @@ def run(case: Case, options=None) -> StudyResult:
         values["linearised_minus_full_max [arcsec]"] = float(
             rad_to_arcsec(np.max(np.abs(best.pp - full)))
         )
-    grading = case.analyses.pin_grading
-    grades = chosen = backlash = None
+    chosen = backlash = None
     if grading is not None:
-        from gearte.units import um_to_mm
-
-        grades = np.asarray(grading.grades_um, dtype=float)
-        window = tuple(float(arcmin_to_rad(v)) for v in grading.backlash_window_arcmin)
-        chosen, backlash = [], []
-        for reducer in reducers:
-            g, bl = sa.pin_grades(reducer, um_to_mm(grades), window)  # type: ignore[arg-type]
-            chosen.append(g)
-            backlash.append(bl)
+        chosen = [c[1] for c in checked]
+        backlash = [c[2] for c in checked]
     rows = []
     for r in range(n_red):
         d, c = int(best.disc_set[r]), int(best.crank_set[r])
@@ -361,13 +371,13 @@ def run(case: Case, options=None) -> StudyResult:
         row["disc_bore_1_on_crank_position"] = 1 + o.disc_index
         for i in range(m):
             row[f"crank_position_{i + 1}"] = cs[(i - o.crank_shift) % m]
-        if sec.planet_indexings > 1:
+        if sec.planet_indexings > 1 and lot.planet_runout is not None:
             row["planet_spline_index"] = o.planet_index
         row["te_peak_to_peak [arcsec]"] = round(float(rad_to_arcsec(best.pp[r])), 3)
         if sec.verify:
             row["te_peak_to_peak_full_model [arcsec]"] = round(float(rad_to_arcsec(full[r])), 3)
         row["in_spec"] = bool(best.pp[r] <= limit)
-        if grading is not None and grades is not None and chosen is not None:
+        if grading is not None and grades is not None and chosen and backlash is not None:
             g = chosen[r]
             row["pin_grade [um]"] = None if g is None else float(grades[g])
             row["backlash [arcmin]"] = (

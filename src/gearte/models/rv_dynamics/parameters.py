@@ -446,7 +446,9 @@ def errors_from_reducer(
     return RVErrors(
         crank_count=m,
         disc_count=n,
-        planet_eccentricity=polar(e.planet),
+        planet_eccentricity=np.array(
+            [(p.amplitude, p.phase) for p in e.first_stage.planets], dtype=float
+        ).reshape(m, 2),
         carrier_hole=polar(e.carrier_bore),
         disc_hole=polar(np.swapaxes(e.disc_bore, 0, 1)),
         cam=polar(e.cam),
