@@ -20,11 +20,12 @@ past the memory bound is not; and the input recorded in ``results.json`` must ke
 value's type (no coercion through ``run`` either).
 
 Measurement files are fuzzed too (``--files N``): the bundled bench files (TE traces, hysteresis
-curve, :mod:`gearte.io.bench`) and one file of each metrology format written from seeded parts
-(:mod:`gearte.io.metrology`), mutated line- and cell-wise (hostile cells, deleted, duplicated or
-swapped rows, ×50 blow-ups, renamed or re-united columns, hostile metadata, cut or corrupted
-bytes), read by their reader: a complete object with finite numbers, or one
-``BenchFileError``/``MeasurementFileError`` line naming the file; anything else is a crash.
+curve, :mod:`gearte.io.bench`), one file of each metrology format written from seeded parts and
+the bundled lot's metrology files (:mod:`gearte.io.metrology`), mutated line- and cell-wise
+(hostile cells, deleted, duplicated or swapped rows, ×50 blow-ups, renamed or re-united columns,
+hostile metadata, cut or corrupted bytes), read by their reader: a complete object with finite
+numbers, or one ``BenchFileError``/``MeasurementFileError`` line naming the file; anything else
+is a crash.
 
 Small runs are part of the test suite (``tests/test_fuzz_cases.py``, hypothesis-driven); the long
 job is ``make fuzz`` (``python tests/fuzzing.py --count 10000 --files 10000 --runs 300``), which
@@ -304,8 +305,9 @@ RUN_SAMPLES = 4
 RUN_BUDGETS = {"GEARTE_MAX_SECONDS": "20", "GEARTE_MAX_MEMORY_GB": "2"}
 
 
-class _Alarm(BaseException):
-    """The per-run alarm (a BaseException, so the CLI's last-resort handler does not take it)."""
+class _Alarm(KeyboardInterrupt):
+    """The per-run alarm: stops the run as Ctrl-C would (also inside a compiled kernel, where
+    CPython reports it as a SystemError caused by it); the run's exit is then a time-out."""
 
 
 def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
@@ -325,7 +327,10 @@ def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
     args = ["run", str(path), "--out", str(out), "--no-report", "--no-progress"]
     args += ["--samples", str(RUN_SAMPLES), "--workers", "1"]
 
+    fired = []
+
     def alarm(_signum: int, _frame: Any) -> None:
+        fired.append(True)
         raise _Alarm
 
     old_env = {k: os.environ.get(k) for k in RUN_BUDGETS}
@@ -356,6 +361,8 @@ def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
             else:
                 os.environ[k] = v
     last = (err.getvalue().strip().splitlines() or [""])[-1][:200]
+    if fired:
+        return Outcome("run_timeout", f"over {timeout_s} s (exit {code})")
     if code not in (0, 1, 2):
         return Outcome("run_bug", f"exit {code}: {err.getvalue()[-300:]}")
     if code == 0:
@@ -451,7 +458,29 @@ def measurement_corpus() -> dict[str, tuple[str, str]]:
             path = Path(d) / f"{fmt}.csv"
             write(path, data)
             files[fmt] = (fmt, path.read_text("utf-8"))
+    # the bundled lot's files (examples/lots/*/), cut to the parts of their first two serials
+    for path in sorted((case_path("synthetic_rv_bench").parent / "lots").glob("*/*.csv")):
+        text = path.read_text("utf-8")
+        fmt = re.search(r"^#\s*format:\s*(\w+)", text, re.M)
+        if fmt and fmt[1] in METROLOGY_READERS:
+            files[f"lot {path.parent.name}/{path.name}"] = (fmt[1], _first_serials(text, 2))
     return files
+
+
+def _first_serials(text: str, n: int) -> str:
+    """A metrology file with the rows of its first ``n`` serial numbers only."""
+    lines = text.splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln and not ln.startswith("#"))
+    serials: list[str] = []
+    kept = []
+    for ln in lines[head + 1 :]:
+        serial = ln.split(",", 1)[0]
+        if serial not in serials:
+            serials.append(serial)
+        if len(serials) > n:
+            break
+        kept.append(ln)
+    return "\n".join([*lines[: head + 1], *kept]) + "\n"
 
 
 def _thin(text: str, every: int) -> str:

@@ -132,6 +132,7 @@ def test_read_only_output_is_refused_before_computing(tmp_path, monkeypatch):
     into the probe where the test runs as root; as another user a real 0o555 folder is used)."""
     parent = tmp_path / "ro"
     parent.mkdir()
+    write_file_set(parent / "o", _set("old", "old"))  # the previous set stays as it is
     if os.geteuid() == 0:
 
         def read_only(*a, **k):
@@ -148,6 +149,7 @@ def test_read_only_output_is_refused_before_computing(tmp_path, monkeypatch):
         parent.chmod(0o755)
     assert r.exit_code == EXIT_OUTPUT, r.output
     assert ran == [] and "Traceback" not in r.output
+    assert _read(parent / "o") == ("old", "old") and _left_over(parent) == []
 
 
 @pytest.mark.parametrize("where", ["file", "under_file", "dangling", "foreign", "nul"])

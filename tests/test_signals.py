@@ -261,3 +261,53 @@ def test_lost_cluster_is_exit_5_with_the_partial_result_written(tmp_path, monkey
     assert r.exit_code == cli.EXIT_CLUSTER_LOST == 5, r.output
     assert "cluster lost" in r.output and "marked partial" in r.output
     assert json.loads((out / "results.json").read_text())["partial"] is True
+
+
+def _kernel_interrupted() -> None:
+    """What CPython raises when Ctrl-C's handler fires inside a compiled (numba) kernel (seen in
+    the long fuzz job: ``CPUDispatcher(<function _solve_all ...>) returned a result with an
+    exception set``)."""
+    try:
+        raise KeyboardInterrupt
+    except KeyboardInterrupt as ki:
+        raise SystemError("CPUDispatcher(f) returned a result with an exception set") from ki
+
+
+def _chunk_interrupted_at_2(i: int) -> int:
+    if i == 2:
+        _kernel_interrupted()
+    return i
+
+
+def test_interrupt_inside_a_compiled_kernel_is_an_interrupt_not_a_bug(capsys):
+    from gearte import cli
+    from gearte.execution import map_chunks
+    from gearte.execution.stop import keep_finished_chunks
+
+    with pytest.raises(SystemExit) as info:
+        cli._guarded(_kernel_interrupted, False)
+    assert info.value.code == 130 and "internal error" not in capsys.readouterr().err
+    with keep_finished_chunks() as scope:
+        got = map_chunks(_chunk_interrupted_at_2, range(5), workers=1, progress=False)
+    assert got == [0, 1] and scope.signum == signal.SIGINT
+
+
+def test_study_that_cannot_use_a_partial_chunk_list_stops_keeping_nothing(monkeypatch):
+    """A study whose code needs every chunk's result (here: it fails on the shorter list) is not
+    turned into a bug by a stop: the run ends as an interrupt with nothing kept."""
+    import gearte.studies as studies
+    from gearte.errors import Interrupted
+    from gearte.execution import map_chunks
+    from gearte.io.case_file import load_case_dict
+
+    class Kind:
+        @staticmethod
+        def run(case, options):
+            got = map_chunks(_chunk_interrupted_at_2, range(5), workers=1, progress=False)
+            return dict(zip(range(5), got, strict=True))  # needs all 5
+
+    case = load_case_dict({"case": {"kind": "foundation_test"}, "demo": {"length_mm": 1.0}})
+    monkeypatch.setattr(studies, "get_kind", lambda kind: Kind)
+    with pytest.raises(Interrupted) as info:
+        studies.run_case(case, studies.RunOptions(progress=False))
+    assert info.value.partial is None and info.value.signum == signal.SIGINT

@@ -69,7 +69,14 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
 
     _stop_on_sigterm()
     try:
-        return fn()
+        try:
+            return fn()
+        except SystemError as exc:
+            # a signal handler raised inside a compiled (numba) kernel: CPython reports the
+            # pending KeyboardInterrupt as a SystemError it caused; it is the interrupt
+            if isinstance(exc.__cause__, KeyboardInterrupt):
+                raise exc.__cause__ from None
+            raise
     except KeyboardInterrupt as exc:
         import signal
 

@@ -171,17 +171,22 @@ def map_chunks(
                         buffer[index] = result
                         bar.advance()
                     hand_back()
-            except BaseException as exc:
+            except BaseException as caught:
+                exc = _signal_in_kernel(caught)
                 stop = isinstance(exc, KeyboardInterrupt | ClusterLostError)
                 if not (stop and scope is not None and not scope.stopped) or reducing:
                     batch.cancel()  # (an interrupt inside reduce: `acc` may be half-updated)
-                    raise
+                    if exc is caught:
+                        raise
+                    raise exc from None
                 for index, result in batch.finished():  # keep what is done, not waited for
                     buffer[index] = result
                 batch.cancel()
                 hand_back()
                 if frontier == 0:  # nothing finished: nothing to keep
-                    raise
+                    if exc is caught:
+                        raise
+                    raise exc from None
                 scope.cause = exc
                 scope.cut.append(
                     f"{description}: {frontier} of {total or '?'} chunks finished and kept"
@@ -194,6 +199,15 @@ def map_chunks(
     if reduce is not None:
         return None if acc is _NOTHING else acc
     return None
+
+
+def _signal_in_kernel(exc: BaseException) -> BaseException:
+    """The ``KeyboardInterrupt`` behind a ``SystemError``: a signal handler that raised while a
+    compiled (numba) kernel ran in this thread is reported by CPython as "returned a result with
+    an exception set", caused by the interrupt. Any other exception is returned as is."""
+    if isinstance(exc, SystemError) and isinstance(exc.__cause__, KeyboardInterrupt):
+        return exc.__cause__
+    return exc
 
 
 def _first(tasks: Iterable[T]) -> Iterable[T]:

@@ -126,21 +126,34 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
     from gearte.execution.stop import keep_finished_chunks
 
     with _numba_timer() as numba, keep_finished_chunks() as stop:
-        result = module.run(case, options or RunOptions())
+        try:
+            result = module.run(case, options or RunOptions())
+        except Exception:
+            if not stop.stopped:
+                raise
+            # the study could not be completed from the finished chunks (a caller needing
+            # every chunk's result): stop as before, keeping nothing
+            raise _stopped(stop, None) from None
     t_end = time.perf_counter()
     result.elapsed_s = t_end - t0
     result.timings["imports: study kind"] = t0 - t_imp
     result.timings.update(numba)
     result.timings.update(analysis_timings(result.analyses, t0, t_end))
     if stop.stopped:
-        from gearte.errors import ClusterLostError, Interrupted
-
         result.partial = True
         result.warnings.insert(0, stop.summary())
-        if stop.signum is not None:
-            raise Interrupted(stop.signum, partial=result) from None
-        raise ClusterLostError(str(stop.cause), partial=result) from None
+        raise _stopped(stop, result) from None
     return result
+
+
+def _stopped(stop: Any, partial: Any) -> BaseException:
+    """The exception that ends a stopped run: :class:`~gearte.errors.Interrupted` for a signal,
+    :class:`~gearte.errors.ClusterLostError` for a lost cluster, carrying ``partial``."""
+    from gearte.errors import ClusterLostError, Interrupted
+
+    if stop.signum is not None:
+        return Interrupted(stop.signum, partial=partial)
+    return ClusterLostError(str(stop.cause), partial=partial)
 
 
 def analysis_timings(analyses: list[Any], start: float, end: float) -> dict[str, float]:
