@@ -134,8 +134,12 @@ def test_signal_mid_monte_carlo_writes_finished_chunks_marked_partial(tmp_path, 
 
 
 def _check_partial(out: Path, scheduler: str, err: str) -> None:
-    if scheduler == "local-cluster" and (out / "results.json").read_bytes() == b"old":
-        # Dask runs chunks in no fixed order: chunk 0 may not have finished (nothing to keep)
+    if (
+        scheduler in ("processes", "local-cluster")
+        and (out / "results.json").read_bytes() == b"old"
+    ):
+        # Dask runs chunks in no fixed order, and a loaded machine may not have handed chunk 0
+        # back from a worker process before the signal: nothing to keep, the old set stays
         assert "nothing written, previous outputs kept" in err
         return
     assert "partial" in err
