@@ -251,3 +251,26 @@ def test_results_json_records_stage_timings(tmp_path: Any) -> None:
         result.elapsed_s, abs=2e-3
     )
     assert "write" in result.timings  # known only after results.json is serialised
+
+
+def _every_bundled_case() -> list[str]:
+    from gearte.cases import list_cases
+
+    return sorted(n for n in list_cases() if n not in CHEAP_CASES)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", _every_bundled_case())
+def test_every_bundled_report_parses(name: str) -> None:
+    """Issue 15 must-show over every bundled case (the cheap three run above in the fast
+    suite): summary block first, contents links resolve, no ``None``/``nan`` strings, every
+    figure inside its analysis section. Sample counts are cut: the layout is under test."""
+    result = run_case(name, RunOptions(progress=False, samples=500))
+    figs = render_figures(result)
+    report = (result, render_report(result, figs), figs)
+    test_report_summary_block_comes_first(report)
+    test_report_contents_links_resolve(report)
+    test_report_has_no_none_or_nan_strings(report)
+    if figs:
+        test_report_every_figure_in_its_analysis_section(report)
+    test_report_headlines_name_each_analysis(report)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 
 __all__ = ["figures"]
@@ -122,9 +122,10 @@ def figures(result) -> list[Figure]:
     orders = _analysis(result, "te_orders")
     cal_a = _analysis(result, "calibration")
     cal = cal_a.data["calibration"] if cal_a is not None else None
-    out = []
+    out: list[Figure] = []
     if cat is not None:
-        out.append(_hysteresis(cat, cal))
+        out += for_analysis("catalogue", [f for f in [_hysteresis(cat, cal)] if f is not None])
     if orders is not None:
-        out += [_traces(orders), _spectrum(orders), _trend(orders)]
-    return [f for f in out if f is not None]
+        figs = [f for f in (_traces(orders), _spectrum(orders), _trend(orders)) if f is not None]
+        out += for_analysis("te_orders", figs)
+    return out

@@ -203,7 +203,26 @@ def analysis_headlines(a: Any) -> list[HeadlineRow]:
                 add(label(base), _text(v, unit))
                 if len(picked) >= 3:
                     break
+    if not picked:  # tables only (ranked lists): their first entry is the headline
+        for base, (_, v) in vals.items():
+            if isinstance(v, list) and v and isinstance(v[0], dict | str):
+                add(f"First of {_lower(label(base))}", _first_entry(v[0]))
+                if len(picked) >= 2:
+                    break
     return picked
+
+
+def _first_entry(entry: dict[str, Any] | str, width: int = 120) -> str:
+    """One line for the first row of a ranked table (a dict of unit-named fields) or list."""
+    if isinstance(entry, str):
+        text = entry
+    else:
+        parts = []
+        for key, x in list(entry.items())[:3]:
+            base, unit = split_unit(key)
+            parts.append(f"{label(base)} {_text(x, unit) if _is_num(x) else x}")
+        text = ", ".join(parts)
+    return text if len(text) <= width else text[: width - 1] + "…"
 
 
 def _pairs(values: dict[str, Any]) -> list[tuple[str, str, float, float]]:

@@ -312,6 +312,8 @@ def run(case: Case, options=None) -> StudyResult:
         title=f"Serial {case.serial.name}: measured inputs",
         values={
             "serial": case.serial.name,
+            "measured_inputs": len(measured),
+            "inputs_from_design": len(design_inputs),
             "measured": dict(measured),
             "from_design": {k: f"design ({case.reducer.case})" for k in design_inputs},
         },
