@@ -40,6 +40,7 @@ from gearte.solvers.rv_equilibrium import (
     LAW_LINEAR,
     LAW_SECANT_PER_CONTACT,
     LAW_SECANT_PER_DISC,
+    _bearing_terms,
     _law_delta,
 )
 
@@ -277,19 +278,7 @@ def _newton_sp(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, kc, q, tol, 
             rx, ry = 2 * m, 2 * m + 1
             wx = _rows_dot(nidx, nval, q, rx) + en[m, 0]
             wy = _rows_dot(nidx, nval, q, ry) + en[m, 1]
-            rr = np.sqrt(wx * wx + wy * wy)
-            k0m = CLEARANCE_RESIDUAL * kn[m]
-            gx, gy = k0m * wx, k0m * wy
-            hxx, hyy, hxy = k0m, k0m, 0.0
-            if rr > cn[m]:
-                k1m = kn[m] - k0m
-                ux, uy = wx / rr, wy / rr
-                s = 1.0 - cn[m] / rr
-                gx += k1m * (rr - cn[m]) * ux
-                gy += k1m * (rr - cn[m]) * uy
-                hxx += k1m * (s + (1.0 - s) * ux * ux)
-                hyy += k1m * (s + (1.0 - s) * uy * uy)
-                hxy += k1m * (1.0 - s) * ux * uy
+            gx, gy, hxx, hyy, hxy = _bearing_terms(wx, wy, kn[m], cn[m])
             # x and y rows share one column pattern (both rows of the same bearing)
             for a in range(Wn):
                 ia = nidx[rx, a]
@@ -462,19 +451,7 @@ def _newton_law(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, F, dp
             rx, ry = 2 * m, 2 * m + 1
             wx = _rows_dot(nidx, nval, q, rx) + en[m, 0]
             wy = _rows_dot(nidx, nval, q, ry) + en[m, 1]
-            rr = np.sqrt(wx * wx + wy * wy)
-            k0m = CLEARANCE_RESIDUAL * kn[m]
-            gx, gy = k0m * wx, k0m * wy
-            hxx, hyy, hxy = k0m, k0m, 0.0
-            if rr > cn[m]:
-                k1m = kn[m] - k0m
-                ux, uy = wx / rr, wy / rr
-                s = 1.0 - cn[m] / rr
-                gx += k1m * (rr - cn[m]) * ux
-                gy += k1m * (rr - cn[m]) * uy
-                hxx += k1m * (s + (1.0 - s) * ux * ux)
-                hyy += k1m * (s + (1.0 - s) * uy * uy)
-                hxy += k1m * (1.0 - s) * ux * uy
+            gx, gy, hxx, hyy, hxy = _bearing_terms(wx, wy, kn[m], cn[m])
             for a in range(Wn):
                 ia = nidx[rx, a]
                 bx, by = nval[rx, a], nval[ry, a]

@@ -139,6 +139,28 @@ def _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q):
 
 
 @njit(cache=True, nogil=True)
+def _bearing_terms(wx, wy, k, c):
+    """Gradient (gx, gy) and Hessian (hxx, hyy, hxy) in w-space of a bearing with radial
+    clearance ``c`` [mm] and stiffness ``k`` [N/mm] at relative displacement (wx, wy) [mm]:
+    k (|w| − c) u and k [s I + (1 − s) u uᵀ] beyond the clearance, plus the residual
+    stiffness CLEARANCE_RESIDUAL·k everywhere (s = 1 − c/|w|, u = w/|w|)."""
+    rr = np.sqrt(wx * wx + wy * wy)
+    k0 = CLEARANCE_RESIDUAL * k
+    gx, gy = k0 * wx, k0 * wy
+    hxx, hyy, hxy = k0, k0, 0.0
+    if rr > c:
+        k1 = k - k0
+        ux, uy = wx / rr, wy / rr
+        s = 1.0 - c / rr
+        gx += k1 * (rr - c) * ux
+        gy += k1 * (rr - c) * uy
+        hxx += k1 * (s + (1.0 - s) * ux * ux)
+        hyy += k1 * (s + (1.0 - s) * uy * uy)
+        hxy += k1 * (1.0 - s) * ux * uy
+    return gx, gy, hxx, hyy, hxy
+
+
+@njit(cache=True, nogil=True)
 def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
     """Minimise Π for fixed contact stiffness; returns (q, iterations, ok).
 
@@ -168,28 +190,14 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
         for m in range(nm):
             wx = Bn[m, 0] @ q + en[m, 0]
             wy = Bn[m, 1] @ q + en[m, 1]
-            rr = np.sqrt(wx * wx + wy * wy)
-            k0m = CLEARANCE_RESIDUAL * kn[m]
-            gx, gy = k0m * wx, k0m * wy
-            hxx, hyy, hxy = k0m, k0m, 0.0
-            if rr > cn[m]:
-                k1m = kn[m] - k0m
-                ux, uy = wx / rr, wy / rr
-                s = 1.0 - cn[m] / rr
-                # w-space gradient k (|w| - c) u and Hessian k [s I + (1 - s) u uᵀ]
-                gx += k1m * (rr - cn[m]) * ux
-                gy += k1m * (rr - cn[m]) * uy
-                hxx += k1m * (s + (1.0 - s) * ux * ux)
-                hyy += k1m * (s + (1.0 - s) * uy * uy)
-                hxy += k1m * (1.0 - s) * ux * uy
-            if True:
-                for a in range(nd):
-                    bx, by = Bn[m, 0, a], Bn[m, 1, a]
-                    grad[a] += gx * bx + gy * by
-                    ta = hxx * bx + hxy * by
-                    tb = hxy * bx + hyy * by
-                    for b in range(nd):
-                        H[a, b] += ta * Bn[m, 0, b] + tb * Bn[m, 1, b]
+            gx, gy, hxx, hyy, hxy = _bearing_terms(wx, wy, kn[m], cn[m])
+            for a in range(nd):
+                bx, by = Bn[m, 0, a], Bn[m, 1, a]
+                grad[a] += gx * bx + gy * by
+                ta = hxx * bx + hxy * by
+                tb = hxy * bx + hyy * by
+                for b in range(nd):
+                    H[a, b] += ta * Bn[m, 0, b] + tb * Bn[m, 1, b]
         for a in range(nd):
             H[a, a] += reg
         dq = -np.linalg.solve(H, grad)
