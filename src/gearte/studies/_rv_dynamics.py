@@ -415,9 +415,10 @@ def _sweep_one(task) -> float:
 
 def _speed_sweep(case, model, options) -> AnalysisResult:
     from gearte.execution import map_chunks
+    from gearte.studies import sample_cap
 
     o = case.analyses.speed_sweep
-    speeds = np.linspace(o.speed_min_rpm, o.speed_max_rpm, o.count)
+    speeds = np.linspace(o.speed_min_rpm, o.speed_max_rpm, sample_cap(o, "count", options))
     p2p = np.array(
         map_chunks(
             _sweep_one,
