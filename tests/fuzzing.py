@@ -11,13 +11,21 @@ and is classified:
 * ``rejected``: a ``CaseFileError``; every line must be one line naming a key;
 * ``crash``: any other exception (would be exit 3 "bug" in the CLI).
 
-Accepted mutants can also go through ``gearte run`` (``--runs N``): in this process, through the
-CLI's own entry point (its exit codes), with ``--samples 4 --workers 1`` and tight time/memory
-budgets (``GEARTE_MAX_SECONDS``/``GEARTE_MAX_MEMORY_GB``, so an oversized mutant is refused at
-validation as it would be for a user), under an address-space limit (:data:`RUN_MEMORY_LIMIT`, the
-memory bound) and a per-run alarm. Exit 0, 1 or 2 is fine; exit 3 (a bug), a timeout or a run
-past the memory bound is not; and the input recorded in ``results.json`` must keep every given
-value's type (no coercion through ``run`` either).
+Accepted mutants also go through ``gearte run`` (``--runs N``, ``-1``: every accepted mutant),
+through the CLI's own entry point (its exit codes, its output writing into a temporary folder),
+with ``--samples 4 --workers 1`` (``--samples`` sets every Monte-Carlo count and caps every other
+count of sampled work) and tight time/memory budgets (``GEARTE_MAX_SECONDS``/
+``GEARTE_MAX_MEMORY_GB``, so an oversized mutant is refused at validation as it would be for a
+user), under an address-space limit (:data:`RUN_MEMORY_LIMIT`, the memory bound) and a time-out.
+The long job runs them in a **fork server** (:class:`ForkServer`): one parent imports gearte and
+runs every bundled case once (every kind's kernels loaded or compiled), then forks a child per
+mutant, ``--workers`` at a time; a child past the time-out is killed and reaped; per run the exit
+code, the message, peak RSS, CPU and wall time are recorded (``--record``). ``--equivalence N``
+runs N further accepted mutants both as real ``gearte run`` processes and through the fork
+server and compares the outcomes. Exit 0, 1 or 2 with one error line (naming the key for bad
+input) is fine; exit 3 (a bug), a crash, a time-out, a run past the memory bound or a malformed
+message is not; and the input recorded in ``results.json`` must keep every given value's type
+(no coercion through ``run`` either).
 
 Measurement files are fuzzed too (``--files N``): the bundled bench files (TE traces, hysteresis
 curve, :mod:`gearte.io.bench`), one file of each metrology format written from seeded parts and
@@ -28,7 +36,7 @@ numbers, or one ``BenchFileError``/``MeasurementFileError`` line naming the file
 is a crash.
 
 Small runs are part of the test suite (``tests/test_fuzz_cases.py``, hypothesis-driven); the long
-job is ``make fuzz`` (``python tests/fuzzing.py --count 10000 --files 10000 --runs 300``), which
+job is ``make fuzz`` (``python tests/fuzzing.py --count 10000 --files 10000 --runs -1``), which
 prints the tallies.
 """
 
@@ -434,6 +442,7 @@ def run_subprocess(text: str, tmp: Path, timeout_s: float, report: bool = False)
     import resource
     import subprocess
 
+    tmp.mkdir(parents=True, exist_ok=True)
     link_case_data(tmp)
     path = tmp / "run.toml"
     path.write_text(text, encoding="utf-8")
@@ -537,9 +546,13 @@ class ForkServer:
                 f = os.open(d / name, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
                 os.dup2(f, fd)
                 os.close(f)
+            # Python's streams onto those files (under pytest they point at its capture)
+            sys.stdout = open(1, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
+            sys.stderr = open(2, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
             code = _cli_exit_code(run_args(d / "run.toml", d / "out", self.report))
         except BaseException as exc:  # noqa: BLE001 - a click usage error or anything else
-            print(f"harness: {type(exc).__name__}: {exc}", file=sys.stderr)
+            what = "MemoryError" if isinstance(exc, MemoryError) else type(exc).__name__
+            print(f"harness: {what}: {exc}", file=sys.stderr)
             code = 98
         finally:
             with contextlib.suppress(Exception):
