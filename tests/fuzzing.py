@@ -52,6 +52,7 @@ import sys
 import time
 import tomllib
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -325,12 +326,18 @@ BAD_RUN = (
 )
 
 
+_LINKED: set[Path] = set()
+
+
 def link_case_data(tmp: Path) -> None:
     """Make the bundled cases' data folders (bench files, the lot's metrology files) reachable
     from ``tmp`` as from ``examples/``, so mutants of the data-backed cases written there still
     find their files (otherwise they could only ever be rejected)."""
     from gearte.cases import case_path
 
+    if tmp in _LINKED:
+        return
+    _LINKED.add(tmp)
     examples = case_path("synthetic_rv_bench").parent
     for entry in examples.iterdir():
         link = tmp / entry.name
@@ -501,10 +508,18 @@ class ForkServer:
     exit code, the message, the child's peak RSS and CPU time (``wait4``) and the wall time.
     """
 
-    def __init__(self, root: Path, workers: int, timeout_s: float, report: bool = False) -> None:
+    def __init__(
+        self,
+        root: Path,
+        workers: int,
+        timeout_s: float,
+        report: bool = False,
+        on_record: Callable[[RunRecord], None] | None = None,
+    ) -> None:
         self.root, self.workers, self.timeout_s, self.report = root, workers, timeout_s, report
         self.running: dict[int, tuple[tuple[int, str, str, str], float, Path]] = {}
         self.records: list[RunRecord] = []
+        self.on_record = on_record
         link_case_data(root)
 
     def warm(self, names: list[str] | None = None) -> dict[str, str]:
@@ -592,6 +607,8 @@ class ForkServer:
             )
         )
         shutil.rmtree(d, ignore_errors=True)
+        if self.on_record is not None:
+            self.on_record(self.records[-1])
 
     def _reap(self, block: bool) -> None:
         import os
@@ -916,6 +933,7 @@ def equivalence(
             jobs.append((i, name, done, text))
         i += 1
     first = len(server.records)
+    server.on_record = None  # not part of the fuzzed runs
     for job in jobs:
         server.submit(*job)
     forked = {r.index: r for r in server.drain()[first:]}
@@ -973,7 +991,15 @@ def main(argv: list[str] | None = None) -> int:
         server = None
         warm_s = 0.0
         if a.runs and not a.in_process:
-            server = ForkServer(tmp, a.workers, a.run_timeout, a.report)
+
+            def on_record(r: RunRecord) -> None:  # as each run ends: a long job can be followed
+                if records is not None:
+                    records.write(json.dumps({"run": vars(r)}) + "\n")
+                    records.flush()
+                if not a.quiet and r.status in BAD_RUN:
+                    print(f"[{r.status}] {r.base}: {r.done}\n    {r.message}", file=sys.stderr)
+
+            server = ForkServer(tmp, a.workers, a.run_timeout, a.report, on_record)
             warmed = server.warm()
             warm_s = time.perf_counter() - t0
             if not a.quiet:
@@ -984,10 +1010,6 @@ def main(argv: list[str] | None = None) -> int:
         if server is not None:
             for r in server.drain():
                 tally[r.status] += 1
-                if records is not None:
-                    records.write(json.dumps({"run": vars(r)}) + "\n")
-                if not a.quiet and r.status in BAD_RUN:
-                    print(f"[{r.status}] {r.base}: {r.done}\n    {r.message}", file=sys.stderr)
         t1 = time.perf_counter()
         mismatches: list[str] = []
         if a.equivalence and server is not None:

@@ -102,21 +102,42 @@ def _accepted(tmp_path, names, n, seed):
     return got
 
 
-def _no_children_left():
+@pytest.fixture
+def forked(monkeypatch):
+    """The pids the fork server forks; :func:`_reaped` checks they are all reaped."""
     import os
 
-    try:
-        os.waitpid(-1, os.WNOHANG)
-    except ChildProcessError:
-        return True
-    return False
+    pids: list[int] = []
+    real_fork = os.fork
+
+    def fork() -> int:
+        pid = real_fork()
+        if pid:
+            pids.append(pid)
+        return pid
+
+    monkeypatch.setattr(os, "fork", fork)
+    return pids
 
 
-def test_fork_server_runs_accepted_mutants_as_gearte_run_and_records_each(tmp_path):
+def _reaped(pids):
+    import os
+
+    for pid in pids:
+        try:
+            os.waitpid(pid, os.WNOHANG)
+        except ChildProcessError:
+            continue
+        return False
+    return bool(pids)
+
+
+def test_fork_server_runs_accepted_mutants_as_gearte_run_and_records_each(tmp_path, forked):
     """The long job's path: a forked child per accepted mutant runs the CLI entry point; each
     run is recorded with its exit code, message, peak RSS and CPU time, and every child is
     reaped."""
     server = ForkServer(tmp_path, workers=2, timeout_s=120)
+    assert server.warm(FAST[:1]) == {FAST[0]: "run_exit_0"}  # the parent: imports and kernels
     jobs = _accepted(tmp_path, FAST[:1], 2, 7)
     for job in jobs:
         server.submit(*job)
@@ -125,11 +146,11 @@ def test_fork_server_runs_accepted_mutants_as_gearte_run_and_records_each(tmp_pa
     for r in records:
         assert r.status in ("run_exit_0", "run_exit_1", "run_exit_2"), r
         assert r.code in (0, 1, 2) and r.peak_rss_mb > 0 and r.cpu_s > 0 and r.wall_s > 0
-    assert _no_children_left()
+    assert _reaped(forked)
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith("run")] == []
 
 
-def test_fork_server_kills_and_reaps_a_run_past_its_time_out(tmp_path, monkeypatch):
+def test_fork_server_kills_and_reaps_a_run_past_its_time_out(tmp_path, monkeypatch, forked):
     import time
 
     monkeypatch.setattr(fuzzing, "_cli_exit_code", lambda args: time.sleep(60) or 0)
@@ -137,7 +158,7 @@ def test_fork_server_kills_and_reaps_a_run_past_its_time_out(tmp_path, monkeypat
     server.submit(0, "jiang2024_spur_pair", "none", to_toml(CORPUS["jiang2024_spur_pair"]))
     (r,) = server.drain()
     assert r.status == "run_timeout" and r.code is None and r.wall_s < 30
-    assert _no_children_left()
+    assert _reaped(forked)
 
 
 def test_fork_server_counts_a_run_past_the_memory_bound(tmp_path, monkeypatch):

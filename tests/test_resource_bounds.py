@@ -146,12 +146,14 @@ def test_samples_caps_the_sobol_and_allocation_runs_of_a_yield(monkeypatch):
         ("hu2020_rv80e_yield", ("analyses", "yield", "sobol_samples"), 10, "sobol_samples"),
         ("jiang2024_spur_pair", ("analysis", "sobol_samples"), 20, "sobol_samples"),
         ("hu2020_rv80e_yield", ("analyses", "yield", "allocation", "samples"), 200, "381"),
+        ("hu2020_rv80e_yield", ("analyses", "yield", "spec"), {}, "spec limit"),
     ],
 )
 def test_sample_counts_run_would_refuse_are_refused_by_validate(name, where, value, key):
     """``sobol_samples = 10`` passed validate and failed in ``run`` (a Sobol estimate needs 50
     base samples, 100 for a gear pair); an allocation search too small to show its target
-    yield failed after the Monte-Carlo. Both are case errors now, naming the key."""
+    yield or without a spec limit failed after the Monte-Carlo. They are case errors now, naming
+    the key."""
     data = _case_dict(name)
     node = data
     for k in where[:-1]:
@@ -160,3 +162,19 @@ def test_sample_counts_run_would_refuse_are_refused_by_validate(name, where, val
     with pytest.raises(CaseFileError) as err:
         load_case_dict(data)
     assert any(key in f"{field}: {msg}" for field, msg in err.value.errors), err.value.errors
+
+
+def test_allocation_cost_of_an_unknown_tolerance_is_refused_before_the_monte_carlo(monkeypatch):
+    """The check needs the drive's tolerance families (known when the analysis starts): it now
+    runs before the yield Monte-Carlo, not after it and the Sobol indices."""
+    import gearte.tolerance.yield_mc as yield_mc
+    from gearte.studies import RunOptions, run_case
+
+    def no_work(*a, **kw):
+        raise AssertionError("the Monte-Carlo ran before the check")
+
+    monkeypatch.setattr(yield_mc, "run_yield", no_work)
+    data = _case_dict("hu2020_rv80e_yield")
+    data["analyses"]["yield"]["allocation"]["costs"]["nonsense"] = {"b": 1.0}
+    with pytest.raises(ParameterError, match="allocation.costs.nonsense"):
+        run_case(data, RunOptions(progress=False, samples=60, workers=1))

@@ -277,6 +277,8 @@ class YieldSection(StrictModel):
 
     @model_validator(mode="after")
     def _sample_counts_can_run(self) -> YieldSection:
+        if self.allocation is not None and not self.spec:
+            raise ValueError("allocation needs at least one spec limit (analyses.yield.spec)")
         if 0 < self.sobol_samples < SOBOL_MIN_SAMPLES:
             raise ValueError(
                 f"sobol_samples = {self.sobol_samples}: Sobol estimation needs 0 (none) or >= "
@@ -468,6 +470,16 @@ def yield_analysis(
     defaults = dict(defaults or {})
     ts = _tolerances(section, units, nominal, defaults, dict(families or {}), grade_um)
     spec = [SpecLimit(q, s.lower, s.upper) for q, s in section.spec.items()]
+    costs: dict[str, CostModel | PriceTable] = {}  # checked before any work
+    for key, c in (section.allocation.costs if section.allocation else {}).items():
+        if key not in ts.families:
+            raise ParameterError(
+                f"analyses.yield.allocation.costs.{key}", key, "has no tolerance to allocate"
+            )
+        if c.b is not None:
+            costs[key] = CostModel(c.a, c.b, c.k)
+        else:
+            costs[key] = PriceTable(tuple(c.widths or ()), tuple(c.prices or ()))
     progress = getattr(options, "progress", False)
     res = run_yield(
         model,
@@ -568,16 +580,6 @@ def yield_analysis(
             files[f"worst_sample_{i + 1}.toml"] = header + to_toml(case)
     values["worst_samples"] = worst
     if section.allocation is not None:
-        costs: dict[str, CostModel | PriceTable] = {}
-        for key, c in section.allocation.costs.items():
-            if key not in ts.families:
-                raise ParameterError(
-                    f"analyses.yield.allocation.costs.{key}", key, "has no tolerance to allocate"
-                )
-            if c.b is not None:
-                costs[key] = CostModel(c.a, c.b, c.k)
-            else:
-                costs[key] = PriceTable(tuple(c.widths or ()), tuple(c.prices or ()))
         # under --samples: capped, but never below what can show the target (validated above)
         alloc_n = sample_cap(section.allocation, "samples", options) or n
         if getattr(options, "samples", None) is not None:
