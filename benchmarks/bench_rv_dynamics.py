@@ -143,7 +143,8 @@ def memory(record_dt: float, report: bool) -> None:
         )
     ratio = rows[20][0] / rows[1][0]
     verdict = "met" if ratio <= 1.2 else "NOT met"
-    print(f"goal peak memory 20 rev / 1 rev ≤ 1.2×: measured {ratio:.2f}× — {verdict}")
+    kids = f"; children (report renderers) {rows[20][1] / rows[1][1]:.2f}×" if rows[1][1] else ""
+    print(f"goal peak memory 20 rev / 1 rev ≤ 1.2×: measured {ratio:.2f}× — {verdict}{kids}")
 
 
 def batch_scaling(model, red, dt: float, settle: float, duration: float, workers: int) -> None:

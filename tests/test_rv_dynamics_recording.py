@@ -199,3 +199,53 @@ def test_batch_system_carries_its_stability_limit(model):
     other = model.with_errors(table3_errors("first"))
     assert other.damped_eigenvalues(mesh="max") is system.stability_eigenvalues
     assert not system.stability_eigenvalues.flags.writeable
+
+
+def test_dopri5_window_is_the_tail_of_its_full_record(start):
+    system, y0, dt = start
+    kw = dict(method="dopri5", t_settle=40 * dt, record_dt=3 * dt, rtol=1e-8, atol=1e-12)
+    full = integrate(system, y0, (0.0, 400 * dt), **kw)
+    tail = integrate(system, y0, (0.0, 400 * dt), record_window=20, **kw)
+    assert full.records == tail.records == full.t.size > 20
+    np.testing.assert_array_equal(tail.t, full.t[-20:])
+    np.testing.assert_array_equal(tail.output, full.output[-20:])
+    assert tail.stats == full.stats
+
+
+def _dte_case(**dte) -> dict:
+    import tomllib
+
+    from gearte.cases import case_path
+
+    data = tomllib.loads(case_path("li2023_rv").read_text())
+    data["analyses"] = {"dte": {"duration_s": 0.05, "settle_s": 0.02, **dte}}
+    return data
+
+
+def test_study_record_points_bound_the_trace_and_zero_keeps_every_row():
+    """`[analyses.dte] record_points`: a short window gives the spectrum of the last rows (its
+    resolution and the notes say so); 0 keeps every row; peak-to-peak is the same."""
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies import RunOptions, run_case
+
+    opts = RunOptions(progress=False, workers=1)
+    win = run_case(load_case_dict(_dte_case(record_points=100)), opts)["dte"]
+    every = run_case(load_case_dict(_dte_case(record_points=0)), opts)["dte"]
+    r_win, r_all = win.data["dte"], every.data["dte"]
+    assert r_win.t.size == 100 and not r_win.covers_span
+    assert r_all.covers_span and r_all.t.size == r_all.solver.records > 400
+    assert win.values["spectrum_window [s]"] == pytest.approx(100 * r_win.record_dt)
+    assert every.values["spectrum_window [s]"] == pytest.approx(r_all.t.size * r_all.record_dt)
+    assert win.values["spectrum_nyquist [Hz]"] == pytest.approx(0.5 / r_win.record_dt)
+    assert any("over the last" in n for n in win.notes)
+    assert not any("over the last" in n for n in every.notes)
+    p2p = "dte_peak_to_peak [arcsec]"
+    assert win.values[p2p] == every.values[p2p]
+
+
+def test_study_refuses_a_negative_record_points():
+    from gearte.errors import CaseFileError
+    from gearte.io.case_file import load_case_dict
+
+    with pytest.raises(CaseFileError, match="record_points"):
+        load_case_dict(_dte_case(record_points=-1))
