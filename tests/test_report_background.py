@@ -73,3 +73,18 @@ def test_unused_worker_is_ended_and_reaped() -> None:
     with ReportWorker.start() as worker:
         pid = worker.pid
     assert _reaped(pid)
+
+
+def test_fixed_grid_leaves_the_asked_room_around_each_panel() -> None:
+    from gearte.plotting import new_figure
+
+    fig, axes = new_figure(2, 3, figsize=(9.0, 5.6), margins_in=(0.9, 0.5, 0.3, 0.1))
+    assert fig.get_layout_engine() is None  # nothing measured at draw time
+    boxes = [ax.get_position() for ax in axes.ravel()]
+    w, h = 9.0, 5.6
+    assert boxes[0].x0 * w == pytest.approx(0.9) and boxes[2].x1 * w == pytest.approx(9.0 - 0.1)
+    assert (boxes[1].x0 - boxes[0].x1) * w == pytest.approx(0.9)  # room for the next y labels
+    assert (boxes[0].y0 - boxes[3].y1) * h == pytest.approx(0.5 + 0.3)  # x labels + title
+    assert boxes[3].y0 * h == pytest.approx(0.5) and (1 - boxes[0].y1) * h == pytest.approx(0.3)
+    with pytest.raises(ValueError, match="no room"):
+        new_figure(1, 4, figsize=(3.0, 3.0), margins_in=(0.9, 0.5, 0.3, 0.1))
