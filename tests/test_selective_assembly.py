@@ -181,3 +181,17 @@ def test_lot_shapes_are_checked(small):
     bad = dataclasses.replace(lot4, cam_phase=lot4.cam_phase[:, :2])
     with pytest.raises(Exception, match="cam_phase"):
         bad.check(design)
+
+
+@pytest.mark.parametrize("kind", ["synthetic_rv110e_lot", "synthetic_rv110e_serial"])
+def test_measured_parts_case_refuses_a_design_that_is_not_an_rv_reducer(kind):
+    """rv_lot and rv_serial share their case base (design reference, files read at
+    validation): a design case of another kind is refused naming ``reducer.case``."""
+    from gearte.errors import CaseFileError
+    from gearte.io.case_file import load_case_dict
+
+    path = case_path(kind)
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    data["reducer"]["case"] = "jiang2024_spur_pair"
+    with pytest.raises(CaseFileError, match=r"reducer\.case.*need rv_reducer"):
+        load_case_dict(data, base_dir=str(path.parent))
