@@ -237,25 +237,35 @@ def run(
         from gearte.studies import RunOptions, run_case
 
         t1 = time.perf_counter()
-        c = load_case(case)
-        t2 = time.perf_counter()
-        default = os.path.join("out", safe_label(c.case.name or c.case.kind))
-        target = check_output_dir(out_dir if out_dir is not None else default)
-        with _executor(scheduler, workers) as executor:
-            opts = RunOptions(
-                progress=not no_progress,
-                seed=seed,
-                samples=samples,
-                scheduler=executor,
-                workers=workers,
-            )
-            try:
-                result = run_case(c, opts)
-            except (KeyboardInterrupt, ClusterLostError) as exc:
-                _write_partial(exc, target)
-                raise
-        result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
-        paths = write_outputs(result, target, report=not no_report)
+        # the report's process imports matplotlib while this one runs the analyses
+        renderer = None
+        if not no_report:
+            from gearte.report.background import ReportWorker
+
+            renderer = ReportWorker.start(case)
+        try:
+            c = load_case(case)
+            t2 = time.perf_counter()
+            default = os.path.join("out", safe_label(c.case.name or c.case.kind))
+            target = check_output_dir(out_dir if out_dir is not None else default)
+            with _executor(scheduler, workers) as executor:
+                opts = RunOptions(
+                    progress=not no_progress,
+                    seed=seed,
+                    samples=samples,
+                    scheduler=executor,
+                    workers=workers,
+                )
+                try:
+                    result = run_case(c, opts)
+                except (KeyboardInterrupt, ClusterLostError) as exc:
+                    _write_partial(exc, target)
+                    raise
+            result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
+            paths = write_outputs(result, target, report=not no_report, worker=renderer)
+        finally:
+            if renderer is not None:
+                renderer.close()
         for w in result.warnings:
             click.echo(f"warning: {w}", err=True)
         click.echo(f"{result.name}: {len(result.analyses)} analyses in {result.elapsed_s:.2f} s")

@@ -120,7 +120,10 @@ def _dte_figures(a) -> list[Figure]:
         b = n.split(".")[0]
         if b not in bodies:
             bodies.append(b)
-    fig, axes = new_figure(2, len(bodies), figsize=(3.0 * len(bodies), 5.6))
+    # a fixed grid of like panels: constrained layout measured 2 x n panels for most of its time
+    fig, axes = new_figure(
+        2, len(bodies), figsize=(3.0 * len(bodies), 5.6), margins_in=(0.95, 0.5, 0.35, 0.1)
+    )
     axes = np.atleast_2d(axes)
     for c, b in enumerate(bodies):
         ix, iy = names.index(f"{b}.x"), names.index(f"{b}.y")
