@@ -32,7 +32,13 @@ import re
 
 from gearte.errors import ParameterError
 
-__all__ = ["SIZE_UPPER_BOUNDS_MM", "IT_GRADES", "standard_tolerance_um", "js_allowances_um"]
+__all__ = [
+    "SIZE_UPPER_BOUNDS_MM",
+    "IT_GRADES",
+    "standard_tolerance_um",
+    "parse_js_field",
+    "js_allowances_um",
+]
 
 #: Upper bound of each nominal-size row [mm]; row ``i`` covers ``bounds[i−1] < size ≤ bounds[i]``
 #: (the first row ``size ≤ 3 mm``).
@@ -101,6 +107,38 @@ def standard_tolerance_um(grade: int, nominal_size_mm: float, field: str = "grad
     return float(_IT_UM[grade][row])
 
 
+def parse_js_field(tolerance_field: str, field: str = "centre_distance_allowance") -> int:
+    """The grade of a symmetric ISO 286 field: ``"js7"`` (or ``"JS 7"``) → 7.
+
+    Parameters
+    ----------
+    tolerance_field : str
+        ``"js5"`` … ``"js11"``.
+    field : str
+        Name of the input (for the error message).
+
+    Returns
+    -------
+    int
+        The standard tolerance grade.
+
+    Examples
+    --------
+    >>> parse_js_field("JS 7")
+    7
+    """
+    m = _JS.match(tolerance_field.lower()) if isinstance(tolerance_field, str) else None
+    grade = int(m.group(1)) if m else -1
+    if grade not in _IT_UM:
+        raise ParameterError(
+            field,
+            tolerance_field,
+            f"must be a symmetric ISO 286 field js{IT_GRADES[0]} … js{IT_GRADES[-1]} (DIN 3964), "
+            "e.g. 'js7'",
+        )
+    return grade
+
+
 def js_allowances_um(
     tolerance_field: str, nominal_size_mm: float, field: str = "centre_distance_allowance"
 ) -> tuple[float, float]:
@@ -129,13 +167,7 @@ def js_allowances_um(
     >>> js_allowances_um("js7", 52.0)   # STplus: A_Ae = +0.015, A_Ai = -0.015 mm
     (15.0, -15.0)
     """
-    m = _JS.match(tolerance_field.lower()) if isinstance(tolerance_field, str) else None
-    grade = int(m.group(1)) if m else -1
-    if grade not in _IT_UM:
-        raise ParameterError(
-            field,
-            tolerance_field,
-            f"must be a symmetric ISO 286 field js{IT_GRADES[0]} … js{IT_GRADES[-1]}, e.g. 'js7'",
-        )
-    half = 0.5 * standard_tolerance_um(grade, nominal_size_mm, field)
+    half = 0.5 * standard_tolerance_um(
+        parse_js_field(tolerance_field, field), nominal_size_mm, field
+    )
     return half, -half
