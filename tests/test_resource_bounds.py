@@ -178,3 +178,24 @@ def test_allocation_cost_of_an_unknown_tolerance_is_refused_before_the_monte_car
     data["analyses"]["yield"]["allocation"]["costs"]["nonsense"] = {"b": 1.0}
     with pytest.raises(ParameterError, match="allocation.costs.nonsense"):
         run_case(data, RunOptions(progress=False, samples=60, workers=1))
+
+
+@pytest.mark.parametrize(
+    ("key", "match"),
+    [
+        ("planet_mass_kg", "reducer.dynamics"),  # no finite elastic mode (was IndexError, exit 3)
+        ("sun_inertia_kgm2", "RK4 integration of"),  # ~1e151 steps (was OverflowError, exit 3)
+    ],
+)
+def test_absurd_dynamics_inertia_is_bad_input_before_any_step(key, match, monkeypatch):
+    """Found by the fuzzing run through ``gearte run``: a mass or inertia of 1e-300 passes its
+    schema bound (> 0); the dynamics then failed with an internal error. Now a clear error
+    naming the dynamics input, or the step count against the time budget, before integrating."""
+    from gearte.studies import RunOptions, run_case
+
+    monkeypatch.setenv("GEARTE_MAX_SECONDS", "20")
+    data = _case_dict("li2023_rv_unmodified")
+    data["reducer"]["dynamics"][key] = 1e-300
+    with pytest.raises(ParameterError, match=match) as err:
+        run_case(data, RunOptions(progress=False, samples=4, workers=1))
+    assert "\n" not in str(err.value)
