@@ -515,8 +515,10 @@ class ForkServer:
         timeout_s: float,
         report: bool = False,
         on_record: Callable[[RunRecord], None] | None = None,
+        cpu_limit_s: int | None = None,
     ) -> None:
         self.root, self.workers, self.timeout_s, self.report = root, workers, timeout_s, report
+        self.cpu_limit_s = cpu_limit_s
         self.running: dict[int, tuple[tuple[int, str, str, str], float, Path]] = {}
         self.records: list[RunRecord] = []
         self.on_record = on_record
@@ -556,6 +558,10 @@ class ForkServer:
         code = 99
         try:
             resource.setrlimit(resource.RLIMIT_AS, (RUN_MEMORY_LIMIT, RUN_MEMORY_LIMIT))
+            if self.cpu_limit_s is not None:  # CPU time: fair on a machine shared with others
+                used = resource.getrusage(resource.RUSAGE_SELF)
+                lim = int(used.ru_utime + used.ru_stime) + self.cpu_limit_s
+                resource.setrlimit(resource.RLIMIT_CPU, (lim, lim + 5))
             os.environ.update(RUN_BUDGETS)
             for fd, name in ((1, "stdout"), (2, "stderr")):
                 f = os.open(d / name, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
@@ -578,6 +584,7 @@ class ForkServer:
     def _finish(self, pid: int, status: int, ru: Any, timed_out: bool) -> None:
         import os
         import shutil
+        import signal
 
         (index, base, done, text), t0, d = self.running.pop(pid)
         wall = time.monotonic() - t0
@@ -585,6 +592,15 @@ class ForkServer:
         code: int | None = None
         if timed_out:
             out = Outcome("run_timeout", f"over {self.timeout_s} s, killed")
+        elif os.WIFSIGNALED(status) and (
+            os.WTERMSIG(status) == signal.SIGXCPU
+            or (  # the hard CPU limit
+                os.WTERMSIG(status) == signal.SIGKILL
+                and self.cpu_limit_s is not None
+                and ru.ru_utime + ru.ru_stime >= self.cpu_limit_s
+            )
+        ):
+            out = Outcome("run_timeout", f"over {self.cpu_limit_s} s of CPU, stopped")
         elif os.WIFSIGNALED(status):
             out = Outcome("run_crash", f"signal {os.WTERMSIG(status)}: {stderr[-300:]}")
         else:
@@ -966,7 +982,14 @@ def main(argv: list[str] | None = None) -> int:
         default=0,
         help="accepted mutants also run through gearte run (-1: every accepted mutant)",
     )
-    ap.add_argument("--run-timeout", type=float, default=120.0, help="per run [s]")
+    ap.add_argument("--run-timeout", type=float, default=120.0, help="per run, wall [s]")
+    ap.add_argument(
+        "--run-cpu-limit",
+        type=int,
+        default=None,
+        help="per run, CPU time [s] (RLIMIT_CPU of the fork server's child); with it the wall "
+        "time-out is only a backstop: give a larger --run-timeout on a shared machine",
+    )
     ap.add_argument(
         "--workers", type=int, default=os.cpu_count() or 1, help="runs at once (fork server)"
     )
@@ -999,7 +1022,7 @@ def main(argv: list[str] | None = None) -> int:
                 if not a.quiet and r.status in BAD_RUN:
                     print(f"[{r.status}] {r.base}: {r.done}\n    {r.message}", file=sys.stderr)
 
-            server = ForkServer(tmp, a.workers, a.run_timeout, a.report, on_record)
+            server = ForkServer(tmp, a.workers, a.run_timeout, a.report, on_record, a.run_cpu_limit)
             warmed = server.warm()
             warm_s = time.perf_counter() - t0
             if not a.quiet:

@@ -193,3 +193,18 @@ def test_fork_server_and_real_gearte_run_processes_agree(tmp_path):
         assert ref.status == forked[i].status, (name, done, ref, forked[i])
         if ref.status != "run_exit_0":
             assert ref.detail.splitlines()[0][:200] == forked[i].message
+
+
+def test_fork_server_stops_a_run_past_its_cpu_time_limit(tmp_path, monkeypatch, forked):
+    """On a shared machine the limit is CPU time (RLIMIT_CPU), the wall time-out a backstop."""
+
+    def spin(args):
+        while True:
+            pass
+
+    monkeypatch.setattr(fuzzing, "_cli_exit_code", spin)
+    server = ForkServer(tmp_path, workers=1, timeout_s=120, cpu_limit_s=1)
+    server.submit(0, "jiang2024_spur_pair", "none", to_toml(CORPUS["jiang2024_spur_pair"]))
+    (r,) = server.drain()
+    assert r.status == "run_timeout" and "CPU" in r.message and r.cpu_s > 0.5
+    assert _reaped(forked)
