@@ -70,10 +70,12 @@ FUZZ_COUNT ?= 10000
 FUZZ_FILES ?= 10000
 FUZZ_RUNS ?= -1
 FUZZ_EQUIVALENCE ?= 20
+FUZZ_RUN_CPU ?= 60
 fuzz: $(DEV_STAMP)
 	mkdir -p out
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test nice -n 10 $(BIN)/python tests/fuzzing.py \
 		--count $(FUZZ_COUNT) --files $(FUZZ_FILES) --runs $(FUZZ_RUNS) \
+		--run-cpu-limit $(FUZZ_RUN_CPU) --run-timeout 600 \
 		--equivalence $(FUZZ_EQUIVALENCE) --record out/fuzz.jsonl
 
 test-slow: $(DEV_STAMP)
