@@ -77,6 +77,7 @@ def run_once(case: str, cache_dir: str, out_dir: str) -> dict[str, float]:
     out["startup"] = wall - t["total in gearte"]
     out["wall"] = wall
     out["cpu"] = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    out["fallback"] = float(any(k.startswith("report process failed") for k in t))
     return out
 
 
@@ -84,8 +85,10 @@ def _row(name: str, label: str, r: dict[str, float]) -> str:
     other = r["wall"] - r["analyses"]
     ratio = other / r["analyses"] if r["analyses"] > 0 else float("inf")
     cells = " ".join(f"{r[s]:7.3f}" for s in STAGES)
+    flag = "  (report rendered in-process: the report process failed)" if r["fallback"] else ""
     return (
-        f"{name:32s} {label:4s} {cells} {r['wall']:7.2f} {r['cpu']:7.2f} {other:7.2f} {ratio:8.1f}"
+        f"{name:32s} {label:4s} {cells} {r['wall']:7.2f} {r['cpu']:7.2f} {other:7.2f} "
+        f"{ratio:8.1f}{flag}"
     )
 
 

@@ -150,3 +150,65 @@ def test_din3967_class_on_a_gear_chain_spur_stage_sets_the_yield_tolerances():
     keys = ("driving_gear_tooth_thickness", "driven_gear_tooth_thickness", "centre_distance")
     got = [tols[f"spur_pair.{k}"][f] for k in keys for f in ("tolerance", "nominal")]
     assert got == pytest.approx([20.0, -90.0, 25.0, -120.0, 20.0, 0.0])
+
+
+def _rv_first_stage(**keys) -> dict:
+    data = tomllib.loads(case_path("han2023_rv110e").read_text())
+    data["analyses"] = {}  # no reducer analysis: the first stage's backlash alone (fast)
+    data["reducer"]["first_stage"].update(keys)
+    return data
+
+
+def test_din3967_classes_on_the_rv_first_stage_report_its_backlash_by_hand():
+    """han2023_rv110e's first stage (m 1.5, z 20/40, α 20°, 40 pins → i = 1 + 40·40/20 = 81):
+    sun d 30 mm cd25 −54/−84 µm, planet d 60 mm cd25 −70/−110 µm, a = 45 mm js6 ±8 µm
+    (IT6 = 16 µm): j_t = 124 − 16 tan 20° = 118.18 µm … 194 + 16 tan 20° = 199.82 µm; at the
+    output j_t / (r_sun·i) = j_t / (15 mm · 81) = 0.334′ … 0.565′."""
+    from gearte import run_case
+    from gearte.studies import RunOptions
+    from gearte.units import rad_to_arcmin
+
+    data = _rv_first_stage(
+        sun_tooth_thickness_allowance="cd25",
+        planet_tooth_thickness_allowance="25 cd",
+        centre_distance_allowance="js6",
+    )
+    v = run_case(load_case(data), RunOptions(progress=False))["first_stage_backlash"].values
+    t, c = math.tan(math.radians(20.0)), math.cos(math.radians(20.0))
+    assert v["sun_allowances [um]"] == [-54.0, -84.0]
+    assert v["planet_allowances [um]"] == [-70.0, -110.0]
+    assert v["centre_distance_allowances [um]"] == [8.0, -8.0]
+    assert v["first_stage_backlash_circumferential_min [um]"] == pytest.approx(124 - 16 * t)
+    assert v["first_stage_backlash_circumferential_max [um]"] == pytest.approx(194 + 16 * t)
+    assert v["first_stage_backlash_normal_max [um]"] == pytest.approx((194 + 16 * t) * c)
+    out = v["first_stage_backlash_at_output_max [arcmin]"]
+    assert out == pytest.approx(rad_to_arcmin((194 + 16 * t) * 1e-3 / (15.0 * 81.0)))
+    assert out == pytest.approx(0.5654, abs=1e-4)
+    assert v["planet_class"] == "cd25"
+
+
+@pytest.mark.parametrize(
+    ("keys", "message"),
+    [
+        ({"sun_tooth_thickness_allowance": "cd25"}, "go together"),
+        (
+            {
+                "sun_tooth_thickness_allowance": "zz25",
+                "planet_tooth_thickness_allowance": "cd25",
+                "centre_distance_allowance": "js6",
+            },
+            r"reducer\.first_stage\.sun_tooth_thickness_allowance.*DIN 3967",
+        ),
+        (
+            {
+                "sun_tooth_thickness_allowance": "cd25",
+                "planet_tooth_thickness_allowance": "cd25",
+                "centre_distance_allowance": "k6",
+            },
+            r"reducer\.first_stage\.centre_distance_allowance.*js5",
+        ),
+    ],
+)
+def test_din3967_bad_rv_first_stage_classes_are_errors_naming_the_key(keys, message):
+    with pytest.raises(CaseFileError, match=message):
+        load_case(_rv_first_stage(**keys))

@@ -54,6 +54,8 @@ def test_worker_that_cannot_render_falls_back_in_process(result: Any, tmp_path: 
     os.kill(worker.pid, 9)  # the worker dies before the result is sent
     paths = write_outputs(result, tmp_path / "out", worker=worker)
     assert paths["report"].read_text().count("data:image/png;base64,") > 0
+    assert "report process failed: rendered in-process" in result.timings  # said, not hidden
+    del result.timings["report process failed: rendered in-process"]
 
 
 def test_unpicklable_result_is_rendered_in_process(result: Any, tmp_path: Any) -> None:

@@ -368,6 +368,9 @@ def write_outputs(
     elif report:
         from gearte.report.html import render_figures, render_report
 
+        if worker is not None:  # say so: the run took the slow path
+            timings["report process failed: rendered in-process"] = 0.0
+
         figures = render_figures(result, timings)
         t0 = time.perf_counter()
         texts["report.html"] = render_report(result, figures)

@@ -62,6 +62,34 @@ FIGURES = "gearte.plotting.gear_chain"
 _UM = Field(ge=0, le=10_000)
 
 
+def thickness_class_key(v: str | None) -> str | None:
+    """A case key's DIN 3967 class, normalised (``"25 CD"`` → ``"cd25"``); None stays None.
+
+    For a pydantic validator: a bad class is a ``ValueError`` with the reason (the location
+    names the key)."""
+    if v is None:
+        return None
+    from gearte.tolerance.din3967 import parse_thickness_class
+
+    try:
+        series, tol = parse_thickness_class(v)
+    except ParameterError as exc:
+        raise ValueError(exc.reason) from None
+    return f"{series}{tol}"
+
+
+def js_field_key(v: str | None) -> str | None:
+    """A case key's ISO 286 js field, normalised (``"JS 7"`` → ``"js7"``); None stays None."""
+    if v is None:
+        return None
+    from gearte.tolerance.iso286 import parse_js_field
+
+    try:
+        return f"js{parse_js_field(v)}"
+    except ParameterError as exc:
+        raise ValueError(f"{v!r} {exc.reason}") from None
+
+
 class _ThicknessLimits(StrictModel):
     thickness_upper_um: float = Field(
         ge=-10_000, le=10_000, description="Upper tooth-thickness deviation Ess [µm]."
@@ -120,15 +148,7 @@ class SpurGearSpec(StrictModel):
     @field_validator("tooth_thickness_allowance")
     @classmethod
     def _thickness_class(cls, v: str | None) -> str | None:
-        if v is None:
-            return None
-        from gearte.tolerance.din3967 import parse_thickness_class
-
-        try:
-            series, tol = parse_thickness_class(v)
-        except ParameterError as exc:
-            raise ValueError(exc.reason) from None
-        return f"{series}{tol}"
+        return thickness_class_key(v)
 
     @model_validator(mode="after")
     def _one_source(self) -> SpurGearSpec:
@@ -360,14 +380,7 @@ class SpurPairSpec(_Clearance, _Distributions):
     @field_validator("centre_distance_allowance")
     @classmethod
     def _js_field(cls, v: str | None) -> str | None:
-        if v is None:
-            return None
-        from gearte.tolerance.iso286 import parse_js_field
-
-        try:
-            return f"js{parse_js_field(v)}"
-        except ParameterError as exc:
-            raise ValueError(f"{v!r} {exc.reason}") from None
+        return js_field_key(v)
 
     @model_validator(mode="after")
     def _one_centre_distance(self) -> SpurPairSpec:

@@ -49,7 +49,8 @@ Case file layout (units in the keys)::
     [analyses.cycloid_compensation]  target_te_change_arcmin, factors, rule
     [analyses.contact]         positions, load_sweep_Nm
     [analyses.modal]           speed_min_rpm, speed_max_rpm, resonance_margin
-    [analyses.dte]             duration_s, settle_s, method, step_fraction, record_dt_s
+    [analyses.dte]             duration_s, settle_s, method, step_fraction, record_dt_s,
+                               record_points
     [analyses.speed_sweep]     speed_min_rpm, speed_max_rpm, count, duration_s, settle_s
     [analyses.batch]           samples, duration_s, settle_s, seed, chunk_size, tolerance_scale
 """
@@ -59,7 +60,7 @@ from __future__ import annotations
 from typing import Any, Literal, get_args
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.planetary import SunPlanets
@@ -173,12 +174,142 @@ class FirstStageSection(StrictModel):
     sun_support_stiffness_N_per_mm: float = Field(
         gt=0, le=1e9, description="Radial stiffness of the sun's support [N/mm]."
     )
+    sun_tooth_thickness_allowance: str | None = Field(
+        default=None,
+        description="DIN 3967 tooth-thickness class of the sun, e.g. 'cd25' (with "
+        "planet_tooth_thickness_allowance and centre_distance_allowance): the first stage's "
+        "backlash and what it adds at the output are reported (analysis first_stage_backlash); "
+        "the reducer model's sun–planet mesh itself has no clearance",
+    )
+    planet_tooth_thickness_allowance: str | None = Field(
+        default=None, description="DIN 3967 tooth-thickness class of the planets, e.g. 'cd25'"
+    )
+    centre_distance_allowance: str | None = Field(
+        default=None,
+        description="ISO 286 field js5 … js11 of the sun–planet centre distance m(z1 + z2)/2 "
+        "(DIN 3964), e.g. 'js6'",
+    )
+
+    @field_validator("sun_tooth_thickness_allowance", "planet_tooth_thickness_allowance")
+    @classmethod
+    def _thickness_class(cls, v: str | None) -> str | None:
+        from gearte.studies.gear_pair import thickness_class_key
+
+        return thickness_class_key(v)
+
+    @field_validator("centre_distance_allowance")
+    @classmethod
+    def _js_field(cls, v: str | None) -> str | None:
+        from gearte.studies.gear_pair import js_field_key
+
+        return js_field_key(v)
 
     @model_validator(mode="after")
     def _mesh(self):
         if self.mesh_stiffness_N_per_mm is None and self.face_width_mm is None:
             raise ValueError("give mesh_stiffness_N_per_mm or face_width_mm (or both)")
+        keys = (
+            "sun_tooth_thickness_allowance",
+            "planet_tooth_thickness_allowance",
+            "centre_distance_allowance",
+        )
+        if 0 < sum(getattr(self, k) is not None for k in keys) < 3:
+            raise ValueError(f"{', '.join(keys)} go together (the first stage's backlash)")
+        if self.sun_tooth_thickness_allowance is not None:
+            first_stage_backlash(self)  # a diameter outside the tables: an error naming the key
         return self
+
+
+def first_stage_backlash(fs: FirstStageSection) -> dict[str, float]:
+    """Backlash limits of the sun–planet mesh from the DIN 3967 classes and the js field.
+
+    Parameters
+    ----------
+    fs : FirstStageSection
+        The first stage with ``sun_tooth_thickness_allowance``,
+        ``planet_tooth_thickness_allowance`` and ``centre_distance_allowance``.
+
+    Returns
+    -------
+    dict
+        ``j_n``/``j_t`` minimum and maximum [µm] (``gearte.tolerance.din3967``), the allowances
+        [µm] and the sun's free angle ``j_t / r_sun`` [rad].
+    """
+    from gearte.tolerance.din3967 import pair_backlash_limits, tooth_thickness_allowances
+    from gearte.tolerance.iso286 import js_allowances_um
+
+    f = "reducer.first_stage."
+    m = fs.module_mm
+    sun = tooth_thickness_allowances(
+        fs.sun_tooth_thickness_allowance,  # type: ignore[arg-type]
+        m * fs.sun_teeth,
+        field=f + "sun_tooth_thickness_allowance",
+    )
+    planet = tooth_thickness_allowances(
+        fs.planet_tooth_thickness_allowance,  # type: ignore[arg-type]
+        m * fs.planet_teeth,
+        field=f + "planet_tooth_thickness_allowance",
+    )
+    a_e, a_i = js_allowances_um(
+        fs.centre_distance_allowance,  # type: ignore[arg-type]
+        0.5 * m * (fs.sun_teeth + fs.planet_teeth),
+        field=f + "centre_distance_allowance",
+    )
+    u1, l1, u2, l2, e, i = (
+        float(um_to_mm(v))
+        for v in (sun.upper_um, sun.lower_um, planet.upper_um, planet.lower_um, a_e, a_i)
+    )
+    b = pair_backlash_limits(u1, l1, u2, l2, e, i, float(deg_to_rad(fs.pressure_angle_deg)))
+    r_sun = 0.5 * m * fs.sun_teeth
+    out = {
+        f"{n} [um]": float(mm_to_um(float(getattr(b, n))))
+        for n in ("normal_min", "normal_max", "circumferential_min", "circumferential_max")
+    }
+    out["sun_free_angle_min [rad]"] = float(b.circumferential_min) / r_sun
+    out["sun_free_angle_max [rad]"] = float(b.circumferential_max) / r_sun
+    out["sun_allowances [um]"] = [sun.upper_um, sun.lower_um]  # type: ignore[assignment]
+    out["planet_allowances [um]"] = [planet.upper_um, planet.lower_um]  # type: ignore[assignment]
+    out["centre_distance_allowances [um]"] = [a_e, a_i]  # type: ignore[assignment]
+    return out
+
+
+def _first_stage_backlash(case: Case, red: RVReducer) -> AnalysisResult:
+    fs = case.reducer.first_stage
+    b = first_stage_backlash(fs)
+    i = float(red.ratio)
+    values: dict[str, Any] = {
+        "sun_class": fs.sun_tooth_thickness_allowance,
+        "planet_class": fs.planet_tooth_thickness_allowance,
+        "centre_distance_field": fs.centre_distance_allowance,
+        "sun_allowances [um]": b["sun_allowances [um]"],
+        "planet_allowances [um]": b["planet_allowances [um]"],
+        "centre_distance_allowances [um]": b["centre_distance_allowances [um]"],
+        "first_stage_backlash_normal_min [um]": b["normal_min [um]"],
+        "first_stage_backlash_normal_max [um]": b["normal_max [um]"],
+        "first_stage_backlash_circumferential_min [um]": b["circumferential_min [um]"],
+        "first_stage_backlash_circumferential_max [um]": b["circumferential_max [um]"],
+        "first_stage_backlash_at_output_min [arcmin]": rad_to_arcmin(
+            b["sun_free_angle_min [rad]"] / i
+        ),
+        "first_stage_backlash_at_output_max [arcmin]": rad_to_arcmin(
+            b["sun_free_angle_max [rad]"] / i
+        ),
+    }
+    return AnalysisResult(
+        name="first_stage_backlash",
+        title="First-stage backlash from the tooth-thickness classes (DIN 3967)",
+        values=values,
+        references=[],
+        notes=[
+            "Sun–planet mesh: j_t = −(A_s,sun + A_s,planet) + 2 A_a tan α, j_n = j_t cos α "
+            "(DIN 3967 Tables 1-2 at d = m·z; ISO 286 js field of a = m(z1 + z2)/2). At the "
+            "output with the input locked: the sun's free angle j_t / r_sun divided by the ratio "
+            f"i = {i:.6g}. One mesh; with several planets the sun stops at the smallest gap.",
+            "Not part of the catalogue, TE or yield analyses: the reducer model's sun–planet mesh "
+            "has no clearance, so their lost motion and backlash leave this out "
+            "(docs/tolerance_grades.md).",
+        ],
+    )
 
 
 class CranksSection(StrictModel):
@@ -1137,6 +1268,8 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
         out.append(_compensation(red, a.compensation))
     if a.yield_ is not None:
         out.append(_yield(case, red0 if red0 is not None else red, a.yield_, options))
+    if case.reducer.first_stage.sun_tooth_thickness_allowance is not None:
+        out.append(_first_stage_backlash(case, red))
     if any(getattr(a, k) is not None for k in ("geometric_te", "tooth_contact")) or (
         a.cycloid_compensation is not None
     ):
