@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from gearte.errors import BenchFileError
+from gearte.io._textfile import read_text_file
 from gearte.models.bench_data import HysteresisCurve, TETrace
 from gearte.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, Nm_to_Nmm, rad_to_deg
 
@@ -112,34 +113,6 @@ class _Table:
         return f"{j + 1} '{self.names[j]}{unit}'"
 
 
-def _read_text(path: str | os.PathLike) -> tuple[str, str]:
-    src = str(path)
-    p = Path(path)
-    try:
-        if p.is_dir():
-            raise BenchFileError(src, None, None, "is a folder, expected a CSV file")
-        size = p.stat().st_size
-    except OSError as exc:
-        raise BenchFileError(src, None, None, f"cannot read: {exc.strerror or exc}") from None
-    if size > MAX_FILE_BYTES:
-        raise BenchFileError(
-            src, None, None, f"is {size} bytes; the limit is {MAX_FILE_BYTES} bytes"
-        )
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise BenchFileError(src, None, None, f"cannot read: {exc.strerror or exc}") from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise BenchFileError(src, line, None, "is not UTF-8 text (a binary file?)") from None
-    if "\x00" in text:
-        line = text[: text.index("\x00")].count("\n") + 1
-        raise BenchFileError(src, line, None, "contains a NUL byte (a binary file?)")
-    return src, text
-
-
 def _split_unit(cell: str) -> tuple[str, str | None]:
     m = _HEADER.match(cell)
     if m is None:
@@ -149,7 +122,7 @@ def _split_unit(cell: str) -> tuple[str, str | None]:
 
 
 def _parse(path, allowed, aliases, text_columns=()) -> _Table:
-    src, text = _read_text(path)
+    src, text = read_text_file(path, BenchFileError, MAX_FILE_BYTES)
     lines = text.splitlines()
     if not any(ln.strip() for ln in lines):
         raise BenchFileError(src, 1, None, "is empty (no header, no data)")
