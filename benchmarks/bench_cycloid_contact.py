@@ -184,14 +184,16 @@ def main() -> None:
         err_force = float(np.max(np.abs(res.force - strong_out[1])) / np.max(res.force))
         r_strong, r_weak = t_strong / t_fast, t_weak / t_fast
         print(f"\n[{law}]")
-        print(f"  first call (compile/cache load):       {t_first * 1e3:9.1f} ms CPU")
-        print(f"  gearte (compiled kernel, warm):        {t_fast * 1e3:9.2f} ms CPU")
-        print(
-            f"  strong: numpy vectorised Newton:    {t_strong * 1e3:9.2f} ms CPU -> {r_strong:.1f}x"
-        )
-        print(f"  weak: gearte's plain twin:          {t_weak * 1e3:9.1f} ms CPU -> {r_weak:.1f}x")
-        print(f"  max rel. difference F_max vs twin:     {err:9.2e}")
-        print(f"  max difference pin forces vs numpy:    {err_force:9.2e} (of the largest)")
+        rows = [
+            ("first call (compile/cache load)", f"{t_first * 1e3:9.1f} ms CPU"),
+            ("gearte (compiled kernel, warm)", f"{t_fast * 1e3:9.2f} ms CPU"),
+            ("strong: numpy vectorised Newton", f"{t_strong * 1e3:9.2f} ms CPU -> {r_strong:.1f}x"),
+            ("weak: gearte's plain twin", f"{t_weak * 1e3:9.1f} ms CPU -> {r_weak:.1f}x"),
+            ("max rel. difference F_max vs twin", f"{err:9.2e}"),
+            ("max difference pin forces vs numpy", f"{err_force:9.2e} (of the largest)"),
+        ]
+        for label, value in rows:
+            print(f"  {label + ':':<36} {value}")
         print(
             f"  F_max over the pitch: {np.min(res.F_max):.1f} .. {np.max(res.F_max):.1f} N, "
             f"pins in mesh {res.pins_in_mesh.min()} .. {res.pins_in_mesh.max()}"

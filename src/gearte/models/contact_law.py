@@ -441,6 +441,9 @@ def force_from_coefficients(
     elastic load: the half-width is then comparable to the radii). Below δ* the inverse is found by
     a safeguarded Newton iteration on u = ln F inside the bracket (ln δ − 60, ln F*); at or beyond
     δ* the law has no inverse and ``inf`` is returned (callers report the load as out of range).
+    The iteration is the solver :func:`gearte.solvers.contact.log_law_force`, here its numpy
+    implementation (no compile for the few callers outside the compiled contact kernels, which
+    call its compiled twin pin by pin).
 
     Parameters
     ----------
@@ -460,7 +463,9 @@ def force_from_coefficients(
     ----------
     See :func:`approach`.
     """
-    return log_law_force(np.asarray(delta), np.asarray(a0), np.asarray(a1), rtol=rtol)
+    return log_law_force(
+        np.asarray(delta), np.asarray(a0), np.asarray(a1), rtol=rtol, implementation="plain"
+    )
 
 
 def force(

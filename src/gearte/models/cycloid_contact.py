@@ -421,9 +421,10 @@ def tooth_contact(
     if not np.all(np.isfinite(theta)):
         raise ParameterError("mesh_angle", mesh_angle, "must be finite")
     if implementation == "plain":
-        return _tooth_contact_plain(
+        arrays = _tooth_contact_plain(
             stage, torque, T_c, theta, E, mu, F_start, rtol, max_iter, clearance_model, contact_law
         )
+        return _result(theta, arrays, T_c, stage.rho0, contact_law)
     theta = theta.reshape(-1)
     R_g, r_g = geometry_radii(stage.r_p, stage.r_rp, stage.dr_rp, stage.dr_p, stage.k1_definition)
     phase, lr, clr, curvature = pin_mesh_table(
@@ -474,6 +475,16 @@ def tooth_contact(
                 f"{int(nev[k])} evaluations (tolerance {rtol:g})"
             )
     _check_deformation(dmax, stage, torque)
+    arrays = (phase, lr, clr, curvature, F, dmax, nev, approach_i, force, in_mesh, pressure)
+    return _result(theta, arrays, T_c, rho, contact_law)
+
+
+def _result(
+    theta: np.ndarray, arrays: tuple[np.ndarray, ...], T_c: float, rho: float, contact_law: str
+) -> ToothContact:
+    """The result from (phase, l/r_c, clearance, curvature, F_max, δ_max, evaluations, approach,
+    force, in-mesh, pressure) of either implementation."""
+    phase, lr, clr, curvature, F, dmax, nev, approach_i, force, in_mesh, pressure = arrays
     return ToothContact(
         mesh_angle=theta,
         phase=phase,
@@ -509,6 +520,21 @@ def _check_deformation(dmax: np.ndarray, stage: CycloidStage, torque: float) -> 
 
 
 @njit(cache=True, nogil=True)
+def _outputs(n, z):  # pragma: no cover - compiled
+    """F_max, δ_max, evaluations, status (n,); approach, force, in-mesh, pressure (n, z)."""
+    return (
+        np.empty(n),
+        np.empty(n),
+        np.empty(n, dtype=np.int64),
+        np.empty(n, dtype=np.int64),
+        np.empty((n, z)),
+        np.zeros((n, z)),
+        np.zeros((n, z), dtype=np.bool_),
+        np.zeros((n, z)),
+    )
+
+
+@njit(cache=True, nogil=True)
 def _hu2020_kernel(
     lr, clr, r_c, A, B, F0, warm, T_c, rtol, max_iter, rho, r, E_star, b
 ):  # pragma: no cover - compiled
@@ -516,14 +542,7 @@ def _hu2020_kernel(
 
     Positions in order; with ``warm`` each starts from the previous one's F_max."""
     n, z = lr.shape
-    F = np.empty(n)
-    dmax = np.empty(n)
-    nev = np.empty(n, dtype=np.int64)
-    status = np.empty(n, dtype=np.int64)
-    approach = np.empty((n, z))
-    force = np.zeros((n, z))
-    in_mesh = np.zeros((n, z), dtype=np.bool_)
-    pressure = np.zeros((n, z))
+    F, dmax, nev, status, approach, force, in_mesh, pressure = _outputs(n, z)
     cl = np.empty(z)
     log_b = math.log(B)
     start = F0
@@ -562,14 +581,7 @@ def _line_contact_kernel(
     F_max of a virtual pin at φ0, forces and pressures. Positions in order, each started from
     the previous one's rotation and pin forces."""
     n, z = lr.shape
-    F = np.empty(n)
-    dmax = np.empty(n)
-    nev = np.empty(n, dtype=np.int64)
-    status = np.empty(n, dtype=np.int64)
-    approach = np.empty((n, z))
-    force = np.zeros((n, z))
-    in_mesh = np.zeros((n, z), dtype=np.bool_)
-    pressure = np.zeros((n, z))
+    F, dmax, nev, status, approach, force, in_mesh, pressure = _outputs(n, z)
     arm = np.zeros(z)
     cl = np.zeros(z)
     a0 = np.ones(z)
@@ -625,7 +637,7 @@ def _tooth_contact_plain(
     max_iter: int,
     clearance_model: str,
     contact_law: str,
-) -> ToothContact:
+) -> tuple[np.ndarray, ...]:
     """The plain twin of the compiled tooth contact: numpy geometry (gearte.geometry.cycloid),
     the law's numpy functions and the plain solvers; the reference the kernels are tested
     against."""
@@ -689,19 +701,4 @@ def _tooth_contact_plain(
             in_mesh, force_from_coefficients(np.where(in_mesh, approach_i - clr, 0.0), a0, a1), 0.0
         )
     pressure = max_contact_pressure(force, curvature, stage.r, E, mu, stage.b)
-    return ToothContact(
-        mesh_angle=theta,
-        phase=phase,
-        clearance=np.where(loaded, clr, np.nan),
-        approach=approach_i,
-        force=force,
-        in_mesh=in_mesh,
-        F_max=F,
-        delta_max=dmax,
-        n_eval=nev,
-        T_c=T_c,
-        rho=rho,
-        curvature=curvature,
-        pressure=pressure,
-        contact_law=contact_law,
-    )
+    return phase, lr, clr, curvature, F, dmax, nev, approach_i, force, in_mesh, pressure

@@ -16,9 +16,9 @@ the bracket (0, compliance limit) that every evaluation narrows, converges in ty
 evaluations from the paper's start (eq 45) and 2–3 from a neighbouring mesh position's answer,
 where the plain Picard iteration of eq 44 that the paper uses oscillates (its Table 4).
 
-Two implementations with one API: :func:`solve_load_sharing` (numba, many mesh positions at
-once) and :func:`solve_load_sharing_plain` (a flat per-pin Python loop with bisection, the
-readable reference the compiled one is tested against).
+Two implementations behind one API (``implementation="numba"`` or ``"plain"``):
+:func:`solve_load_sharing` compiled (many mesh positions at once) or its plain twin (a flat
+per-pin Python loop with bisection, the readable reference the compiled one is tested against).
 
 Pins each on their own law (Hu 2020 eq 37, 42 / Li 2023 eq 3–4): every pin i has its own
 log-law coefficients ``δ_i(F) = F (a0_i − a1_i ln F)`` (the form of every law of
@@ -29,8 +29,8 @@ convex (each F(δ) is the inverse of a concave increasing δ(F)), so a safeguard
 known) converges from any start. Each evaluation inverts every loaded pin's law
 (:func:`log_law_force`: Newton on u = ln F inside the bracket (ln δ − 60, a0/a1 − 1)), started
 from that pin's ln F of the previous evaluation; over a sweep of mesh positions the compiled
-kernel starts each position from the previous one's rotation and forces. Twins:
-:func:`log_law_force_plain`, :func:`solve_rotation_plain` (numpy, vectorised over positions).
+kernel starts each position from the previous one's rotation and forces. Their plain twins
+(``implementation="plain"``) are numpy, vectorised over positions.
 """
 
 from __future__ import annotations
@@ -44,14 +44,13 @@ from gearte.errors import ConvergenceError, ParameterError
 
 __all__ = [
     "solve_load_sharing",
-    "solve_load_sharing_plain",
     "compliance_limit",
     "check_status",
     "log_law_force",
-    "log_law_force_plain",
     "solve_rotation",
-    "solve_rotation_plain",
 ]
+# the plain twins, by name (tests and the models' ``implementation="plain"`` paths):
+# solve_load_sharing_plain, log_law_force_plain, solve_rotation_plain
 
 _OK, _NO_CONV, _NO_BRACKET, _LIMIT = 0, 1, 2, 3
 
@@ -183,8 +182,13 @@ def solve_load_sharing(
     F_start: float | np.ndarray,
     rtol: float = 1e-12,
     max_iter: int = 200,
+    implementation: str = "numba",
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Solve eq 44 for F_max at many mesh positions (numba kernel).
+    """Solve eq 44 for F_max at many mesh positions.
+
+    ``implementation="numba"``: safeguarded Newton (module docstring), all positions in one
+    compiled call; ``"plain"``: the twin, per-pin Python loops and bisection to a bracket of
+    relative width ``rtol``.
 
     Parameters
     ----------
@@ -204,6 +208,8 @@ def solve_load_sharing(
         Relative size of the last Newton step [-].
     max_iter : int
         Newton/bisection steps allowed per position.
+    implementation : {"numba", "plain"}
+        The compiled kernel or its plain twin (the readable reference it is tested against).
 
     Returns
     -------
@@ -219,6 +225,10 @@ def solve_load_sharing(
     ParameterError
         When the load lies beyond the compliance law's range.
     """
+    if implementation not in ("numba", "plain"):
+        raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
+    if implementation == "plain":
+        return _solve_load_sharing_plain(lr, clr, T_c, r_c, A, B, F_start, rtol, max_iter)
     lr, clr, F0 = _prep(lr, clr, T_c, r_c, A, B, F_start)
     F, nit, status = _solve_batch(
         lr, clr, float(T_c), float(r_c), float(A), float(B), F0, float(rtol), int(max_iter)
@@ -255,54 +265,24 @@ def check_status(
     ConvergenceError
         A position did not converge.
     """
-    bad = np.nonzero(np.asarray(status) != _OK)[0]
+    status = np.asarray(status)
+    if not status.any():  # _OK == 0 everywhere
+        return
+    bad = np.nonzero(status != _OK)[0]
     if bad.size:
         k = int(bad[0])
         _raise(int(status[k]), k, float(F[k]), int(n_eval[k]), rtol, T_c, compliance_limit(B))
 
 
 def solve_load_sharing_plain(
-    lr: np.ndarray,
-    clr: np.ndarray,
-    *,
-    T_c: float,
-    r_c: float,
-    A: float,
-    B: float,
-    F_start: float | np.ndarray,
-    rtol: float = 1e-12,
-    max_iter: int = 200,
+    lr: np.ndarray, clr: np.ndarray, **kw
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Plain-Python twin of :func:`solve_load_sharing`: per-pin loops and bisection.
+    """:func:`solve_load_sharing` with ``implementation="plain"`` (the readable twin)."""
+    return solve_load_sharing(lr, clr, implementation="plain", **kw)
 
-    Same arguments and results; kept flat and readable as the reference implementation.
 
-    Parameters
-    ----------
-    lr : ndarray, shape (n, z_p)
-        l_i / r_c of every pin at each mesh position [-]; pins with lr ≤ 0 never touch.
-    clr : ndarray, shape (n, z_p)
-        Initial clearance Δ_i (eq 32) [mm].
-    T_c : float
-        Torque on the disc [N·mm].
-    r_c : float
-        Cycloid pitch radius a z_c [mm].
-    A, B : float
-        Compliance constants: δ_max(F) = A F (2/3 + ln(B/F)) [mm/N, N].
-    F_start : float or ndarray
-        Start value(s) of F_max [N] (seed the bracket only).
-    rtol : float
-        Relative width of the final bracket [-].
-    max_iter : int
-        Iterations allowed after bracketing.
-
-    Returns
-    -------
-    F_max : ndarray, shape (n,)
-        The fixed point [N].
-    n_eval : ndarray, shape (n,)
-        Residual evaluations used.
-    """
+def _solve_load_sharing_plain(lr, clr, T_c, r_c, A, B, F_start, rtol, max_iter):
+    """Per-pin Python loops and bisection: the flat, readable reference of eq 41–44."""
     lr, clr, F0 = _prep(lr, clr, T_c, r_c, A, B, F_start)
     Fcap = compliance_limit(B)
     out = np.empty(lr.shape[0])
@@ -403,11 +383,19 @@ def _log_force_flat(delta, a0, a1, rtol):  # pragma: no cover - compiled
 
 
 def log_law_force(
-    delta: np.ndarray, a0: np.ndarray, a1: np.ndarray, *, rtol: float = 1e-12
+    delta: np.ndarray,
+    a0: np.ndarray,
+    a1: np.ndarray,
+    *,
+    rtol: float = 1e-12,
+    implementation: str = "numba",
 ) -> np.ndarray:
     """Inverse of the log law ``δ = F (a0 − a1 ln F)``: the force F [N] for an approach δ [mm].
 
-    Compiled (numba); :func:`log_law_force_plain` is its numpy twin. δ ≤ 0 gives 0; at or beyond
+    Safeguarded Newton on u = ln F inside (ln δ − 60, a0/a1 − 1), compiled (``"numba"``, one
+    element at a time, stopping when the step is below √rtol: quadratic convergence leaves an
+    error of about step²/2) or the numpy twin (``"plain"``, vectorised, stopping when every step
+    is below rtol). δ ≤ 0 gives 0; at or beyond
     δ* = a1 exp(a0/a1 − 1), where δ(F) stops increasing, ``inf`` (callers report the load as out
     of the law's range).
 
@@ -420,6 +408,8 @@ def log_law_force(
         broadcast against ``delta``.
     rtol : float
         Tolerance on ln F, i.e. relative on F [-].
+    implementation : {"numba", "plain"}
+        The compiled kernel or its plain twin (the readable reference it is tested against).
 
     Returns
     -------
@@ -431,6 +421,10 @@ def log_law_force(
     ConvergenceError
         Newton did not converge in 100 iterations.
     """
+    if implementation not in ("numba", "plain"):
+        raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
+    if implementation == "plain":
+        return _log_law_force_plain(delta, a0, a1, rtol)
     d, b0, b1 = np.broadcast_arrays(
         np.asarray(delta, dtype=float), np.asarray(a0, dtype=float), np.asarray(a1, dtype=float)
     )
@@ -444,25 +438,13 @@ def log_law_force(
     return out
 
 
-def log_law_force_plain(
-    delta: np.ndarray, a0: np.ndarray, a1: np.ndarray, *, rtol: float = 1e-12
-) -> np.ndarray:
-    """Numpy twin of :func:`log_law_force`: the same safeguarded Newton, vectorised.
+def log_law_force_plain(delta: np.ndarray, a0: np.ndarray, a1: np.ndarray, **kw) -> np.ndarray:
+    """:func:`log_law_force` with ``implementation="plain"`` (the numpy twin)."""
+    return log_law_force(delta, a0, a1, implementation="plain", **kw)
 
-    Parameters
-    ----------
-    delta : ndarray
-        Approach δ [mm].
-    a0, a1 : ndarray
-        Law coefficients [mm/N], broadcast against ``delta``.
-    rtol : float
-        Tolerance on ln F, i.e. relative on F [-].
 
-    Returns
-    -------
-    numpy.ndarray
-        F [N] (0 for δ ≤ 0, ``inf`` beyond the law's range).
-    """
+def _log_law_force_plain(delta, a0, a1, rtol):
+    """The inverse vectorised in numpy (every element iterates until all steps are ≤ rtol)."""
     d = np.asarray(delta, dtype=float)
     d, a0, a1 = np.broadcast_arrays(d, np.asarray(a0, dtype=float), np.asarray(a1, dtype=float))
     out = np.zeros(d.shape)
@@ -608,13 +590,18 @@ def solve_rotation(
     rot_start: float | np.ndarray | None = None,
     force_rtol: float = 1e-12,
     max_iter: int = 200,
+    implementation: str = "numba",
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Disc rotation and pin forces that carry ``torque`` (compatibility + equilibrium; numba).
+    """Disc rotation and pin forces that carry ``torque`` (compatibility + equilibrium).
 
     Pin i is compressed by ``δ_i = l_i Δφ − c_i`` and carries ``F_i = F(δ_i)`` of the log law
     ``δ = F (a0_i − a1_i ln F)`` with its own coefficients; ``Σ F_i l_i = T``. Safeguarded
-    Newton on T(Δφ), positions in order, each started from the previous one's answer (module
-    docstring). :func:`solve_rotation_plain` is the numpy twin.
+    Newton on T(Δφ) (dT/dΔφ = Σ k_t l², bisection when a step leaves the bracket).
+    ``"numba"``: positions in order, each started from the previous one's answer, every pin's
+    force from its previous ln F (module docstring); the answer is the last evaluated rotation,
+    once the Newton step or the bracket is below ``rtol``. ``"plain"``: the numpy twin, all
+    positions at once, the bracket found by doubling from ``rot_start``, every pin's law
+    inverted from scratch at each step.
 
     Parameters
     ----------
@@ -629,12 +616,14 @@ def solve_rotation(
     rtol : float
         Relative tolerance on Δφ [-].
     rot_start : float or ndarray (n,), optional
-        Start value(s) of Δφ [rad]; default: 1e-6 for the first position, then the previous
-        position's answer. The answer does not depend on it beyond ``rtol``.
+        Start value(s) of Δφ [rad]; default: 1e-6 for the first position, then (``"numba"``)
+        the previous position's answer. The answer does not depend on it beyond ``rtol``.
     force_rtol : float
         Relative tolerance of each pin's force [-].
     max_iter : int
         Newton/bisection steps allowed per position.
+    implementation : {"numba", "plain"}
+        The compiled kernel or its plain twin (the readable reference it is tested against).
 
     Returns
     -------
@@ -655,7 +644,13 @@ def solve_rotation(
     Li et al. (2023) eq 3–4, doi:10.3390/machines11060626; Hu et al. (2020) eq 37–44,
     doi:10.3390/app10020481.
     """
+    if implementation not in ("numba", "plain"):
+        raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
     arm, clearance, a0, a1 = _rotation_inputs(arm, clearance, a0, a1, torque)
+    if implementation == "plain":
+        return _solve_rotation_plain(
+            arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter
+        )
     n = arm.shape[0]
     rot0 = np.full(n, np.nan) if rot_start is None else np.broadcast_to(rot_start, (n,))
     rot, force, nev, status = _rotation_batch(
@@ -682,57 +677,21 @@ def solve_rotation(
 
 
 def solve_rotation_plain(
-    arm: np.ndarray,
-    clearance: np.ndarray,
-    a0: np.ndarray,
-    a1: np.ndarray,
-    torque: float,
-    *,
-    rtol: float = 1e-11,
-    rot_start: float | np.ndarray | None = None,
-    force_rtol: float = 1e-12,
-    max_iter: int = 200,
+    arm: np.ndarray, clearance: np.ndarray, a0: np.ndarray, a1: np.ndarray, torque: float, **kw
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Numpy twin of :func:`solve_rotation`, vectorised over the positions.
+    """:func:`solve_rotation` with ``implementation="plain"`` (the numpy twin)."""
+    return solve_rotation(arm, clearance, a0, a1, torque, implementation="plain", **kw)
 
-    T(Δφ) is bracketed by doubling from ``rot_start`` and its root found by safeguarded Newton
-    (dT/dΔφ = Σ k_t l², bisection when a step leaves the bracket), every position at once; each
-    evaluation inverts every pin's law from scratch (:func:`log_law_force_plain`).
 
-    Parameters
-    ----------
-    arm : ndarray (n, z)
-        Arm l_i of each pin's contact normal [mm]; ≤ 0 for pins that cannot carry load.
-    clearance : ndarray (n, z)
-        Normal clearance c_i at Δφ = 0 [mm] (finite where the arm is > 0), ≥ 0.
-    a0, a1 : ndarray (n, z)
-        Log-law coefficients of each pin [mm/N].
-    torque : float
-        Torque T [N·mm], > 0.
-    rtol : float
-        Relative tolerance on Δφ [-].
-    rot_start : float or ndarray (n,), optional
-        Lower start of the bracket search [rad] (default 1e-6).
-    force_rtol : float
-        Relative tolerance of each pin's force [-].
-    max_iter : int
-        Newton/bisection steps allowed.
-
-    Returns
-    -------
-    rotation : ndarray (n,)
-        Δφ [rad].
-    force : ndarray (n, z)
-        F_i [N].
-    """
-    arm, clearance, a0, a1 = _rotation_inputs(arm, clearance, a0, a1, torque)
+def _solve_rotation_plain(arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter):
+    """All positions at once in numpy: bracket by doubling, then safeguarded Newton."""
     n = arm.shape[0]
     loaded = arm > 0.0
     la = np.where(loaded, arm, 0.0)
 
     def torque_at(rot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         delta = np.where(loaded, rot[:, None] * la - clearance, 0.0)
-        f = log_law_force_plain(delta, a0, a1, rtol=force_rtol)
+        f = _log_law_force_plain(delta, a0, a1, force_rtol)
         return np.sum(f * la, axis=1), f
 
     lo = np.zeros(n)

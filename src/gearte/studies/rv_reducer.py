@@ -49,7 +49,8 @@ Case file layout (units in the keys)::
     [analyses.cycloid_compensation]  target_te_change_arcmin, factors, rule
     [analyses.contact]         positions, load_sweep_Nm
     [analyses.modal]           speed_min_rpm, speed_max_rpm, resonance_margin
-    [analyses.dte]             duration_s, settle_s, method, step_fraction, record_dt_s
+    [analyses.dte]             duration_s, settle_s, method, step_fraction, record_dt_s,
+                               record_points
     [analyses.speed_sweep]     speed_min_rpm, speed_max_rpm, count, duration_s, settle_s
     [analyses.batch]           samples, duration_s, settle_s, seed, chunk_size, tolerance_scale
 """
