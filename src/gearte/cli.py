@@ -518,7 +518,7 @@ def validate(cases: tuple[str, ...]) -> None:
     "--processes",
     type=click.IntRange(min=1),
     default=None,
-    help="Kinds compiled side by side (default: the machine's cores, at most 2).",
+    help="Case groups compiled side by side (default: the machine's cores, at most 4).",
 )
 @click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
 def warm_cache_cmd(kinds: tuple[str, ...], processes: int | None, debug: bool) -> None:
@@ -530,9 +530,9 @@ def warm_cache_cmd(kinds: tuple[str, ...], processes: int | None, debug: bool) -
 
         from gearte.warm import warm_cache, warm_cache_parallel
 
-        n = processes if processes is not None else min(2, os.cpu_count() or 1)
+        n = processes if processes is not None else min(4, os.cpu_count() or 1)
         t0 = time.perf_counter()
-        click.echo(f"==> compiling gearte's numba kernels, one case group per kind ({n} at a time)")
+        click.echo(f"==> compiling gearte's numba kernels, one line per case ({n} at a time)")
         if n == 1:
             cpu = [0.0]
 
@@ -545,9 +545,8 @@ def warm_cache_cmd(kinds: tuple[str, ...], processes: int | None, debug: bool) -
 
             list(warm_cache(list(kinds) or None, report=report))
         else:
-            for kind, rows in warm_cache_parallel(list(kinds) or None, processes=n):
-                for case, wall, cpu_s in rows:
-                    click.echo(f"  {kind:14s} {case:32s} {wall:6.1f} s ({cpu_s:.1f} s CPU)")
+            for kind, case, wall, cpu_s in warm_cache_parallel(list(kinds) or None, processes=n):
+                click.echo(f"  {kind:14s} {case:32s} {wall:6.1f} s ({cpu_s:.1f} s CPU)")
         click.echo(f"==> numba cache warm ({time.perf_counter() - t0:.1f} s)")
 
     _guarded(_warm, debug)

@@ -265,7 +265,10 @@ def check_status(
     ConvergenceError
         A position did not converge.
     """
-    bad = np.nonzero(np.asarray(status) != _OK)[0]
+    status = np.asarray(status)
+    if not status.any():  # _OK == 0 everywhere
+        return
+    bad = np.nonzero(status != _OK)[0]
     if bad.size:
         k = int(bad[0])
         _raise(int(status[k]), k, float(F[k]), int(n_eval[k]), rtol, T_c, compliance_limit(B))
