@@ -56,3 +56,19 @@ def read_text_file(
         line = text[: text.index("\x00")].count("\n") + 1
         raise error(src, line, None, "contains a NUL byte (a binary file?)")
     return src, text
+
+
+def header_delimiter(header: str) -> str:
+    """The column delimiter of a CSV header line: ``,``, else a tab, else ``;`` (``,`` if none).
+
+    Parameters
+    ----------
+    header : str
+        The header line.
+
+    Returns
+    -------
+    str
+        The delimiter.
+    """
+    return "," if "," in header else ("\t" if "\t" in header else (";" if ";" in header else ","))

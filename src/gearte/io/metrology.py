@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from gearte.errors import MeasurementFileError
-from gearte.io._textfile import read_text_file
+from gearte.io._textfile import header_delimiter, read_text_file
 from gearte.units import DEG_PER_RAD, mm_to_um, rad_to_deg
 
 __all__ = [
@@ -272,7 +272,7 @@ def _parse(path: str | os.PathLike, fmt: str) -> _Table:
         raise _err(src, len(lines), None, "has a header but no column names and no data")
     header_line = i + 1
     header = lines[i]
-    delim = "," if "," in header else ("\t" if "\t" in header else (";" if ";" in header else ","))
+    delim = header_delimiter(header)
     names: list[str] = []
     units: list[str | None] = []
     for j, cell in enumerate(header.split(delim)):
