@@ -11,6 +11,7 @@ import pytest
 from gearte.models.rv_dynamics import RVDynamicModel
 from gearte.runners.rv_dynamics_sim import (
     RECORD_POINTS,
+    TRACE_POINTS,
     default_step,
     dte_spectrum,
     ode_system,
@@ -34,14 +35,19 @@ def start(model):
 
 
 def test_recorded_rows_do_not_grow_with_duration(model):
-    """Twice and eight times the span keep the same number of rows: the last record_points."""
-    short = simulate_dte(model, 0.02, settle_s=0.01, record_points=64, envelope_points=32)
-    long = simulate_dte(model, 0.08, settle_s=0.01, record_points=64, envelope_points=32)
+    """Twice and eight times the span keep the same number of rows: the last record_points
+    rows of states and the last trace_points samples of the DTE."""
+    kw = dict(settle_s=0.01, record_points=48, trace_points=64, envelope_points=32)
+    short = simulate_dte(model, 0.02, **kw)
+    long = simulate_dte(model, 0.08, **kw)
     for r, end in ((short, 0.03), (long, 0.09)):
-        assert r.t.size == r.dte.size == r.states.shape[0] == 64
+        assert r.t.size == r.dte.size == 64
+        assert r.states.shape[0] == r.states_t.size == 48
         assert r.envelope.shape == (32, 2) and r.envelope_t.size == 32
-        assert not r.covers_span
+        assert not r.covers_span and not r.states_cover_span
         assert end - r.record_dt < r.t[-1] <= end + 1e-12  # the last rows
+        assert r.states_t[-1] == r.t[-1]
+        np.testing.assert_array_equal(r.states_t, r.t[-48:])
     assert long.solver.records > 3 * short.solver.records
     np.testing.assert_allclose(np.diff(long.t), long.record_dt, rtol=1e-9)
 
@@ -59,6 +65,11 @@ def test_window_is_the_tail_of_the_full_record(start):
     np.testing.assert_array_equal(tail.states, full.states[-50:])
     assert tail.stats == full.stats
     np.testing.assert_array_equal(tail.y_final, full.y_final)
+    both = integrate(system, y0, (0.0, 400 * dt), record_window=30, output_window=80, **kw)
+    np.testing.assert_array_equal(both.t, full.t[-80:])
+    np.testing.assert_array_equal(both.output, full.output[-80:])
+    np.testing.assert_array_equal(both.states_t, full.t[-30:])
+    np.testing.assert_array_equal(both.states, full.states[-30:])
 
 
 @pytest.mark.parametrize("method", ["rk4", "dopri5"])
@@ -103,16 +114,22 @@ def test_default_record_covers_the_default_dte_and_one_output_revolution(model):
     paper's reducer at 1500 rpm, recorded every 1e-4 s, fit in the default window (so the
     trace, trajectories and spectrum are those of the whole span, as before issue 12)."""
     assert DTEOptions().record_points == RECORD_POINTS
+    assert DTEOptions().trace_points == TRACE_POINTS
     d = DTEOptions()
     rev = 1.0 / model.params.frequencies()["output rotation"]
     rows = int((rev + d.record_dt_s) / d.record_dt_s) + 1
     assert RECORD_POINTS >= rows > int(d.duration_s / d.record_dt_s)
     r = simulate_dte(model, d.duration_s, settle_s=d.settle_s, record_dt=d.record_dt_s)
     every = simulate_dte(
-        model, d.duration_s, settle_s=d.settle_s, record_dt=d.record_dt_s, record_points=None
+        model,
+        d.duration_s,
+        settle_s=d.settle_s,
+        record_dt=d.record_dt_s,
+        record_points=None,
+        trace_points=None,
     )
-    assert r.covers_span
-    for name in ("t", "dte", "states"):
+    assert r.covers_span and r.states_cover_span
+    for name in ("t", "dte", "states", "states_t"):
         np.testing.assert_array_equal(getattr(r, name), getattr(every, name))
     assert r.peak_to_peak == every.peak_to_peak
 
@@ -142,8 +159,8 @@ def test_windowed_spectrum_of_a_long_span_keeps_its_peaks(model):
     1/window, here 4.8 Hz against 2.6 Hz) and finds the same four largest sources as the whole
     span recorded, their amplitudes within 10 % (Hann scalloping: the bins differ)."""
     src = model.params.frequencies()
-    win = simulate_dte(model, 0.4, settle_s=0.1, record_points=2000)
-    whole = simulate_dte(model, 0.4, settle_s=0.1, record_points=None)
+    win = simulate_dte(model, 0.4, settle_s=0.1, trace_points=2000)
+    whole = simulate_dte(model, 0.4, settle_s=0.1, trace_points=None)
     assert win.t.size == 2000 and whole.t.size > 3800
     assert win.recorded_span == pytest.approx(2000 * win.record_dt)
     _, _, p_win = dte_spectrum(win.t, win.dte, src)
@@ -223,21 +240,24 @@ def _dte_case(**dte) -> dict:
 
 
 def test_study_record_points_bound_the_trace_and_zero_keeps_every_row():
-    """`[analyses.dte] record_points`: a short window gives the spectrum of the last rows (its
-    resolution and the notes say so); 0 keeps every row; peak-to-peak is the same."""
+    """`[analyses.dte] trace_points` / `record_points`: short windows give the spectrum and
+    trajectories of the last rows (the values and notes say so); 0 keeps every row;
+    peak-to-peak is the same."""
     from gearte.io.case_file import load_case_dict
     from gearte.studies import RunOptions, run_case
 
     opts = RunOptions(progress=False, workers=1)
-    win = run_case(load_case_dict(_dte_case(record_points=100)), opts)["dte"]
-    every = run_case(load_case_dict(_dte_case(record_points=0)), opts)["dte"]
+    win = run_case(load_case_dict(_dte_case(trace_points=100, record_points=50)), opts)["dte"]
+    every = run_case(load_case_dict(_dte_case(trace_points=0, record_points=0)), opts)["dte"]
     r_win, r_all = win.data["dte"], every.data["dte"]
     assert r_win.t.size == 100 and not r_win.covers_span
+    assert r_win.states.shape[0] == 50 and not r_win.states_cover_span
     assert r_all.covers_span and r_all.t.size == r_all.solver.records > 400
+    assert r_all.states_cover_span
     assert win.values["spectrum_window [s]"] == pytest.approx(100 * r_win.record_dt)
     assert every.values["spectrum_window [s]"] == pytest.approx(r_all.t.size * r_all.record_dt)
     assert win.values["spectrum_nyquist [Hz]"] == pytest.approx(0.5 / r_win.record_dt)
-    assert any("over the last" in n for n in win.notes)
+    assert any("trace_points" in n and "record_points" in n for n in win.notes)
     assert not any("over the last" in n for n in every.notes)
     p2p = "dte_peak_to_peak [arcsec]"
     assert win.values[p2p] == every.values[p2p]
@@ -249,3 +269,5 @@ def test_study_refuses_a_negative_record_points():
 
     with pytest.raises(CaseFileError, match="record_points"):
         load_case_dict(_dte_case(record_points=-1))
+    with pytest.raises(CaseFileError, match="trace_points"):
+        load_case_dict(_dte_case(trace_points=-1))

@@ -269,17 +269,18 @@ def run(
         from gearte.studies import RunOptions, run_case
 
         t1 = time.perf_counter()
-        # the report's process imports matplotlib while this one runs the analyses
+        c = load_case(case)
+        t2 = time.perf_counter()
+        default = os.path.join("out", safe_label(c.case.name or c.case.kind))
+        target = check_output_dir(out_dir if out_dir is not None else default)
+        # the report's process (forked with the case's kind imported: its result unpickles
+        # there) imports matplotlib while this one runs the analyses
         renderer = None
         if not no_report:
             from gearte.report.background import ReportWorker
 
-            renderer = ReportWorker.start(case)
+            renderer = ReportWorker.start()
         try:
-            c = load_case(case)
-            t2 = time.perf_counter()
-            default = os.path.join("out", safe_label(c.case.name or c.case.kind))
-            target = check_output_dir(out_dir if out_dir is not None else default)
             with _executor(scheduler, workers) as executor:
                 opts = RunOptions(
                     progress=not no_progress,

@@ -144,8 +144,8 @@ def _dte_figures(a) -> list[Figure]:
             "phase portraits (paper 004 Fig 10)"
             + (
                 "."
-                if r.covers_span
-                else f", over the last {r.recorded_span:.3g} s recorded (record_points)."
+                if r.states_cover_span
+                else f", over the last {r.states_span:.3g} s recorded (record_points)."
             ),
             fig,
         )

@@ -36,6 +36,7 @@ __all__ = [
     "dte_batch",
     "default_step",
     "RECORD_POINTS",
+    "TRACE_POINTS",
     "ENVELOPE_POINTS",
 ]
 
@@ -70,9 +71,12 @@ def ode_system(model: RVDynamicModel, errors: RVErrors | None = None) -> ODESyst
     )
 
 
-#: Rows of the recorded trace kept by default (the last ones): one output revolution of the
+#: Rows of recorded states kept by default (the last ones): one output revolution of the
 #: Li 2023 reducer at 1500 rpm (4.84 s) at the default 1e-4 s interval fits (46 670 rows).
 RECORD_POINTS = 65536
+#: Samples of the recorded DTE trace kept by default (the last ones; the spectrum's window):
+#: 27 s at the default 1e-4 s interval, 2 MB.
+TRACE_POINTS = 262144
 #: Buckets of the full-rate DTE envelope (min/max) over the whole span.
 ENVELOPE_POINTS = 4096
 
@@ -82,13 +86,13 @@ class DTEResult:
     """Dynamic transmission error of one run (after settling).
 
     ``peak_to_peak``, ``rms`` [arcsec] and ``dte_mean`` [arcsec] (the static wind-up) come
-    from the DTE at every integration step over the whole span. The recorded trace — t [s],
-    dte [arcsec] (mean removed) and the recorded states (columns ``state_names``) every
-    ``record_dt`` [s] — is the whole span when it has at most ``record_points`` rows, else its
-    last ``record_points`` rows (``covers_span`` tells which; memory independent of the
-    duration). ``envelope_t`` [s], ``envelope`` [arcsec] (buckets × [min, max], mean removed):
-    the full-rate DTE's extremes in equal buckets over the whole span. ``solver``: the solver
-    result; ``dt`` [s] the RK4 step.
+    from the DTE at every integration step over the whole span. The recorded trace — t [s] and
+    dte [arcsec] (mean removed) every ``record_dt`` [s] — is the whole span when it has at most
+    ``trace_points`` samples, else its last ``trace_points`` (``covers_span`` tells which); the
+    recorded states (columns ``state_names``, times ``states_t`` [s]) likewise with
+    ``record_points`` rows. Memory is independent of the duration. ``envelope_t`` [s],
+    ``envelope`` [arcsec] (buckets × [min, max], mean removed): the full-rate DTE's extremes in
+    equal buckets over the whole span. ``solver``: the solver result; ``dt`` [s] the RK4 step.
     """
 
     t: np.ndarray
@@ -102,6 +106,7 @@ class DTEResult:
     dt: float
     record_dt: float = float("nan")
     covers_span: bool = True
+    states_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     envelope_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     envelope: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
 
@@ -109,6 +114,17 @@ class DTEResult:
     def recorded_span(self) -> float:
         """Span of the recorded trace [s] (the spectrum's window: resolution 1/this)."""
         return float(self.t[-1] - self.t[0]) + self.record_dt if self.t.size else 0.0
+
+    @property
+    def states_span(self) -> float:
+        """Span of the recorded states [s] (trajectories and phase portraits)."""
+        t = self.states_t
+        return float(t[-1] - t[0]) + self.record_dt if t.size else 0.0
+
+    @property
+    def states_cover_span(self) -> bool:
+        """Whether the recorded states cover the whole span after settling."""
+        return self.states_t.size == self.solver.records
 
 
 def default_step(model: RVDynamicModel, fraction: float = 0.85) -> float:
@@ -129,6 +145,7 @@ def simulate_dte(
     record_dt: float | None = 1e-4,
     record_bodies: tuple[str, ...] = ("sun", "planet1", "disc1", "output"),
     record_points: int | None = RECORD_POINTS,
+    trace_points: int | None = TRACE_POINTS,
     envelope_points: int = ENVELOPE_POINTS,
     rtol: float = 1e-8,
     atol: float = 1e-12,
@@ -156,9 +173,11 @@ def simulate_dte(
     record_bodies : tuple of str
         Bodies whose states are recorded.
     record_points : int, optional
-        Most recorded rows kept [-]: a longer span keeps its last ``record_points`` rows, so
-        memory does not grow with ``duration_s``; ``None`` keeps every row (memory grows with
-        the duration: the full-rate option, with ``record_dt`` = ``dt``).
+        Most rows of recorded states kept [-]: a longer span keeps its last ``record_points``
+        rows, so memory does not grow with ``duration_s``; ``None`` keeps every row (memory
+        grows with the duration: the full-rate option, with ``record_dt`` = ``dt``).
+    trace_points : int, optional
+        The same for the recorded DTE trace [-] (the spectrum's window); ``None``: every sample.
     envelope_points : int
         Buckets [-] of the DTE's min/max envelope over the whole span, from every step.
     rtol, atol : float
@@ -173,6 +192,8 @@ def simulate_dte(
         raise ParameterError("duration_s", duration_s, "must be > 0")
     if record_points is not None and record_points < 8:
         raise ParameterError("record_points", record_points, "must be ≥ 8 (or None: all rows)")
+    if trace_points is not None and trace_points < 8:
+        raise ParameterError("trace_points", trace_points, "must be ≥ 8 (or None: all samples)")
     system = ode_system(model)
     q0 = model.static_equilibrium(0.0)
     y0 = np.concatenate([q0, np.zeros_like(q0)])
@@ -199,6 +220,7 @@ def simulate_dte(
         record_dt=record_dt,
         record_states=idx,
         record_window=record_points,
+        output_window=trace_points,
         envelope_points=envelope_points,
         rtol=rtol,
         atol=atol,
@@ -218,6 +240,7 @@ def simulate_dte(
         dt=float(dt) if dt is not None else float("nan"),
         record_dt=rec_dt,
         covers_span=res.records == res.t.size,
+        states_t=res.states_t,
         envelope_t=res.envelope_t,
         envelope=res.envelope * ARCSEC_PER_RAD - mean,
     )

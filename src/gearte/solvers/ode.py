@@ -89,9 +89,10 @@ class ODEResult:
     """Result of :func:`integrate`.
 
     t [s] and output (plus the recorded states ``states``, columns = ``record_states``) on the
-    recording grid after the settling time — the last ``record_window`` rows when a window was
-    asked for; ``records`` the rows recorded over the whole span (more than ``t.size`` when the
-    window dropped the first ones); ``stats`` of the output after settling (min, max, mean,
+    recording grid after the settling time — the last ``output_window`` / ``record_window`` rows
+    when a window was asked for (``states_t`` [s]: the times of the states' rows); ``records``
+    the rows recorded over the whole span (more than ``t.size`` when the window dropped the
+    first ones); ``stats`` of the output after settling (min, max, mean,
     rms, peak_to_peak, count); ``envelope`` (buckets × [min, max]) of the output over the span
     after settling, ``envelope_t`` [s] the buckets' centres; ``y_final``; counters and wall
     time [s].
@@ -107,6 +108,7 @@ class ODEResult:
     n_rhs: int
     wall_time: float
     records: int = 0
+    states_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     envelope: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
     envelope_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
 
@@ -178,7 +180,30 @@ def _env_update(env, b, o):
         env[b, 1] = o
 
 
-def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, rec, work_size, env):
+@njit(cache=True, nogil=True)
+def _new_stats():
+    stats = np.zeros(_STATS)
+    stats[1] = np.inf
+    stats[2] = -np.inf
+    return stats
+
+
+@njit(cache=True, nogil=True)
+def _record(trace, rec, rec_idx, nrec, o, y):
+    """Sample ``nrec`` (output ``o``, states ``y[rec_idx]``) into the ring buffers ``trace`` and
+    ``rec`` (each keeps its last rows; an empty one records nothing); returns ``nrec + 1``."""
+    if trace.shape[0] > 0:
+        trace[nrec % trace.shape[0]] = o
+    if rec.shape[0] > 0:
+        r = nrec % rec.shape[0]
+        for c in range(rec_idx.size):
+            rec[r, c] = y[rec_idx[c]]
+    return nrec + 1
+
+
+def _rk4_template(
+    y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, trace, rec, work_size, env
+):
     n = y0.size
     work = np.full(work_size, np.nan)
     y = y0.copy()
@@ -187,11 +212,8 @@ def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, r
     k3 = np.empty(n)
     k4 = np.empty(n)
     tmp = np.empty(n)
-    stats = np.zeros(_STATS)
-    stats[1] = np.inf
-    stats[2] = -np.inf
-    nrec = 0  # rows recorded in all; rec keeps the last rec.shape[0] (ring buffer)
-    cap = rec.shape[0]
+    stats = _new_stats()
+    nrec = 0  # samples recorded in all; trace/rec keep their last rows (ring buffers)
     n_env = env.shape[0]
     n_out = n_steps - settle_steps + 1  # output samples after settling (envelope buckets)
     h2 = 0.5 * dt
@@ -201,11 +223,8 @@ def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, r
         _stats_update(stats, o)
         if n_env > 0:
             _env_update(env, 0, o)
-        if rec_every > 0 and cap > 0:
-            rec[0, 0] = o
-            for c in range(rec_idx.size):
-                rec[0, 1 + c] = y[rec_idx[c]]
-            nrec = 1
+        if rec_every > 0:
+            nrec = _record(trace, rec, rec_idx, nrec, o, y)
     for s in range(n_steps):
         t = t0 + s * dt
         rhs(t, y, args, k1, work)
@@ -231,12 +250,8 @@ def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, r
             j = s + 1 - settle_steps
             if n_env > 0:
                 _env_update(env, (j * n_env) // n_out, o)
-            if rec_every > 0 and cap > 0 and j % rec_every == 0:
-                r = nrec % cap
-                rec[r, 0] = o
-                for c in range(rec_idx.size):
-                    rec[r, 1 + c] = y[rec_idx[c]]
-                nrec += 1
+            if rec_every > 0 and j % rec_every == 0:
+                nrec = _record(trace, rec, rec_idx, nrec, o, y)
     return y, stats, nrec, -1
 
 
@@ -270,6 +285,7 @@ def _dopri5_template(
     t_settle,
     rec_dt,
     rec_idx,
+    trace,
     rec,
     max_steps,
     work_size,
@@ -288,17 +304,14 @@ def _dopri5_template(
     k7 = np.empty(n)
     yn = np.empty(n)
     tmp = np.empty(n)
-    stats = np.zeros(_STATS)
-    stats[1] = np.inf
-    stats[2] = -np.inf
+    stats = _new_stats()
     counters = np.zeros(3)  # accepted, rejected, rhs evaluations
     t = t0
     h = h0
     rhs(t, y, args, k1, work)
     counters[2] += 1
     next_rec = t_settle
-    nrec = 0  # samples on the recording grid so far; rec keeps the last rec.shape[0]
-    cap = rec.shape[0]
+    nrec = 0  # samples on the recording grid so far; trace/rec keep their last rows
     n_env = env.shape[0]
     while t < t_end:
         if counters[0] + counters[1] >= max_steps:
@@ -353,12 +366,7 @@ def _dopri5_template(
                 _stats_update(stats, o)
                 if n_env > 0:
                     _env_update(env, min((nrec * n_env) // n_out, n_env - 1), o)
-                if cap > 0:
-                    r = nrec % cap
-                    rec[r, 0] = o
-                    for c in range(rec_idx.size):
-                        rec[r, 1 + c] = tmp[rec_idx[c]]
-                nrec += 1
+                nrec = _record(trace, rec, rec_idx, nrec, o, tmp)
                 next_rec += rec_dt
             t = t_new
             acc = 0.0
@@ -462,8 +470,8 @@ def _finish_stats(stats: np.ndarray) -> dict[str, float]:
 def _ring_order(rec: np.ndarray, nrec: int) -> np.ndarray:
     """Copy of the rows of a ring buffer ``rec`` that received ``nrec`` rows, oldest first."""
     cap = rec.shape[0]
-    if nrec <= cap:
-        return rec[:nrec].copy()
+    if nrec <= cap or cap == 0:
+        return rec[: min(nrec, cap)].copy()
     k = nrec % cap
     return np.concatenate([rec[k:], rec[:k]])
 
@@ -488,6 +496,7 @@ def integrate(
     record_dt: float | None = None,
     record_states: np.ndarray | list[int] | None = None,
     record_window: int | None = None,
+    output_window: int | None = None,
     envelope_points: int = 0,
     max_records: int = 2_000_000,
     max_steps: int = 50_000_000,
@@ -512,6 +521,9 @@ def integrate(
         Most recorded rows kept [-]: the kernel writes rows into a ring buffer of this many and
         the result holds the *last* ones (memory independent of the span). ``None`` keeps every
         row of the span.
+    output_window : int, optional
+        The same for the recorded output alone (``t``, ``output``; one float a row, so it can
+        reach further back than the states); default ``record_window``.
     envelope_points : int
         Buckets [-] of the output's min/max envelope over the span after settling, updated at
         every RK4 step (DOPRI5, scipy: every recorded sample); 0 for none. Capped at the
@@ -545,6 +557,9 @@ def integrate(
         raise ParameterError("t_settle", t_settle, f"must be in [0, {t1 - t0:g}) s")
     if record_window is not None and record_window < 1:
         raise ParameterError("record_window", record_window, "must be ≥ 1 row (or None: all)")
+    if output_window is not None and output_window < 1:
+        raise ParameterError("output_window", output_window, "must be ≥ 1 row (or None: all)")
+    out_window = record_window if output_window is None else output_window
     if envelope_points < 0:
         raise ParameterError("envelope_points", envelope_points, "must be ≥ 0")
     y0 = np.ascontiguousarray(y0, dtype=float)
@@ -553,8 +568,8 @@ def integrate(
     a = system.args if args is None else args
     idx = np.asarray([] if record_states is None else record_states, dtype=np.int64)
 
-    def rows(needed: int) -> int:
-        cap = needed if record_window is None else min(needed, record_window)
+    def rows(needed: int, window: int | None) -> int:
+        cap = needed if window is None else min(needed, window)
         if cap > max_records:
             raise ParameterError(
                 "record_dt",
@@ -600,15 +615,18 @@ def integrate(
         settle_steps = int(round(t_settle / dt))
         n_out = n_steps - settle_steps + 1
         if record_dt is None:
-            rec_every, n_rec = 0, 0
+            rec_every, n_trace, n_rec = 0, 0, 0
         else:
             rec_every = max(1, int(round(record_dt / dt)))
-            n_rec = rows((n_steps - settle_steps) // rec_every + 1)
-        rec = np.zeros((n_rec, 1 + idx.size))
+            needed = (n_steps - settle_steps) // rec_every + 1
+            n_trace = rows(needed, out_window)
+            n_rec = rows(needed, record_window) if idx.size else 0
+        trace = np.zeros(n_trace)
+        rec = np.zeros((n_rec, idx.size))
         env = _new_envelope(min(envelope_points, n_out))
         rk4, _ = kernels(system.rhs, system.output, system.key)
         y, stats, nrec, status = rk4(
-            y0, t0, dt, n_steps, a, settle_steps, rec_every, idx, rec, system.work_size, env
+            y0, t0, dt, n_steps, a, settle_steps, rec_every, idx, trace, rec, system.work_size, env
         )
         if status >= 0:
             raise DivergenceError(
@@ -616,7 +634,10 @@ def integrate(
                 f"(step {status} of {n_steps}, dt = {dt:.3g} s)"
             )
         records = int(nrec)
-        t_rec = t0 + (settle_steps + rec_every * np.arange(max(0, nrec - n_rec), nrec)) * dt
+
+        def times(n: int) -> np.ndarray:
+            return t0 + (settle_steps + rec_every * np.arange(max(0, nrec - n), nrec)) * dt
+
         per = n_out / max(env.shape[0], 1)  # output samples per envelope bucket
         env_t = t0 + (settle_steps + (np.arange(env.shape[0]) + 0.5) * per - 0.5) * dt
         n_rhs = 4 * n_steps
@@ -625,8 +646,10 @@ def integrate(
         h0 = dt if dt is not None else 1e-6
         rec_dt = record_dt if record_dt is not None else (t1 - t0) / 10000
         n_out = int((t1 - t0 - t_settle) / rec_dt) + 1
-        n_rec = 0 if record_dt is None else rows(n_out + 1)
-        rec = np.zeros((n_rec, 1 + idx.size))
+        n_trace = 0 if record_dt is None else rows(n_out + 1, out_window)
+        n_rec = 0 if record_dt is None or not idx.size else rows(n_out + 1, record_window)
+        trace = np.zeros(n_trace)
+        rec = np.zeros((n_rec, idx.size))
         env = _new_envelope(min(envelope_points, n_out))
         atol_arr = np.broadcast_to(np.asarray(atol, dtype=float), y0.shape).copy()
         _, dp = kernels(system.rhs, system.output, system.key)
@@ -642,6 +665,7 @@ def integrate(
             t0 + t_settle,
             rec_dt,
             idx,
+            trace,
             rec,
             max_steps,
             system.work_size,
@@ -652,10 +676,13 @@ def integrate(
             raise DivergenceError("DOPRI5 diverged: non-finite state or error estimate")
         if status == -2:
             raise DivergenceError(f"DOPRI5 exceeded {max_steps} steps (stiff or diverging)")
-        if n_rec == 0:
+        if record_dt is None:
             nrec = 0
         records = int(nrec)
-        t_rec = t0 + t_settle + rec_dt * np.arange(max(0, nrec - n_rec), nrec)
+
+        def times(n: int) -> np.ndarray:
+            return t0 + t_settle + rec_dt * np.arange(max(0, nrec - n), nrec)
+
         per = n_out / max(env.shape[0], 1)
         env_t = t0 + t_settle + ((np.arange(env.shape[0]) + 0.5) * per - 0.5) * rec_dt
         n_rhs = int(counters[2])
@@ -686,11 +713,19 @@ def integrate(
             np.maximum.at(env[:, 1], b, outs)
         per = outs.size / max(n_env, 1)
         env_t = np.interp((np.arange(n_env) + 0.5) * per - 0.5, np.arange(outs.size), sol.t)
-        rec = np.column_stack([outs] + [sol.y[i] for i in idx]) if outs.size else np.zeros((0, 1))
-        records = rec.shape[0]
+        records = outs.size
+        n_trace = records if out_window is None else min(records, out_window)
         n_rec = records if record_window is None else min(records, record_window)
-        rec, t_rec = rec[records - n_rec :], sol.t[sol.t.size - n_rec :]
-        nrec = n_rec
+        trace = outs[records - n_trace :]
+        rec = np.zeros((n_rec, idx.size))
+        for c, i in enumerate(idx):
+            rec[:, c] = sol.y[i, records - n_rec :]
+        t_all = sol.t
+
+        def times(n: int) -> np.ndarray:
+            return t_all[t_all.size - n :] if n else t_all[:0]
+
+        nrec = records
         n_rhs = int(sol.nfev)
         steps = int(sol.t.size)
     else:
@@ -699,14 +734,19 @@ def integrate(
     st = _finish_stats(np.asarray(stats))
     if not np.all(np.isfinite(list(st.values()))):
         raise DivergenceError(f"{method}: non-finite output statistics")
-    output_rows = _ring_order(rec[:, 0], nrec)
-    state_rows = _ring_order(rec[:, 1:], nrec)
-    del rec
+    if method == "scipy":
+        output_rows, state_rows = trace.copy(), rec.copy()
+    else:
+        output_rows, state_rows = _ring_order(trace, nrec), _ring_order(rec, nrec)
+    del rec, trace
+    if idx.size == 0:  # no states: as many empty rows as the output has
+        state_rows = np.zeros((output_rows.size, 0))
     return ODEResult(
         method=method,
-        t=t_rec,
+        t=times(output_rows.size),
         output=output_rows,
         states=state_rows,
+        states_t=times(state_rows.shape[0]),
         y_final=np.asarray(y).copy(),
         stats=st,
         n_steps=steps,

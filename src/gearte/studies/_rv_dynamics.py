@@ -100,10 +100,18 @@ class DTEOptions(StrictModel):
         65536,  # gearte.runners.rv_dynamics_sim.RECORD_POINTS (not imported: numba at load)
         ge=0,
         le=2_000_000,
-        description="most recorded rows kept, the last ones: the trace, trajectories and "
-        "spectrum cover the last record_points x record_dt_s seconds; peak-to-peak, RMS and the "
-        "DTE envelope always cover the whole span at every step. 0 keeps every row (memory "
+        description="most rows of recorded states kept, the last ones: trajectories and phase "
+        "portraits cover the last record_points x record_dt_s seconds; peak-to-peak, RMS and "
+        "the DTE envelope always cover the whole span at every step. 0 keeps every row (memory "
         "grows with duration_s)",
+    )
+    trace_points: int = Field(
+        262144,  # gearte.runners.rv_dynamics_sim.TRACE_POINTS
+        ge=0,
+        le=20_000_000,
+        description="most samples of the recorded DTE trace kept, the last ones: the spectrum "
+        "covers the last trace_points x record_dt_s seconds (resolution 1/that). 0 keeps every "
+        "sample (memory grows with duration_s)",
     )
 
 
@@ -391,6 +399,7 @@ def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
         dt=dt,
         record_dt=opts.record_dt_s,
         record_points=opts.record_points or None,
+        trace_points=opts.trace_points or None,
     )
     sources = model.params.frequencies()
     freq, spec, peaks = dte_spectrum(r.t, r.dte, sources)
@@ -422,13 +431,18 @@ def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
         f"Spectrum resolution {resolution:.3g} Hz (Hann window); peaks labelled by the nearest "
         "harmonic of a rotation or mesh frequency, or a mesh ± rotation sideband.",
         f"Peak-to-peak and RMS from every step over the whole span (DOPRI5, scipy: every "
-        f"recording instant); the spectrum, the trace "
-        f"and the trajectories from the states recorded every {r.record_dt:.3g} s "
+        f"recording instant); the spectrum from the DTE recorded every {r.record_dt:.3g} s "
+        + (
+            "over the whole span"
+            if r.covers_span
+            else f"over the last {window:.3g} s ({r.t.size} samples, trace_points; the DTE plot "
+            "draws the full-rate envelope of the whole span)"
+        )
+        + "; the trajectories "
         + (
             "over the whole span."
-            if r.covers_span
-            else f"over the last {window:.3g} s ({r.t.size} rows; record_points bounds the "
-            "memory); the DTE plot draws the full-rate envelope of the whole span."
+            if r.states_cover_span
+            else f"over the last {r.states_span:.3g} s ({r.states_t.size} rows, record_points)."
         ),
         "Paper 004 Fig 11: 0.78″ without errors, 17.25″ with errors (bench 22.56″/23.37″).",
     ]
