@@ -21,9 +21,11 @@ $(VENV)/bin/python:
 	@echo "==> creating $(VENV) with $(PYTHON)"
 	$(PYTHON) -m venv $(VENV)
 
+# --no-compile: pip byte-compiles every installed module otherwise (~24 s of CPU for scipy,
+# matplotlib, numba...); Python compiles the few that gearte imports on first use instead.
 $(RUN_STAMP): pyproject.toml $(CONSTRAINTS) | $(VENV)/bin/python
 	@echo "==> installing gearte and its runtime dependencies (pinned by $(CONSTRAINTS))"
-	$(PIP) --progress-bar on -e .
+	$(PIP) --progress-bar on --no-compile -e .
 	rm -f $(VENV)/.installed-run-*
 	touch $(RUN_STAMP)
 

@@ -16,12 +16,22 @@
    1.5× of it), and ``solve_ivp`` (RK45 and DOP853, rtol 1e-6) on the compiled right-hand side
    (on ``--baseline-span`` s, scaled).
 
-Run: ``PYTHONPATH=src python benchmarks/bench_rv_dynamics.py [--full-baseline]``.
+6. Memory (issue 12): the ``dte`` analysis of ``li2023_rv_errors`` (run through the study, at
+   ``--record-dt``) over 1 and over 20 output revolutions, each in a fresh process; peak resident
+   memory from ``resource.getrusage(RUSAGE_SELF / RUSAGE_CHILDREN).ru_maxrss`` (goal: 20
+   revolutions within 1.2× of 1). ``--report`` also builds and writes the report.
+
+Run: ``PYTHONPATH=src python benchmarks/bench_rv_dynamics.py [--full-baseline]
+[--only speed,batch,memory]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import resource
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -79,6 +89,122 @@ def _rk4_hand(y0, t0, dt, n_steps, settle_steps, args, work_size):
     return hi - lo
 
 
+def _memory_child(revs: float, record_dt: float, report: bool) -> None:
+    """One ``dte`` analysis over ``revs`` output revolutions; prints the peak memory [MiB]."""
+    import tempfile
+    import tomllib
+
+    import gearte
+    from gearte.cases import case_path
+    from gearte.studies import RunOptions
+
+    data = tomllib.loads(case_path("li2023_rv_errors").read_text())
+    rpm = data["operation"]["input_speed_rpm"]
+    model, _ = load_dynamic_model("li2023_rv_errors")
+    f_out = model.params.frequencies()["output rotation"]
+    assert abs(f_out - rpm / 60 / model.params.ratio) < 1e-9
+    data["analyses"] = {
+        "dte": {"duration_s": revs / f_out, "settle_s": 0.1, "record_dt_s": record_dt}
+    }
+    c0 = time.process_time()
+    result = gearte.run_case(gearte.load_case(data), RunOptions(progress=False, workers=1))
+    v = result["dte"].values
+    if report:
+        with tempfile.TemporaryDirectory() as tmp:
+            gearte.write_outputs(result, tmp)
+    cpu = time.process_time() - c0
+    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+    print(
+        f"MEMORY {revs:g} {own:.1f} {kids:.1f} {cpu:.2f} {v['dte_peak_to_peak [arcsec]']:.6f} "
+        f"{v['spectrum_window [s]']:.4f} {v['dominant_dte_frequency [Hz]']:.4f}"
+    )
+
+
+def memory(record_dt: float, report: bool) -> None:
+    """Peak memory of the dte analysis at 1 and 20 output revolutions, fresh process each."""
+    rows = {}
+    for revs in (1, 20):
+        cmd = [sys.executable, __file__, "--memory-child", str(revs), "--record-dt", str(record_dt)]
+        if report:
+            cmd.append("--report")
+        out = subprocess.run(cmd, capture_output=True, text=True, env=os.environ.copy())
+        line = [x for x in out.stdout.splitlines() if x.startswith("MEMORY")]
+        if out.returncode or not line:
+            print(out.stdout, out.stderr)
+            raise SystemExit(f"memory child for {revs} revolutions failed")
+        _, _, own, kids, cpu, p2p, window, dom = line[0].split()
+        rows[revs] = (float(own), float(kids))
+        print(
+            f"dte analysis, {revs:2d} output revolution(s) at record_dt {record_dt:g} s: peak RSS "
+            f"{float(own):7.1f} MiB (children {float(kids):6.1f} MiB), {float(cpu):6.2f} s CPU; "
+            f"DTE p2p {float(p2p):.4f}″, spectrum window {float(window):.3f} s, dominant "
+            f"{float(dom):.3f} Hz"
+        )
+    ratio = rows[20][0] / rows[1][0]
+    verdict = "met" if ratio <= 1.2 else "NOT met"
+    kids = f"; children (report renderers) {rows[20][1] / rows[1][1]:.2f}×" if rows[1][1] else ""
+    print(f"goal peak memory 20 rev / 1 rev ≤ 1.2×: measured {ratio:.2f}× — {verdict}{kids}")
+
+
+def batch_scaling(model, red, dt: float, settle: float, duration: float, workers: int) -> None:
+    """A batch of 2 runs at the default chunk size on 1 and on ``workers`` workers."""
+    kw = dict(seed=1, duration_s=duration, settle_s=settle, dt=dt)
+    kw["tolerances"] = batch_tolerances(red)
+    dte_batch(model, 2, workers=workers, **kw)  # warm: threads' first call, kernels
+    best = {}
+    for w in (1, workers) * 3:
+        c0, t0 = time.process_time(), time.perf_counter()
+        r = dte_batch(model, 2, workers=w, **kw)
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        best.setdefault(w, []).append((wall, cpu, r["rows"]))
+    same = np.array_equal(best[1][0][2], best[workers][0][2])
+    w1 = min(x[0] for x in best[1])
+    w2 = min(x[0] for x in best[workers])
+    c1 = min(x[1] for x in best[1])
+    c2 = min(x[1] for x in best[workers])
+    load = os.getloadavg()
+    print(
+        f"batch of 2 runs ({duration:g} s + {settle:g} s simulated each), default chunks, best of "
+        f"3: 1 worker {w1:.3f} s wall / {c1:.3f} s CPU, {workers} workers {w2:.3f} s wall / "
+        f"{c2:.3f} s CPU; rows identical: {same}; load average {load[0]:.1f}"
+    )
+    verdict = "met" if w1 / w2 >= 1.6 else "NOT met"
+    print(
+        f"goal batch of 2 on {workers} workers ≥ 1.6× 1 worker (wall): measured {w1 / w2:.2f}× — "
+        f"{verdict}{'' if load[0] < 1.0 else ' (machine loaded: needs 2 idle cores)'}"
+    )
+    # Amdahl from CPU times (load-insensitive): CPU inside the runs (chunk calls, thread time)
+    # against the whole batch's CPU on 1 worker; the rest is serial (the parent's work)
+    import gearte.runners.rv_dynamics_sim as sim
+
+    inner, spent = sim._batch_chunk, []
+
+    def timed(task, shared):
+        c0 = time.thread_time()
+        out = inner(task, shared)
+        spent.append(time.thread_time() - c0)
+        return out
+
+    sim._batch_chunk = timed
+    try:
+        splits = []
+        for _ in range(3):
+            spent.clear()
+            c0 = time.process_time()
+            dte_batch(model, 2, workers=1, **kw)
+            total = time.process_time() - c0
+            splits.append((total - sum(spent), sum(spent) / 2))
+    finally:
+        sim._batch_chunk = inner
+    serial, p_run = min(splits)
+    print(
+        f"  CPU split (1 worker, best of 3): one run {p_run * 1e3:.1f} ms, outside the runs "
+        f"{serial * 1e3:.1f} ms → on 2 idle cores at most "
+        f"{(serial + 2 * p_run) / (serial + p_run):.2f}× (Amdahl)"
+    )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--baseline-span", type=float, default=0.02, help="simulated s for solve_ivp")
@@ -86,9 +212,31 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=64)
     ap.add_argument("--batch-duration", type=float, default=1.0, help="simulated s/realisation")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--only", default="speed,batch,memory", help="parts to run (comma list)")
+    ap.add_argument("--record-dt", type=float, default=1e-4, help="memory: recording interval")
+    ap.add_argument("--report", action="store_true", help="memory: also write the report")
+    ap.add_argument("--memory-child", type=float, default=None, help=argparse.SUPPRESS)
     a = ap.parse_args()
+    if a.memory_child is not None:
+        _memory_child(a.memory_child, a.record_dt, a.report)
+        return
+    parts = set(a.only.split(","))
 
     model, red = load_dynamic_model("li2023_rv_errors")  # Li 2023 Tables 1-3, mean k_cr
+    dt = default_step(model)
+    settle = 0.1
+    if "speed" in parts:
+        speed(model, red, a)
+    if "batch" in parts:
+        batch(model, red, dt, settle, a)
+        batch_scaling(model, red, dt, settle, a.batch_duration, a.workers)
+        batch_scaling(model, red, dt, settle, 0.5, a.workers)  # the study's default span
+    if "memory" in parts:
+        memory(a.record_dt, a.report)
+
+
+def speed(model, red, a) -> None:
+    """Parts 1-3 and 5: the compiled integrator against its baselines."""
     system = ode_system(model)
     dt = default_step(model)
     q0 = model.static_equilibrium(0.0)
@@ -147,6 +295,10 @@ def main() -> None:
         f"hand-written numba RK4, same rhs/step: {c_hand:8.3f} s CPU (gearte {c_fast:.3f} s CPU:"
         f" {c_fast / c_hand:.2f}× of it, goal ≤ 1.5×), DTE p2p {p2p_hand * ARCSEC_PER_RAD:.3f}″"
     )
+    verdict = "met" if c_fast / c_hand <= 1.5 else "NOT met"
+    print(
+        f"goal gearte RK4 ≤ 1.5× hand-written numba RK4 (CPU): {c_fast / c_hand:.2f}× — {verdict}"
+    )
     from scipy.integrate import solve_ivp
 
     w = np.full(RHS_WORK_SIZE, np.nan)
@@ -192,6 +344,9 @@ def main() -> None:
     print(f"baseline for the full span     : {t_base_full:8.1f} s ({kind})")
     print(f"speed-up compiled / baseline   : {t_base_full / t_fast:8.0f}× (goal ≥ 200×)")
 
+
+def batch(model, red, dt: float, settle: float, a) -> None:
+    """Part 4: ``--samples`` realisations, sequential against threads."""
     # batch of error realisations
     kw = dict(seed=1, duration_s=a.batch_duration, settle_s=settle, chunk_size=4, dt=dt)
     kw["tolerances"] = batch_tolerances(red)
@@ -207,13 +362,6 @@ def main() -> None:
             f"{rr['simulated_s'] / rr['wall_s']:7.1f} sim-s/s (goal ≥ 50 aggregate)"
         )
     print(f"batch speed-up threads / sequential: {r1['wall_s'] / r2['wall_s']:.2f}×")
-    kw2 = {k: v for k, v in kw.items() if k != "chunk_size"}  # the default chunk size
-    b1 = dte_batch(model, 2, workers=1, **kw2)
-    b2 = dte_batch(model, 2, workers=2, **kw2)
-    print(
-        f"batch of 2, default chunks: 1 worker {b1['wall_s']:.2f} s, 2 workers {b2['wall_s']:.2f}"
-        f" s wall: {b1['wall_s'] / b2['wall_s']:.2f}× (goal ≥ 1.6×; needs 2 idle cores)"
-    )
     print(
         f"DTE p2p over realisations: mean {r2['peak_to_peak_mean']:.2f}″, sd "
         f"{r2['peak_to_peak_sd']:.2f}″, max {r2['peak_to_peak_max']:.2f}″"

@@ -180,7 +180,7 @@ def test_rk4_step_above_stability_limit_refused(unmod):
 
 
 def test_divergence_raised_not_returned(unmod):
-    sysm = replace(ode_system(unmod), stability_eigenvalues=None)
+    sysm = replace(ode_system(unmod), stability_eigenvalues=None, stability_limit=None)
     lim = rk4_stability_limit(ode_system(unmod).stability_eigenvalues)
     q = unmod.static_equilibrium(0.0)
     y0 = np.concatenate([q, 0 * q])

@@ -137,3 +137,35 @@ def test_validate_refuses_a_malformed_measurement_file_naming_file_line_column(t
     assert r.exit_code == 2
     assert f"{p}, line 4, column 3 'eccentricity [mm]'" in r.output
     assert "Traceback" not in r.output
+
+
+def test_reproducer_serial_te_at_default_zero_load_fraction_with_measured_clearances():
+    """The bundled serial (measured bearing clearances) raised ConvergenceError in
+    ``transmission_error`` at the default zero_load_fraction 1e-3 (its case file used 0.01).
+    Cause: the mesh-period refinement windows were solved as one sweep, each window
+    warm-started from the end of the previous one, far away; at 0.1 % of the torque the parts
+    float in their bearing clearances (residual stiffness 1e-6 k) and Newton needs > 100 steps
+    from such a start (a cold start fails too). Each window now starts from the coarse solution
+    nearest it. The equilibrium is unique, so the result is the old sweep's with a 10× longer
+    Newton budget, to round-off."""
+    from gearte.models import rv_load_sharing as ls
+    from gearte.solvers.rv_equilibrium import solve_positions
+    from gearte.studies.rv_serial import build_serial
+
+    case = load_case(case_path("synthetic_rv110e_serial"))
+    assert case.analyses.transmission_error.zero_load_fraction == 1e-3  # the default again
+    _, red, _ = build_serial(case)
+    torque = 1078e3
+    te = ls.transmission_error(red, torque, zero_load_fraction=1e-3)
+    # the former path: every window in one sweep, with maxit 1000 instead of 100
+    centres = {int(np.argmax(x)) for x in (te.total, te.geometric, te.elastic)}
+    centres |= {int(np.argmin(x)) for x in (te.total, te.geometric, te.elastic)}
+    offs = (np.arange(24) / 24 - 0.5) * ls.mesh_period(red)
+    fsys = ls.assemble(red, np.concatenate([te.theta[c] + offs for c in sorted(centres)]))
+    slaw = ls.solver_law(red, fsys, ls.contact_law(red))
+    with pytest.raises(Exception, match="no equilibrium"):
+        solve_positions(fsys, 1e-3 * torque, slaw)  # the reproducer
+    old = solve_positions(fsys, 1e-3 * torque, slaw, maxit=1000)
+    geo = ls._postprocess(red, fsys, old, 1e-3 * torque, slaw.name).output_error
+    every = np.concatenate([te.geometric, geo])
+    assert te.geometric_pp == pytest.approx(every.max() - every.min(), rel=1e-9, abs=1e-15)

@@ -132,6 +132,35 @@ def test_rv_lot_study_on_part_of_the_bundled_lot():
     assert len(csv) == 4 and csv[0].startswith("reducer,disc_slot_1,disc_slot_2")
     used = {c for row in csv[1:] for c in row.split(",")[1:3] + row.split(",")[4:7]}
     assert used == {f"D-{k:04d}" for k in range(1, 7)} | {f"C-{k:04d}" for k in range(1, 10)}
+    # the report summary: the worst reducer checked against the spec, the counts with the spec
+    # they count against (the spec column was empty)
+    from gearte.report.summary import analysis_headlines
+
+    rows = analysis_headlines(res["selective_assembly"])
+    worst = rows[0]
+    assert worst.quantity.lower().startswith("worst te")
+    assert worst.spec == "≤ 15″" and worst.status in ("pass", "fail")
+    assert (worst.status == "pass") == (v["worst_te_peak_to_peak [arcsec]"] <= 15.0)
+    counts = [r for r in rows if r.quantity.startswith("Reducers in spec")]
+    assert counts and all(r.spec == "TE peak-to-peak ≤ 15″" for r in counts)
+
+
+def test_pin_grading_summary_names_the_backlash_window():
+    """The pin-grading summary rows carry the window they grade into in the spec column."""
+    from gearte.report.summary import analysis_headlines
+    from gearte.results import AnalysisResult
+
+    a = AnalysisResult(
+        name="pin_grading",
+        title="Pin grades",
+        values={
+            "backlash_window [arcmin]": [0.2, 0.6],
+            "reducers_graded": 18,
+            "reducers_without_grade": 6,
+        },
+    )
+    rows = {r.quantity: r.spec for r in analysis_headlines(a)}
+    assert rows["Reducers graded"] == "backlash 0.2′ – 0.6′"
 
 
 @pytest.mark.slow
@@ -152,3 +181,17 @@ def test_lot_shapes_are_checked(small):
     bad = dataclasses.replace(lot4, cam_phase=lot4.cam_phase[:, :2])
     with pytest.raises(Exception, match="cam_phase"):
         bad.check(design)
+
+
+@pytest.mark.parametrize("kind", ["synthetic_rv110e_lot", "synthetic_rv110e_serial"])
+def test_measured_parts_case_refuses_a_design_that_is_not_an_rv_reducer(kind):
+    """rv_lot and rv_serial share their case base (design reference, files read at
+    validation): a design case of another kind is refused naming ``reducer.case``."""
+    from gearte.errors import CaseFileError
+    from gearte.io.case_file import load_case_dict
+
+    path = case_path(kind)
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    data["reducer"]["case"] = "jiang2024_spur_pair"
+    with pytest.raises(CaseFileError, match=r"reducer\.case.*need rv_reducer"):
+        load_case_dict(data, base_dir=str(path.parent))

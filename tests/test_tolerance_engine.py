@@ -26,6 +26,7 @@ from gearte.tolerance.montecarlo import (
     process_capability,
     reduce_samples,
 )
+from gearte.tolerance.rng import standard_normals
 from gearte.tolerance.stackup import Contributor, FunctionStack, LinearStack, z_for_confidence
 from jiang2024_data import bevel_pair, spur_pair
 
@@ -195,8 +196,8 @@ def test_function_stack_linearisation_and_mc():
 # -- compiled kernel vs plain reference ---------------------------------------------------
 def test_kernel_samples_identical_to_python_loop():
     st = _mixed_stack()
-    a = kernel_samples(st, np.random.default_rng(3), 2000)
-    b = linear_stack_reference(st, np.random.default_rng(3), 2000)
+    a = kernel_samples(st, 3, 2000)
+    b = linear_stack_reference(st, 3, 2000)
     np.testing.assert_array_equal(a, b)
 
 
@@ -204,9 +205,9 @@ def test_kernel_reduction_equals_numpy_twin():
     st = _mixed_stack()
     n = 5000
     r = monte_carlo(st, n, seed=9, chunk_size=n, nbins=50, lower_spec=20.0, upper_spec=40.0)
-    from gearte.execution import spawn_generators
+    from gearte.execution import spawn_seeds
 
-    y = linear_stack_reference(st, spawn_generators(9, 1)[0], n)
+    y = linear_stack_reference(st, spawn_seeds(9, 1)[0], n)
     lo, hi = st.mean - 8 * st.sd, st.mean + 8 * st.sd
     twin = reduce_samples(
         y, shift=st.mean, lo=lo, hi=hi, nbins=50, lsl=20.0, usl=40.0, keep=100_000
@@ -238,8 +239,8 @@ def test_rayleigh_phase_normal_identity_in_kernel():
     b = monte_carlo(_polar(st), 400_000, seed=3)
     assert abs(a.mean - b.mean) < 4 * math.hypot(a.std_error, b.std_error)
     assert a.sd == pytest.approx(b.sd, rel=0.01)
-    xa = kernel_samples(st, np.random.default_rng(0), 100_000)
-    xb = kernel_samples(_polar(st), np.random.default_rng(1), 100_000)
+    xa = kernel_samples(st, 0, 100_000)
+    xb = kernel_samples(_polar(st), 1, 100_000)
     assert stats.ks_2samp(xa, xb).pvalue > 1e-3
 
 
@@ -365,8 +366,8 @@ def test_kernel_draws_one_normal_per_sample_for_the_gaussian_group():
     st = spur_pair().backlash_stack()
     codes, params, sens, _ = st.kernel_arrays()
     assert set(codes.tolist()) <= {0, 3}
-    y = kernel_samples(st, np.random.default_rng(11), 10_000)
-    z = np.random.default_rng(11).standard_normal(10_000)
+    y = kernel_samples(st, 11, 10_000)
+    z = standard_normals(11, 10_000)
     np.testing.assert_allclose(y, st.mean + st.sd * z, rtol=0, atol=1e-12 * st.sd)
 
 
@@ -374,6 +375,6 @@ def test_grouped_normal_draw_matches_per_contributor_numpy_draws():
     """The grouped kernel draw and the numpy engine's contributor-by-contributor draws give the
     same distribution for a mixed stack (two-sample KS, 200 000 samples each)."""
     st = _mixed_stack()
-    a = kernel_samples(st, np.random.default_rng(21), 200_000)
+    a = kernel_samples(st, 21, 200_000)
     b = st.sample(np.random.default_rng(22), 200_000)
     assert stats.ks_2samp(a, b).pvalue > 1e-3

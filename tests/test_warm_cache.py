@@ -1,6 +1,8 @@
 """`gearte warm-cache` (issue 12): the warm-up cases cover every study kind that has a bundled
-case, each named case exists and is of its kind, and bad input is refused cleanly. (The warm-up
-itself compiles for minutes; benchmarks/bench_compile.py measures it.)"""
+case, each named case exists and is of its kind, the parallel chains hold each warm-up case
+once, and bad input is refused cleanly. (The warm-up itself compiles for a minute;
+benchmarks/bench_compile.py measures it and checks with --coverage that no bundled case
+compiles anything after it.)"""
 
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ from click.testing import CliRunner
 
 from gearte.cases import list_cases
 from gearte.cli import main
-from gearte.warm import WARM_CASES
+from gearte.warm import BENCH_CASES, WARM_CASES, WARM_CHAINS, _chains
 
 
 def _kind_of(path) -> str:
@@ -25,6 +27,19 @@ def test_warm_cases_cover_every_kind_with_a_bundled_case():
         for c in cases:
             assert c in bundled, f"{kind}: {c} is not a bundled case"
             assert _kind_of(bundled[c]) == kind
+
+
+def test_warm_chains_hold_every_warm_up_case_once_and_bench_cases_one_per_kind():
+    chained = [c for chain in WARM_CHAINS for c in chain]
+    assert sorted(chained) == sorted(c for cases in WARM_CASES.values() for c in cases)
+    assert len(set(chained)) == len(chained)
+    bundled = list_cases()
+    assert set(BENCH_CASES) == set(WARM_CASES)
+    for kind, case in BENCH_CASES.items():
+        assert _kind_of(bundled[case]) == kind
+    # a kind filter keeps only that kind's cases, in chain order
+    assert _chains(["rv_serial"]) == [[("rv_serial", "synthetic_rv110e_serial")]]
+    assert _chains(["gear_chain", "rv_lot"]) == []
 
 
 def test_warm_cache_refuses_an_unknown_kind():

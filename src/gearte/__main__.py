@@ -1,3 +1,3 @@
-from gearte.cli import main
+from gearte.cli import entry
 
-main()
+entry()

@@ -2,10 +2,19 @@
 
 numba caches compiled kernels on disk (``__pycache__`` beside the sources, or ``NUMBA_CACHE_DIR``)
 keyed by the source file's path and modification time, so the first ``gearte run`` of each kind
-after an install compiles for seconds to tens of seconds. :func:`warm_cache` runs one bundled
-case per kind (the group of kernels that kind uses: the cases are chosen so that their analyses
-call every kernel of the kind) with a small sample count and no outputs, and reports the seconds
-of each; ``gearte warm-cache`` prints them as they finish and ``make demo`` calls it.
+after an install compiles for seconds to tens of seconds. :func:`warm_cache` runs bundled cases
+(:data:`WARM_CASES`: per kind, the cases whose analyses together call every kernel of the kind)
+with a small sample count and no outputs, and reports the seconds of each; ``gearte warm-cache``
+prints them as they finish and ``make demo`` calls it.
+
+Only cases that compile something are run: a case whose kernels another warm-up case already
+compiled (same kernels, same argument types) is left out, and so are kinds without kernels of
+their own (``gear_chain``: its stages are drives of the other kinds). ``benchmarks/bench_compile.py
+--coverage`` checks that after the warm-up no bundled case compiles anything.
+
+In parallel (:func:`warm_cache_parallel`) the cases run in :data:`WARM_CHAINS`: cases that share
+kernels run one after the other in the same process (the later ones load what the first one
+compiled), chains that share none run side by side, longest first.
 
 Later runs load the kernels from the cache (a fraction of a second per kind). Editing a source
 file invalidates its kernels only.
@@ -15,24 +24,80 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator, Sequence
+from typing import Any
 
-__all__ = ["WARM_CASES", "warm_cache", "warm_cache_parallel"]
+__all__ = ["WARM_CASES", "WARM_CHAINS", "BENCH_CASES", "warm_cache", "warm_cache_parallel"]
 
 WARM_CASES: dict[str, tuple[str, ...]] = {
-    "cycloid_stage": ("hu2020_rv80e_initial", "hu2020_rv80e_yield"),
-    "gear_pair": ("jiang2024_spur_pair", "jiang2024_bevel_pair"),
-    "gear_chain": ("jiang2024_shoulder_swing",),
-    "planetary": ("wang2013_2kh_eq9", "wang2013_2kh_eq9_yield"),
-    "rv_reducer": ("hu2020_rv80e_initial_reducer", "li2023_rv", "han2023_rv110e_yield"),
-    "rv_bench": ("synthetic_rv_bench",),
-    "rv_lot": ("synthetic_rv110e_lot",),
+    "cycloid_stage": ("hu2020_rv80e_initial",),
+    "gear_pair": ("jiang2024_spur_pair",),
+    "gear_chain": (),
+    "planetary": ("wang2013_2kh_eq9",),
+    "rv_reducer": ("hu2020_rv80e_initial_reducer", "han2023_rv110e_yield"),
+    "rv_bench": (),
+    "rv_lot": (),
     "rv_serial": ("synthetic_rv110e_serial",),
 }
-_LONGEST_FIRST = ("rv_reducer", "rv_lot", "planetary", "cycloid_stage", "gear_pair")
-"""Per study kind, the bundled cases whose analyses together call every kernel of the kind."""
+"""Per study kind, the bundled cases whose analyses together call every kernel of the kind that
+no earlier warm-up case compiles (measured with ``bench_compile.py --coverage`` on 2026-11-25:
+after these, every other bundled case compiles nothing — e.g. ``rv_bench`` and ``rv_lot`` use
+the RV reducer's kernels, ``gear_chain`` those of its stages' kinds)."""
+
+WARM_CHAINS: tuple[tuple[str, ...], ...] = (
+    ("han2023_rv110e_yield",),  # the batched RV solver (solvers/rv_batch.py)
+    # RV equilibrium, dynamics, contact; then the serial's line-contact law
+    ("hu2020_rv80e_initial_reducer", "synthetic_rv110e_serial"),
+    ("wang2013_2kh_eq9",),  # trig_extremes, planetary errors and assembly
+    ("jiang2024_spur_pair", "hu2020_rv80e_initial"),  # tolerance Monte-Carlo; cycloid contact
+)
+"""The cases of :data:`WARM_CASES` in the order the parallel warm-up runs them: one chain per
+process at a time, longest first; a chain's cases share kernels."""
+
+BENCH_CASES: dict[str, str] = {
+    "cycloid_stage": "hu2020_rv80e_initial",
+    "gear_pair": "jiang2024_spur_pair",
+    "gear_chain": "robot_joint_spur_rv",
+    "planetary": "wang2013_2kh_eq9",
+    "rv_reducer": "hu2020_rv80e_initial_reducer",
+    "rv_bench": "synthetic_rv_bench",
+    "rv_lot": "synthetic_rv110e_lot",
+    "rv_serial": "synthetic_rv110e_serial",
+}
+"""One bundled case per kind: the first run of a kind that ``bench_compile.py`` measures."""
 
 WARM_SAMPLES = 256
 """Monte-Carlo sample count of the warm-up runs (enough to call every kernel once)."""
+
+
+def _check(kinds: Sequence[str] | None) -> list[str]:
+    from gearte.errors import ParameterError
+
+    names = list(WARM_CASES) if kinds is None else list(kinds)
+    for k in names:
+        if k not in WARM_CASES:
+            raise ParameterError("kinds", k, f"must be one of {sorted(WARM_CASES)}")
+    return names
+
+
+def _chains(kinds: Sequence[str] | None) -> list[list[tuple[str, str]]]:
+    """:data:`WARM_CHAINS` as (kind, case) pairs, restricted to ``kinds``; empty chains dropped."""
+    names = set(_check(kinds))
+    kind_of = {c: k for k, cases in WARM_CASES.items() for c in cases}
+    out = []
+    for chain in WARM_CHAINS:
+        sel = [(kind_of[c], c) for c in chain if kind_of[c] in names]
+        if sel:
+            out.append(sel)
+    return out
+
+
+def _run_one(case: str) -> tuple[float, float]:
+    """Run one warm-up case in this process: (wall [s], CPU [s])."""
+    from gearte.studies import RunOptions, run_case
+
+    w, c = time.perf_counter(), time.process_time()
+    run_case(case, RunOptions(progress=False, samples=WARM_SAMPLES, workers=1))
+    return time.perf_counter() - w, time.process_time() - c
 
 
 def warm_cache(
@@ -40,7 +105,8 @@ def warm_cache(
     *,
     report: Callable[[str, str, float], None] | None = None,
 ) -> Iterator[tuple[str, str, float]]:
-    """Run the warm-up cases of ``kinds`` (default: all of :data:`WARM_CASES`), one by one.
+    """Run the warm-up cases of ``kinds`` (default: all of :data:`WARM_CASES`), one by one in
+    this process.
 
     Parameters
     ----------
@@ -55,62 +121,69 @@ def warm_cache(
     (kind, case, seconds)
         Wall seconds of each warm-up run [s] (compile + the small run).
     """
-    from gearte.studies import RunOptions, run_case
-
-    names = _check(kinds)
-    opts = RunOptions(progress=False, samples=WARM_SAMPLES, workers=1)
-    for k in names:
-        for case in WARM_CASES[k]:
+    for chain in _chains(kinds):
+        for k, case in chain:
             if report is not None:
                 report(k, case, -1.0)
-            t0 = time.perf_counter()
-            run_case(case, opts)
-            dt = time.perf_counter() - t0
+            dt, _ = _run_one(case)
             if report is not None:
                 report(k, case, dt)
             yield k, case, dt
 
 
-def _check(kinds: Sequence[str] | None) -> list[str]:
-    from gearte.errors import ParameterError
-
-    names = list(WARM_CASES) if kinds is None else list(kinds)
-    for k in names:
-        if k not in WARM_CASES:
-            raise ParameterError("kinds", k, f"must be one of {sorted(WARM_CASES)}")
-    return names
+_QUEUE: Any = None
 
 
-def _warm_kind(kind: str) -> list[tuple[str, float, float]]:
-    """Warm one kind in this process: (case, wall [s], CPU [s]) per case."""
-    from gearte.studies import RunOptions, run_case
+def _init_worker(queue: Any) -> None:
+    global _QUEUE
+    _QUEUE = queue
 
-    out = []
-    for case in WARM_CASES[kind]:
-        w, c = time.perf_counter(), time.process_time()
-        run_case(case, RunOptions(progress=False, samples=WARM_SAMPLES, workers=1))
-        out.append((case, time.perf_counter() - w, time.process_time() - c))
-    return out
+
+def _warm_chain(chain: list[tuple[str, str]]) -> None:
+    """Worker: run a chain's cases in order, reporting each through the queue."""
+    for kind, case in chain:
+        wall, cpu = _run_one(case)
+        _QUEUE.put((kind, case, wall, cpu))
 
 
 def warm_cache_parallel(
     kinds: Sequence[str] | None = None, processes: int = 2
-) -> Iterator[tuple[str, list[tuple[str, float, float]]]]:
-    """Warm ``kinds`` in ``processes`` worker processes (numba's cache files are written
-    atomically, so processes may share the cache), longest kinds first.
+) -> Iterator[tuple[str, str, float, float]]:
+    """Warm ``kinds`` in ``processes`` worker processes, one chain of :data:`WARM_CHAINS` per
+    process at a time (numba writes its cache files atomically, so processes may share the
+    cache).
 
     Yields
     ------
-    (kind, [(case, wall [s], CPU [s]), ...])
-        As each kind finishes.
+    (kind, case, wall [s], CPU [s])
+        As each case finishes.
     """
     import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    import queue as queue_mod
+    from concurrent.futures import ProcessPoolExecutor
 
-    names = _check(kinds)
-    names.sort(key=lambda k: _LONGEST_FIRST.index(k) if k in _LONGEST_FIRST else 99)
+    chains = _chains(kinds)
+    if not chains:
+        return
     ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=max(1, int(processes)), mp_context=ctx) as pool:
-        futures = {pool.submit(_warm_kind, k): k for k in names}
-        for f in as_completed(futures):
-            yield futures[f], f.result()
+    events = ctx.Queue()
+    n = max(1, min(int(processes), len(chains)))
+    with ProcessPoolExecutor(
+        max_workers=n, mp_context=ctx, initializer=_init_worker, initargs=(events,)
+    ) as pool:
+        futures = [pool.submit(_warm_chain, ch) for ch in chains]
+        left = sum(len(ch) for ch in chains)
+        while left:
+            try:
+                ev = events.get(timeout=0.2)
+            except queue_mod.Empty:
+                ev = None
+            if ev is None:
+                for f in futures:
+                    if f.done() and f.exception() is not None:
+                        f.result()  # raises the worker's error here
+                continue
+            left -= 1
+            yield ev
+        for f in futures:
+            f.result()

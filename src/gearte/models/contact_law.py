@@ -50,9 +50,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike
 
-from gearte.errors import ConvergenceError, ParameterError
+from gearte.errors import ParameterError
+from gearte.solvers.contact import log_law_force
 
 __all__ = [
     "LAWS",
@@ -70,6 +72,8 @@ __all__ = [
     "force_from_coefficients",
     "secant_stiffness",
     "tangent_stiffness",
+    "line_contact_a0_scalar",
+    "max_contact_pressure_scalar",
 ]
 
 #: Names of the contact laws; the first is the default for user drives.
@@ -437,6 +441,9 @@ def force_from_coefficients(
     elastic load: the half-width is then comparable to the radii). Below δ* the inverse is found by
     a safeguarded Newton iteration on u = ln F inside the bracket (ln δ − 60, ln F*); at or beyond
     δ* the law has no inverse and ``inf`` is returned (callers report the load as out of range).
+    The iteration is the solver :func:`gearte.solvers.contact.log_law_force`, here its numpy
+    implementation (no compile for the few callers outside the compiled contact kernels, which
+    call its compiled twin pin by pin).
 
     Parameters
     ----------
@@ -456,45 +463,9 @@ def force_from_coefficients(
     ----------
     See :func:`approach`.
     """
-    d = np.asarray(delta, dtype=float)
-    d, a0, a1 = np.broadcast_arrays(d, np.asarray(a0, dtype=float), np.asarray(a1, dtype=float))
-    out = np.zeros(d.shape)
-    pos = d > 0
-    if not np.any(pos):
-        return out
-    dd, b0, b1 = d[pos], a0[pos], a1[pos]
-    u_star = b0 / b1 - 1.0
-    beyond = dd >= b1 * np.exp(u_star)
-    res = np.full(dd.shape, np.inf)
-    ok = ~beyond
-    if np.any(ok):
-        dd, b0, b1, hi = dd[ok], b0[ok], b1[ok], u_star[ok]
-        lo = np.log(dd) - 60.0
-        # start from the fixed point of the slowly varying log, kept inside the bracket
-        u = np.clip(np.log(dd) - np.log(np.maximum(b0 - b1 * np.log(dd / b0), b1)), lo, hi)
-        r = np.zeros_like(u)
-        for _ in range(100):
-            f = np.exp(u)
-            r = f * (b0 - b1 * u) - dd
-            lo = np.where(r < 0.0, u, lo)
-            hi = np.where(r > 0.0, u, hi)
-            dr = f * (b0 - b1 * u - b1)
-            step = np.where(dr > 0.0, r / np.where(dr > 0.0, dr, 1.0), np.inf)
-            u_new = u - step
-            bad = ~((u_new > lo) & (u_new < hi))
-            u_new = np.where(bad, 0.5 * (lo + hi), u_new)
-            if np.all(np.abs(u_new - u) <= rtol):
-                u = u_new
-                break
-            u = u_new
-        else:
-            raise ConvergenceError(
-                f"contact_law.force: Newton did not converge in 100 iterations (max residual "
-                f"{np.max(np.abs(r)):.3g} mm, tolerance {rtol:g} relative)"
-            )
-        res[ok] = np.exp(u)
-    out[pos] = res
-    return out
+    return log_law_force(
+        np.asarray(delta), np.asarray(a0), np.asarray(a1), rtol=rtol, implementation="plain"
+    )
 
 
 def force(
@@ -526,3 +497,87 @@ def force(
     """
     a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
     return force_from_coefficients(delta, a0, a1, rtol=rtol)
+
+
+# --- compiled twins (numba, one pin at a time) for the compiled tooth contact ----------------
+# The numpy functions above are the reference; tests/test_contact_compiled.py checks these
+# against them to 1e-12.
+
+
+@njit(cache=True, nogil=True)
+def _relative_radius_scalar(rho, r):  # pragma: no cover - compiled
+    """Twin of :func:`relative_radius` for one pin [mm]."""
+    curv = 1.0 / r
+    if math.isfinite(rho) and rho != 0.0:
+        curv -= 1.0 / rho
+    elif rho == 0.0:
+        return -0.0  # numpy: 1/r − inf → −inf, 1/−inf = −0
+    return 1.0 / curv if curv != 0.0 else math.inf
+
+
+@njit(cache=True, nogil=True)
+def line_contact_a0_scalar(rho, r, E_star, b, a1, rho_cap):  # pragma: no cover - compiled
+    """Coefficient a0 [mm/N] of the ``"line_contact"`` law for one pin (compiled twin).
+
+    Twin of :func:`log_law_coefficients` with ``law="line_contact"``: ``a0 = a1 (ln(16 |ρ| r) −
+    ln q − 1)``, ``q = 4 R* / (π b E*)``, |ρ| capped at ``rho_cap`` (``inf``: no cap).
+
+    Parameters
+    ----------
+    rho : float
+        Signed flank curvature radius where the pin touches [mm].
+    r : float
+        Pin radius [mm].
+    E_star : float
+        Contact modulus E* [MPa] (:func:`contact_modulus`).
+    b : float
+        Face width [mm].
+    a1 : float
+        Coefficient a1 = 2 (1 − ν²)/(π E b) [mm/N].
+    rho_cap : float
+        Upper bound of |ρ| in the logarithm [mm] (``inf`` for none).
+
+    Returns
+    -------
+    float
+        a0 [mm/N].
+
+    References
+    ----------
+    Johnson (1985) §5.6, doi:10.1017/CBO9781139171731.
+    """
+    rho_abs = min(abs(rho), rho_cap)
+    q = 4.0 * _relative_radius_scalar(rho, r) / (math.pi * b * E_star)
+    return a1 * (math.log(16.0 * rho_abs * r / q) - 1.0)  # one log: ln(16|ρ|r) − ln q
+
+
+@njit(cache=True, nogil=True)
+def max_contact_pressure_scalar(F, rho, r, E_star, b):  # pragma: no cover - compiled
+    """Hertz pressure p0 [MPa] of one pin (compiled twin of :func:`max_contact_pressure`).
+
+    Parameters
+    ----------
+    F : float
+        Contact force [N] (≤ 0 gives 0).
+    rho : float
+        Signed flank curvature radius where the pin touches [mm].
+    r : float
+        Pin radius [mm].
+    E_star : float
+        Contact modulus E* [MPa].
+    b : float
+        Face width [mm].
+
+    Returns
+    -------
+    float
+        p0 = (F E* / (π b R*))^½ [MPa].
+
+    References
+    ----------
+    Johnson (1985), eq 4.45. doi:10.1017/CBO9781139171731
+    """
+    f = max(F, 0.0)
+    if f == 0.0:
+        return 0.0
+    return math.sqrt(f * E_star / (math.pi * b * _relative_radius_scalar(rho, r)))

@@ -32,20 +32,35 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike
 
-from gearte.errors import ParameterError
-from gearte.geometry.cycloid import CycloidStage
+from gearte.errors import ConvergenceError, ParameterError
+from gearte.geometry.cycloid import CycloidStage, geometry_radii
+from gearte.geometry.cycloid_kernels import pin_mesh_table
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     HU2020_HALF_WIDTH_FACTOR,
     approach,
     check_law,
+    contact_modulus,
     force_from_coefficients,
+    line_contact_a0_scalar,
     log_law_coefficients,
     max_contact_pressure,
+    max_contact_pressure_scalar,
 )
-from gearte.solvers.contact import solve_load_sharing, solve_load_sharing_plain
+from gearte.solvers.contact import (
+    _LIMIT,
+    _OK,
+    _log_force,
+    _rotation_one,
+    _solve_one,
+    check_status,
+    compliance_limit,
+    solve_load_sharing_plain,
+    solve_rotation_plain,
+)
 
 __all__ = [
     "compliance_constants",
@@ -405,11 +420,232 @@ def tooth_contact(
     theta = np.atleast_1d(np.asarray(mesh_angle, dtype=float))
     if not np.all(np.isfinite(theta)):
         raise ParameterError("mesh_angle", mesh_angle, "must be finite")
+    if implementation == "plain":
+        arrays = _tooth_contact_plain(
+            stage, torque, T_c, theta, E, mu, F_start, rtol, max_iter, clearance_model, contact_law
+        )
+        return _result(theta, arrays, T_c, stage.rho0, contact_law)
+    theta = theta.reshape(-1)
+    R_g, r_g = geometry_radii(stage.r_p, stage.r_rp, stage.dr_rp, stage.dr_p, stage.k1_definition)
+    phase, lr, clr, curvature = pin_mesh_table(
+        theta, z_p=stage.z_p, K1=stage.K1, R=R_g, r=r_g, dr_rp=stage.dr_rp, dr_p=stage.dr_p
+    )
+    if clearance_model == "envelope":
+        from gearte.geometry.cycloid import envelope_clearance
+
+        clr = np.ascontiguousarray(envelope_clearance(stage, theta), dtype=float)
+    rho = stage.rho0
+    E_star = float(contact_modulus(E, mu))
+    if contact_law == "hu2020":
+        A, B = compliance_constants(rho, stage.r, E, mu, stage.b, law="hu2020")
+        warm = F_start is None
+        F0 = float(start_force(T_c, stage.K1, stage.z_c, stage.r_p) if F_start is None else F_start)
+        if not (math.isfinite(F0) and 0.0 < F0 < compliance_limit(B)):
+            raise ParameterError(
+                "F_start",
+                F0,
+                f"start value must be finite, > 0 and below the compliance limit "
+                f"{compliance_limit(B):.4g} N",
+            )
+        F, dmax, nev, status, approach_i, force, in_mesh, pressure = _hu2020_kernel(
+            lr, clr, float(stage.r_c), A, B, F0, warm, float(T_c), float(rtol), int(max_iter),
+            curvature, float(stage.r), E_star, float(stage.b),
+        )  # fmt: skip
+        check_status(status, F, nev, rtol=rtol, T_c=T_c, B=B)
+    else:
+        cap = stage.curvature_cap
+        b0, b1 = log_law_coefficients("line_contact", rho, stage.r, E, mu, stage.b, rho_cap=cap)
+        F, dmax, nev, status, approach_i, force, in_mesh, pressure = _line_contact_kernel(
+            lr, clr, float(stage.r_c), float(T_c), max(float(rtol), 1e-13), _FORCE_RTOL,
+            int(max_iter), curvature, float(stage.r), float(E_star), float(stage.b), float(b1),
+            float(cap), float(b0),
+        )  # fmt: skip
+        bad = np.nonzero(status != _OK)[0]
+        if bad.size:
+            k = int(bad[0])
+            if status[k] == _LIMIT:
+                raise ParameterError(
+                    "torque",
+                    T_c,
+                    "[N·mm] loads a pin beyond the range of the elastic contact law (its "
+                    "approach δ(F) stops increasing); the stage is far too small for this torque",
+                )
+            raise ConvergenceError(
+                f"tooth contact (mesh position {k}): the disc rotation did not converge after "
+                f"{int(nev[k])} evaluations (tolerance {rtol:g})"
+            )
+    _check_deformation(dmax, stage, torque)
+    arrays = (phase, lr, clr, curvature, F, dmax, nev, approach_i, force, in_mesh, pressure)
+    return _result(theta, arrays, T_c, rho, contact_law)
+
+
+def _result(
+    theta: np.ndarray, arrays: tuple[np.ndarray, ...], T_c: float, rho: float, contact_law: str
+) -> ToothContact:
+    """The result from (phase, l/r_c, clearance, curvature, F_max, δ_max, evaluations, approach,
+    force, in-mesh, pressure) of either implementation."""
+    phase, lr, clr, curvature, F, dmax, nev, approach_i, force, in_mesh, pressure = arrays
+    return ToothContact(
+        mesh_angle=theta,
+        phase=phase,
+        clearance=np.where(lr > _LOADED, clr, np.nan),
+        approach=approach_i,
+        force=force,
+        in_mesh=in_mesh,
+        F_max=F,
+        delta_max=dmax,
+        n_eval=nev,
+        T_c=T_c,
+        rho=rho,
+        curvature=curvature,
+        pressure=pressure,
+        contact_law=contact_law,
+    )
+
+
+#: Arm ratio l/r_c above which a pin is on the loaded flank [-].
+_LOADED = 1e-12
+#: Relative tolerance of each pin's force inside the rotation solve [-].
+_FORCE_RTOL = 1e-12
+
+
+def _check_deformation(dmax: np.ndarray, stage: CycloidStage, torque: float) -> None:
+    if np.max(dmax) > 0.1 * stage.r:
+        raise ParameterError(
+            "torque",
+            torque,
+            f"gives a normal deformation of {np.max(dmax):.3g} mm, beyond the elastic contact "
+            f"model's range (at most 0.1 x pin radius = {0.1 * stage.r:.3g} mm)",
+        )
+
+
+@njit(cache=True, nogil=True)
+def _outputs(n, z):  # pragma: no cover - compiled
+    """F_max, δ_max, evaluations, status (n,); approach, force, in-mesh, pressure (n, z)."""
+    return (
+        np.empty(n),
+        np.empty(n),
+        np.empty(n, dtype=np.int64),
+        np.empty(n, dtype=np.int64),
+        np.empty((n, z)),
+        np.zeros((n, z)),
+        np.zeros((n, z), dtype=np.bool_),
+        np.zeros((n, z)),
+    )
+
+
+@njit(cache=True, nogil=True)
+def _hu2020_kernel(
+    lr, clr, r_c, A, B, F0, warm, T_c, rtol, max_iter, rho, r, E_star, b
+):  # pragma: no cover - compiled
+    """Eq 41–44 at every position (solver: Illinois on eq 44), then eq 37, 41 and the pressure.
+
+    Positions in order; with ``warm`` each starts from the previous one's F_max."""
+    n, z = lr.shape
+    F, dmax, nev, status, approach, force, in_mesh, pressure = _outputs(n, z)
+    cl = np.empty(z)
+    log_b = math.log(B)
+    start = F0
+    for k in range(n):
+        for i in range(z):
+            cl[i] = clr[k, i] if lr[k, i] > _LOADED else 1e300
+        f, it, st = _solve_one(lr[k], cl, T_c, r_c, A, B, start, rtol, max_iter)
+        F[k] = f
+        nev[k] = it
+        status[k] = st
+        if st != _OK:
+            dmax[k] = np.nan
+            approach[k, :] = np.nan
+            continue
+        if warm:
+            start = f
+        k_sec = 1.0 / (A * (2.0 / 3.0 + log_b - math.log(f)))  # F_max/δ_max, eq 41 [N/mm]
+        dm = f / k_sec
+        dmax[k] = dm
+        for i in range(z):
+            a = lr[k, i] * dm  # eq 37
+            approach[k, i] = a
+            if lr[k, i] > _LOADED and a > clr[k, i]:
+                fi = (a - clr[k, i]) * k_sec  # eq 41
+                force[k, i] = fi
+                in_mesh[k, i] = True
+                pressure[k, i] = max_contact_pressure_scalar(fi, rho[k, i], r, E_star, b)
+    return F, dmax, nev, status, approach, force, in_mesh, pressure
+
+
+@njit(cache=True, nogil=True)
+def _line_contact_kernel(
+    lr, clr, r_c, T_c, rtol, frtol, max_iter, rho, r, E_star, b, a1, rho_cap, b0
+):  # pragma: no cover - compiled
+    """Each pin on its own line-contact law (eq 37, 42), the disc rotation from the solver,
+    F_max of a virtual pin at φ0, forces and pressures. Positions in order, each started from
+    the previous one's rotation and pin forces."""
+    n, z = lr.shape
+    F, dmax, nev, status, approach, force, in_mesh, pressure = _outputs(n, z)
+    arm = np.zeros(z)
+    cl = np.zeros(z)
+    a0 = np.ones(z)
+    a1v = np.full(z, a1)
+    u = np.full(z, np.nan)
+    f = np.zeros(z)
+    rot = np.nan
+    u_max = np.nan
+    for k in range(n):
+        for i in range(z):
+            if lr[k, i] > _LOADED:
+                arm[i] = lr[k, i] * r_c
+                cl[i] = clr[k, i]
+                a0[i] = line_contact_a0_scalar(rho[k, i], r, E_star, b, a1, rho_cap)
+            else:
+                arm[i] = 0.0
+                cl[i] = 0.0
+        rk, it, st = _rotation_one(arm, cl, a0, a1v, T_c, rot, u, f, rtol, frtol, max_iter)
+        nev[k] = it
+        if st == _OK:
+            for i in range(z):
+                if not f[i] < math.inf:
+                    st = _LIMIT
+        status[k] = st
+        if st != _OK:
+            F[k] = np.nan
+            dmax[k] = np.nan
+            approach[k, :] = np.nan
+            continue
+        rot = rk
+        dm = r_c * rk
+        dmax[k] = dm
+        F[k], u_max = _log_force(dm, b0, a1, u_max, frtol)  # virtual pin at φ0 (l = r_c)
+        for i in range(z):
+            a = lr[k, i] * dm  # eq 37
+            approach[k, i] = a
+            if lr[k, i] > _LOADED and a > clr[k, i]:
+                force[k, i] = f[i]
+                in_mesh[k, i] = True
+                pressure[k, i] = max_contact_pressure_scalar(f[i], rho[k, i], r, E_star, b)
+    return F, dmax, nev, status, approach, force, in_mesh, pressure
+
+
+def _tooth_contact_plain(
+    stage: CycloidStage,
+    torque: float,
+    T_c: float,
+    theta: np.ndarray,
+    E: float,
+    mu: float,
+    F_start: float | None,
+    rtol: float,
+    max_iter: int,
+    clearance_model: str,
+    contact_law: str,
+) -> tuple[np.ndarray, ...]:
+    """The plain twin of the compiled tooth contact: numpy geometry (gearte.geometry.cycloid),
+    the law's numpy functions and the plain solvers; the reference the kernels are tested
+    against."""
     phase = stage.pin_phases(theta)
     K1 = stage.K1
     S = np.sqrt(1.0 + K1 * K1 - 2.0 * K1 * np.cos(phase))
     lr = np.sin(phase) / S
-    loaded = lr > 1e-12
+    loaded = lr > _LOADED
     if clearance_model == "eq32":
         clr = np.where(loaded, stage.initial_clearance(phase), np.inf)
     else:
@@ -422,8 +658,7 @@ def tooth_contact(
         A, B = compliance_constants(rho, stage.r, E, mu, stage.b, law="hu2020")
         if F_start is None:
             F_start = start_force(T_c, K1, stage.z_c, stage.r_p)
-        solve = solve_load_sharing if implementation == "numba" else solve_load_sharing_plain
-        F, nev = solve(
+        F, nev = solve_load_sharing_plain(
             lr,
             np.where(loaded, clr, 1e300),
             T_c=T_c,
@@ -437,25 +672,26 @@ def tooth_contact(
         k_sec = 1.0 / (A * (2.0 / 3.0 + math.log(B) - np.log(F)))  # F_max/δ_max, eq 41 [N/mm]
         dmax = F / k_sec
     else:
-        from gearte.models.cycloid_loaded_contact import solve_rotation
-
         cap = stage.curvature_cap
         a0, a1 = log_law_coefficients(
             "line_contact", curvature, stage.r, E, mu, stage.b, rho_cap=cap
         )
         arm = np.where(loaded, lr * stage.r_c, 0.0)
-        rot, _ = solve_rotation(arm, np.where(loaded, clr, 0.0), a0, a1, T_c, rtol=max(rtol, 1e-13))
+        rot, _ = solve_rotation_plain(
+            arm,
+            np.where(loaded, clr, 0.0),
+            a0,
+            a1,
+            T_c,
+            rtol=max(rtol, 1e-13),
+            force_rtol=_FORCE_RTOL,
+            max_iter=max_iter,
+        )
         dmax = stage.r_c * rot
         b0, b1 = log_law_coefficients("line_contact", rho, stage.r, E, mu, stage.b, rho_cap=cap)
         F = force_from_coefficients(dmax, b0, b1)
         nev = np.zeros(theta.shape, dtype=np.int64)
-    if np.max(dmax) > 0.1 * stage.r:
-        raise ParameterError(
-            "torque",
-            torque,
-            f"gives a normal deformation of {np.max(dmax):.3g} mm, beyond the elastic contact "
-            f"model's range (at most 0.1 x pin radius = {0.1 * stage.r:.3g} mm)",
-        )
+    _check_deformation(dmax, stage, torque)
     approach_i = lr * dmax[:, None]
     in_mesh = loaded & (approach_i > clr)
     if contact_law == "hu2020":
@@ -465,19 +701,4 @@ def tooth_contact(
             in_mesh, force_from_coefficients(np.where(in_mesh, approach_i - clr, 0.0), a0, a1), 0.0
         )
     pressure = max_contact_pressure(force, curvature, stage.r, E, mu, stage.b)
-    return ToothContact(
-        mesh_angle=theta,
-        phase=phase,
-        clearance=np.where(loaded, clr, np.nan),
-        approach=approach_i,
-        force=force,
-        in_mesh=in_mesh,
-        F_max=F,
-        delta_max=dmax,
-        n_eval=nev,
-        T_c=T_c,
-        rho=rho,
-        curvature=curvature,
-        pressure=pressure,
-        contact_law=contact_law,
-    )
+    return phase, lr, clr, curvature, F, dmax, nev, approach_i, force, in_mesh, pressure

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from gearte.errors import ConvergenceError, ParameterError
+from gearte.errors import ParameterError
 from gearte.geometry.cycloid import CycloidStage
 from gearte.models.contact_law import (
     DEFAULT_LAW,
@@ -36,6 +36,7 @@ from gearte.models.contact_law import (
     log_law_coefficients,
     max_contact_pressure,
 )
+from gearte.solvers.contact import solve_rotation as _solve_rotation
 
 __all__ = [
     "CycloidPinPair",
@@ -435,56 +436,7 @@ def solve_rotation(
     Li et al. (2023) eq 3–4, doi:10.3390/machines11060626; Hu et al. (2020) eq 37–44,
     doi:10.3390/app10020481.
     """
-    n = arm.shape[0]
-
-    def torque_at(rot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        delta = np.where(arm > 0.0, rot[:, None] * arm - clearance, 0.0)
-        f = force_from_coefficients(delta, a0, a1)
-        return np.sum(f * arm, axis=1), f
-
-    lo = np.zeros(n)
-    hi = np.full(n, 1e-6)
-    for _ in range(200):
-        t_hi, _ = torque_at(hi)
-        short = t_hi < torque_Nmm
-        if not np.any(short):
-            break
-        lo = np.where(short, hi, lo)
-        hi = np.where(short, hi * 2.0, hi)
-    else:  # pragma: no cover - only for absurd loads
-        raise ConvergenceError("solve_rotation: could not bracket the elastic rotation")
-    # safeguarded Newton on T(Δφ) inside the bracket (dT/dΔφ = Σ k_t,i l_i², k_t the tangent
-    # stiffness of each loaded pin); a step leaving the bracket is replaced by bisection
-    rot = 0.5 * (lo + hi)
-    for it in range(200):  # noqa: B007 - reported on failure
-        t_mid, f = torque_at(rot)
-        above = t_mid > torque_Nmm
-        hi = np.where(above, rot, hi)
-        lo = np.where(above, lo, rot)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            kt = np.where(f > 0.0, 1.0 / (a0 - a1 * np.log(np.where(f > 0.0, f, 1.0)) - a1), 0.0)
-        slope = np.sum(kt * arm * arm, axis=1)
-        step = np.where(slope > 0.0, (t_mid - torque_Nmm) / np.where(slope > 0.0, slope, 1.0), 0.0)
-        new = rot - step
-        new = np.where((slope > 0.0) & (new > lo) & (new < hi), new, 0.5 * (lo + hi))
-        done = np.abs(new - rot) <= rtol * np.abs(new)
-        rot = new
-        if np.all(done) or np.all(hi - lo <= rtol * hi):
-            break
-    else:  # pragma: no cover
-        raise ConvergenceError(
-            f"solve_rotation: Newton/bisection stopped after {it + 1} iterations "
-            f"(bracket {np.max((hi - lo) / hi):.3g} relative, tolerance {rtol:g})"
-        )
-    force = torque_at(rot)[1]
-    if not np.all(np.isfinite(force)):
-        raise ParameterError(
-            "torque",
-            torque_Nmm,
-            "[N·mm] loads a pin beyond the range of the elastic contact law (its approach δ(F) "
-            "stops increasing); the stage is far too small for this torque",
-        )
-    return rot, force
+    return _solve_rotation(arm, clearance, a0, a1, torque_Nmm, rtol=rtol)
 
 
 def loaded_contact(

@@ -37,15 +37,42 @@ def for_analysis(name: str, figs: list[Figure]) -> list[Figure]:
 
 
 def new_figure(
-    nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float] = (7.0, 4.0), **subplot_kw: Any
+    nrows: int = 1,
+    ncols: int = 1,
+    *,
+    figsize: tuple[float, float] = (7.0, 4.0),
+    margins_in: tuple[float, float, float, float] | None = None,
+    **subplot_kw: Any,
 ) -> tuple[Any, Any]:
     """A matplotlib Figure (Agg canvas, no pyplot) and its axes: ``nrows`` × ``ncols`` subplots,
-    ``figsize`` [inch]; ``subplot_kw`` passed to ``Figure.subplots``."""
+    ``figsize`` [inch]; ``subplot_kw`` passed to ``Figure.subplots``.
+
+    By default matplotlib's constrained layout places the axes (it measures every label: about
+    half of a figure's drawing time). A regular grid of like panels may give ``margins_in``
+    [inch] = (left, bottom, top, gap): the room left of each panel (tick labels and y label),
+    below it (tick labels and x label), above it (title) and to the right edge; the grid is then
+    fixed, with no measuring (for a 2 × 4 grid of panels a fifth of the drawing time)."""
     from matplotlib.figure import Figure as MplFigure
 
-    fig = MplFigure(figsize=figsize, layout="constrained")
-    axes = fig.subplots(nrows, ncols, **subplot_kw)
-    return fig, axes
+    if margins_in is None:
+        fig = MplFigure(figsize=figsize, layout="constrained")
+        return fig, fig.subplots(nrows, ncols, **subplot_kw)
+    left, bottom, top, gap = margins_in
+    w, h = figsize
+    panel_w = (w - ncols * left - gap) / ncols
+    panel_h = (h - nrows * (bottom + top)) / nrows
+    if panel_w <= 0 or panel_h <= 0:
+        raise ValueError(f"margins_in={margins_in} leave no room for panels in {figsize} inch")
+    fig = MplFigure(figsize=figsize)
+    fig.subplots_adjust(
+        left=left / w,
+        right=1.0 - gap / w,
+        bottom=bottom / h,
+        top=1.0 - top / h,
+        wspace=left / panel_w,
+        hspace=(bottom + top) / panel_h,
+    )
+    return fig, fig.subplots(nrows, ncols, **subplot_kw)
 
 
 def figures_for(result: Any) -> list[Figure]:

@@ -95,10 +95,12 @@ def te_period_figure(result: Any) -> Figure | None:
     s = a["coupled_te_amplitude_sum [arcsec]"]
     ax.axhline(s, color=PALETTE[2], ls=":", lw=1, label=f"Σ group amplitudes {s:.1f}″")
     if "assembly" in result:
-        from gearte.models.planetary_errors import coupled_te
-
         d = result["assembly"].data
-        opt = coupled_te(d["terms"], d["mags"], d["optimal"].angles)
+        opt = d.get("optimal_te")
+        if opt is None:  # a result from before the analysis kept it
+            from gearte.models.planetary_errors import coupled_te
+
+            opt = coupled_te(d["terms"], d["mags"], d["optimal"].angles)
         yo = rad_to_arcsec(opt.signal(u) * abs(opt.scale))
         ax.plot(
             u / (2 * np.pi) * per,

@@ -30,6 +30,8 @@ __all__ = [
 
 #: Resolution of the embedded PNGs (a 7-inch figure is 700 px wide, as it is shown).
 DPI = 100
+#: zlib level of the embedded PNGs (see :func:`figure_to_png_base64`).
+PNG_COMPRESS_LEVEL = 3
 
 
 @dataclass
@@ -42,6 +44,7 @@ class RenderedFigure:
     png: str  # base64
     width: int
     height: int
+    seconds: float = 0.0  # wall time of polishing and drawing it [s]
 
 
 def figure_to_png_base64(fig: Any, dpi: int = DPI) -> str:
@@ -60,19 +63,28 @@ def figure_to_png_base64(fig: Any, dpi: int = DPI) -> str:
         Base64 text of the PNG.
     """
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
+    # zlib level 3, not Pillow's 6: half the encoding time (~15 of ~30 ms for a 700 x 400 px
+    # figure) for ~18 % more bytes
+    fig.savefig(buf, format="png", dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
     return base64.b64encode(buf.getvalue()).decode("ascii")
 
 
 def _render_one(f: Any, polished: bool = False) -> RenderedFigure:
     from gearte.plotting.display import polish
 
+    t0 = time.perf_counter()
     if not polished:
         polish(f.fig)
     w, h = f.fig.get_size_inches()
     png = figure_to_png_base64(f.fig)
     return RenderedFigure(
-        f.title, f.caption, f.analysis, png, int(round(w * DPI)), int(round(h * DPI))
+        f.title,
+        f.caption,
+        f.analysis,
+        png,
+        int(round(w * DPI)),
+        int(round(h * DPI)),
+        time.perf_counter() - t0,
     )
 
 
@@ -86,7 +98,7 @@ def render_figures(
     available, forked copies of this process render shares of the figures in parallel and send
     the PNGs back (the figures are not pickled: a fork inherits them). ``timings`` (if given)
     receives ``"figures"`` (building the matplotlib figures) and ``"render"`` (drawing them to
-    PNG), in seconds [s].
+    PNG) and ``"render: slowest figure"``, in seconds [s].
     """
     from gearte.plotting import figures_for
 
@@ -98,6 +110,7 @@ def render_figures(
     if timings is not None:
         timings["figures"] = t1 - t0
         timings["render"] = t2 - t1
+        timings["render: slowest figure"] = max((f.seconds for f in out), default=0.0)
     return out
 
 

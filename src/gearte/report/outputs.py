@@ -326,7 +326,7 @@ def atomic_write_text(path: Path, text: str) -> None:
 
 
 def write_outputs(
-    result: Any, out_dir: str | os.PathLike[str], *, report: bool = True
+    result: Any, out_dir: str | os.PathLike[str], *, report: bool = True, worker: Any = None
 ) -> dict[str, Path]:
     """Write ``results.json`` (and ``report.html`` unless ``report=False``), the analyses' extra
     files and the tabular results as CSV (:func:`gearte.report.tables.csv_files`) into
@@ -335,6 +335,9 @@ def write_outputs(
     The time of each stage (``"figures"``, ``"render"``, ``"html"``, ``"csv"``) is added to
     ``result.timings`` before ``results.json`` is serialised; ``"write"`` (the file set) is added
     after, so it is in ``result.timings`` but not in ``results.json``.
+
+    ``worker``: a :class:`gearte.report.background.ReportWorker` started before the analyses;
+    it renders the report while this process writes the CSV tables (in-process where it cannot).
 
     Returns
     -------
@@ -352,8 +355,21 @@ def write_outputs(
 
     timings = result.timings
     texts: dict[str, str] = {}
-    if report:
+    sent = report and worker is not None and worker.submit(result)
+    t0 = time.perf_counter()
+    csv_texts = csv_files(result)
+    t_csv = time.perf_counter() - t0
+    got = worker.collect() if sent else None
+    if worker is not None:
+        worker.close()
+    if got is not None:
+        texts["report.html"], report_timings = got
+        timings.update(report_timings)
+    elif report:
         from gearte.report.html import render_figures, render_report
+
+        if worker is not None:  # say so: the run took the slow path
+            timings["report process failed: rendered in-process"] = 0.0
 
         figures = render_figures(result, timings)
         t0 = time.perf_counter()
@@ -365,10 +381,9 @@ def write_outputs(
             if Path(fname).name != fname or fname in keys or fname == MARKER:
                 raise ValueError(f"analysis {analysis.name!r}: bad output file name {fname!r}")
             texts[fname] = text
-    t0 = time.perf_counter()
-    for fname, text in csv_files(result).items():
+    for fname, text in csv_texts.items():
         texts.setdefault(fname, text)
-    timings["csv"] = time.perf_counter() - t0
+    timings["csv"] = t_csv
     texts = {"results.json": result.to_json(), **texts}
     # Every document exists in memory: only now touch the disk.
     t0 = time.perf_counter()

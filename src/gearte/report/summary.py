@@ -5,7 +5,8 @@
   them shows its first numeric scalars. Before/after pairs show as ``before → after``; shares by
   item show the largest item.
 * Spec checks: a boolean ``meets_<limit>`` value, and a value with its limit in the same analysis
-  (:data:`SPEC_CHECKS`), give a pass/fail row with the limit.
+  (:data:`SPEC_CHECKS`), give a pass/fail row with the limit; a count of items meeting a limit
+  (:data:`SPEC_OF`, e.g. reducers in spec) shows that limit in its spec column.
 * Trade-off warnings: an analysis that recommends a change and reports quantities before and after
   it (``X_before``/``X_after``) gets a warning when the change worsens any of them other than the
   first (the one the recommendation aims at), e.g. a compensation that cuts TE while raising the
@@ -30,6 +31,7 @@ __all__ = [
     "tradeoff_warnings",
     "HEADLINE_KEYS",
     "SPEC_CHECKS",
+    "SPEC_OF",
 ]
 
 MAX_HEADLINES = 4
@@ -100,7 +102,19 @@ SPEC_CHECKS: list[tuple[str, str, str]] = [
     ("backlash_min", "min_backlash_limit", ">="),
     ("backlash_after_shim_min", "target_min_backlash", ">="),
     ("joint_lost_motion_max", "joint_lost_motion_limit", "<="),
+    ("worst_te_peak_to_peak", "te_spec", "<="),
 ]
+
+#: Counts of items that meet a limit of the same analysis: the spec column shows that limit,
+#: ``{}`` replaced by its value (a ``[lower, upper]`` pair as a range).
+SPEC_OF: dict[str, tuple[str, str]] = {
+    "reducers_in_spec": ("te_spec", "TE peak-to-peak ≤ {}"),
+    "reducers_in_spec_random_mean": ("te_spec", "TE peak-to-peak ≤ {}"),
+    "reducers_in_spec_orientation_only": ("te_spec", "TE peak-to-peak ≤ {}"),
+    "reducers_in_spec_full_model": ("te_spec", "TE peak-to-peak ≤ {}"),
+    "reducers_graded": ("backlash_window", "backlash {}"),
+    "reducers_without_grade": ("backlash_window", "backlash {}"),
+}
 
 
 @dataclass
@@ -129,6 +143,19 @@ def _finite(v: Any) -> bool:
 
 def _text(v: Any, unit: str) -> str:
     return v if isinstance(v, str) else format_quantity(v, unit)
+
+
+def _spec_of(base: str, vals: dict[str, tuple[str, Any]]) -> str:
+    """The spec column of a count of items meeting a limit (:data:`SPEC_OF`), or ``""``."""
+    ref = SPEC_OF.get(base)
+    if ref is None or ref[0] not in vals:
+        return ""
+    unit, lim = vals[ref[0]]
+    if _finite(lim):
+        return ref[1].format(_text(lim, unit))
+    if isinstance(lim, list | tuple) and len(lim) == 2 and all(_finite(x) for x in lim):
+        return ref[1].format(f"{_text(lim[0], unit)} – {_text(lim[1], unit)}")
+    return ""
 
 
 def headlines(result: Any) -> list[HeadlineRow]:
@@ -180,7 +207,7 @@ def analysis_headlines(a: Any) -> list[HeadlineRow]:
         if base in vals:
             unit, v = vals[base]
             if _is_num(v) or isinstance(v, str):
-                add(label(base), _text(v, unit))
+                add(label(base), _text(v, unit), _spec_of(base, vals))
             continue
         if f"{base}_before" in vals and f"{base}_after" in vals:
             unit, b = vals[f"{base}_before"]
@@ -200,7 +227,7 @@ def analysis_headlines(a: Any) -> list[HeadlineRow]:
     if not picked:
         for base, (unit, v) in vals.items():
             if _finite(v) and base not in ("seed", "samples"):
-                add(label(base), _text(v, unit))
+                add(label(base), _text(v, unit), _spec_of(base, vals))
                 if len(picked) >= 3:
                     break
     if not picked:  # tables only (ranked lists): their first entry is the headline

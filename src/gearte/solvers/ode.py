@@ -40,6 +40,7 @@ __all__ = [
     "ODEResult",
     "integrate",
     "rk4_stability_limit",
+    "cached_stability_limit",
     "kernels",
 ]
 
@@ -62,6 +63,10 @@ class ODESystem:
     output_python : ``g(t, y) -> float`` plain twin (optional; defaults to ``output.py_func``).
     stability_eigenvalues : eigenvalues of the linearised state matrix at its stiffest [1/s]
         (optional); used to refuse RK4 steps above the stability limit.
+    work_size : floats of the rhs's scratch array [-].
+    stability_limit : the RK4 stability limit of those eigenvalues [s] (optional): computed once
+        where the system is built (:func:`rk4_stability_limit`), so the workers of a batch do
+        not each compute it again.
     """
 
     rhs: Any
@@ -72,6 +77,7 @@ class ODESystem:
     output_python: Callable[[float, np.ndarray], float] | None = None
     stability_eigenvalues: np.ndarray | None = field(default=None, repr=False)
     work_size: int = 0
+    stability_limit: float | None = None
 
 
 @dataclass(frozen=True)
@@ -79,8 +85,13 @@ class ODEResult:
     """Result of :func:`integrate`.
 
     t [s] and output (plus the recorded states ``states``, columns = ``record_states``) on the
-    recording grid after the settling time; ``stats`` of the output after settling (min, max,
-    mean, rms, peak_to_peak, count); ``y_final``; counters and wall time [s].
+    recording grid after the settling time — the last ``output_window`` / ``record_window`` rows
+    when a window was asked for (``states_t`` [s]: the times of the states' rows); ``records``
+    the rows recorded over the whole span (more than ``t.size`` when the window dropped the
+    first ones); ``stats`` of the output after settling (min, max, mean,
+    rms, peak_to_peak, count); ``envelope`` (buckets × [min, max]) of the output over the span
+    after settling, ``envelope_t`` [s] the buckets' centres; ``y_final``; counters and wall
+    time [s].
     """
 
     method: str
@@ -92,6 +103,10 @@ class ODEResult:
     n_steps: int
     n_rhs: int
     wall_time: float
+    records: int = 0
+    states_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    envelope: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
+    envelope_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
 
     @property
     def peak_to_peak(self) -> float:
@@ -109,30 +124,31 @@ def rk4_stability_limit(eigenvalues: np.ndarray) -> float:
     R(z) = 1 + z + z²/2 + z³/6 + z⁴/24. For each λ the first crossing of |R| = 1 along the ray
     h λ is bracketed on a fine grid and refined by bisection; purely imaginary λ (|R| > 1 for
     small h, a mild instability RK4 shares with every explicit scheme) are bounded at |hλ| = 2√2.
+    All eigenvalues at once (one array per grid and bisection step).
     """
-    lam = np.asarray(eigenvalues, dtype=complex)
+    lam = np.asarray(eigenvalues, dtype=complex).ravel()
     lam = lam[np.abs(lam) > 0]
     if lam.size == 0:
         return np.inf
-    limits = []
-    for lm in lam:
-        s = np.linspace(1e-6, 3.5, 3501) / abs(lm)
-        amp = _rk4_amp(s * lm)
-        bad = np.nonzero(amp > 1.0 + 1e-12)[0]
-        if bad.size == 0:
-            limits.append(3.5 / abs(lm))
-            continue
-        if bad[0] == 0:  # marginal (imaginary axis): use the imaginary-axis bound
-            limits.append(2.0 * np.sqrt(2.0) / abs(lm))
-            continue
-        lo, hi = s[bad[0] - 1], s[bad[0]]
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            if _rk4_amp(mid * lm) > 1.0 + 1e-12:
-                hi = mid
-            else:
-                lo = mid
-        limits.append(lo)
+    # |R(conj z)| = |R(z)| (real coefficients): one of each conjugate pair
+    lam = np.unique(np.where(lam.imag < 0, np.conj(lam), lam))
+    mag = np.abs(lam)
+    s = np.linspace(1e-6, 3.5, 3501)[None, :] / mag[:, None]
+    bad = _rk4_amp(s * lam[:, None]) > 1.0 + 1e-12
+    first = np.argmax(bad, axis=1)
+    rows = np.arange(lam.size)
+    lo = s[rows, np.maximum(first - 1, 0)]
+    hi = s[rows, first]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        over = _rk4_amp(mid * lam) > 1.0 + 1e-12
+        hi = np.where(over, mid, hi)
+        lo = np.where(over, lo, mid)
+    limits = np.where(
+        ~bad.any(axis=1),
+        3.5 / mag,  # never unstable on the grid
+        np.where(first == 0, 2.0 * np.sqrt(2.0) / mag, lo),  # marginal: imaginary-axis bound
+    )
     return float(np.min(limits))
 
 
@@ -152,7 +168,17 @@ def _stats_update(stats, o):
     stats[4] += o * o
 
 
-def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, rec, work_size):
+@njit(cache=True, nogil=True)
+def _env_update(env, b, o):
+    if o < env[b, 0]:
+        env[b, 0] = o
+    if o > env[b, 1]:
+        env[b, 1] = o
+
+
+def _rk4_template(
+    y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, trace, rec, work_size, env
+):
     n = y0.size
     work = np.full(work_size, np.nan)
     y = y0.copy()
@@ -164,16 +190,24 @@ def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, r
     stats = np.zeros(_STATS)
     stats[1] = np.inf
     stats[2] = -np.inf
-    nrec = 0
+    nrec = 0  # samples recorded in all; trace/rec keep their last rows (ring buffers)
+    cap_t = trace.shape[0]
+    cap = rec.shape[0]
+    n_env = env.shape[0]
+    n_out = n_steps - settle_steps + 1  # output samples after settling (envelope buckets)
     h2 = 0.5 * dt
     h6 = dt / 6.0
     if settle_steps == 0:
         o = output(t0, y, args)
         _stats_update(stats, o)
-        if rec_every > 0 and rec.shape[0] > 0:
-            rec[0, 0] = o
-            for c in range(rec_idx.size):
-                rec[0, 1 + c] = y[rec_idx[c]]
+        if n_env > 0:
+            _env_update(env, 0, o)
+        if rec_every > 0:
+            if cap_t > 0:
+                trace[0] = o
+            if cap > 0:
+                for c in range(rec_idx.size):
+                    rec[0, c] = y[rec_idx[c]]
             nrec = 1
     for s in range(n_steps):
         t = t0 + s * dt
@@ -197,12 +231,17 @@ def _rk4_template(y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, r
         if s + 1 >= settle_steps:
             o = output(t_next, y, args)
             _stats_update(stats, o)
-            if rec_every > 0 and (s + 1 - settle_steps) % rec_every == 0:
-                if nrec < rec.shape[0]:
-                    rec[nrec, 0] = o
+            j = s + 1 - settle_steps
+            if n_env > 0:
+                _env_update(env, (j * n_env) // n_out, o)
+            if rec_every > 0 and j % rec_every == 0:
+                if cap_t > 0:
+                    trace[nrec % cap_t] = o
+                if cap > 0:
+                    r = nrec % cap
                     for c in range(rec_idx.size):
-                        rec[nrec, 1 + c] = y[rec_idx[c]]
-                    nrec += 1
+                        rec[r, c] = y[rec_idx[c]]
+                nrec += 1
     return y, stats, nrec, -1
 
 
@@ -236,9 +275,12 @@ def _dopri5_template(
     t_settle,
     rec_dt,
     rec_idx,
+    trace,
     rec,
     max_steps,
     work_size,
+    env,
+    n_out,
 ):
     n = y0.size
     work = np.full(work_size, np.nan)
@@ -261,7 +303,10 @@ def _dopri5_template(
     rhs(t, y, args, k1, work)
     counters[2] += 1
     next_rec = t_settle
-    nrec = 0
+    nrec = 0  # samples on the recording grid so far; trace/rec keep their last rows
+    cap_t = trace.shape[0]
+    cap = rec.shape[0]
+    n_env = env.shape[0]
     while t < t_end:
         if counters[0] + counters[1] >= max_steps:
             return y, stats, nrec, counters, -2
@@ -313,11 +358,15 @@ def _dopri5_template(
                     tmp[i] = h00 * y[i] + h10 * h * k1[i] + h01 * yn[i] + h11 * h * k7[i]
                 o = output(next_rec, tmp, args)
                 _stats_update(stats, o)
-                if nrec < rec.shape[0]:
-                    rec[nrec, 0] = o
+                if n_env > 0:
+                    _env_update(env, min((nrec * n_env) // n_out, n_env - 1), o)
+                if cap_t > 0:
+                    trace[nrec % cap_t] = o
+                if cap > 0:
+                    r = nrec % cap
                     for c in range(rec_idx.size):
-                        rec[nrec, 1 + c] = tmp[rec_idx[c]]
-                    nrec += 1
+                        rec[r, c] = tmp[rec_idx[c]]
+                nrec += 1
                 next_rec += rec_dt
             t = t_new
             acc = 0.0
@@ -380,19 +429,27 @@ def kernels(rhs, output, key: str = ""):
 _LIMITS: dict[int, tuple[Any, float]] = {}
 
 
+def cached_stability_limit(eigenvalues: np.ndarray) -> float:
+    """:func:`rk4_stability_limit` [s] of ``eigenvalues`` [1/s], computed once per array object
+    (a model that hands back the same eigenvalue array gets its limit without recomputing)."""
+    hit = _LIMITS.get(id(eigenvalues))
+    if hit is not None and hit[0] is eigenvalues:
+        return hit[1]
+    lim = rk4_stability_limit(eigenvalues)
+    if len(_LIMITS) > 64:
+        _LIMITS.clear()
+    _LIMITS[id(eigenvalues)] = (eigenvalues, lim)
+    return lim
+
+
 def _cached_limit(system: ODESystem) -> float:
-    """RK4 stability limit of a system, computed once per eigenvalue array."""
+    """RK4 stability limit of a system: its own, or computed once per eigenvalue array."""
+    if system.stability_limit is not None:
+        return system.stability_limit
     ev = system.stability_eigenvalues
     if ev is None:
         raise ParameterError("stability_eigenvalues", None, "needed for the RK4 stability limit")
-    hit = _LIMITS.get(id(ev))
-    if hit is not None and hit[0] is ev:
-        return hit[1]
-    lim = rk4_stability_limit(ev)
-    if len(_LIMITS) > 64:
-        _LIMITS.clear()
-    _LIMITS[id(ev)] = (ev, lim)
-    return lim
+    return cached_stability_limit(ev)
 
 
 def _finish_stats(stats: np.ndarray) -> dict[str, float]:
@@ -410,6 +467,22 @@ def _finish_stats(stats: np.ndarray) -> dict[str, float]:
     }
 
 
+def _ring_order(rec: np.ndarray, nrec: int) -> np.ndarray:
+    """Copy of the rows of a ring buffer ``rec`` that received ``nrec`` rows, oldest first."""
+    cap = rec.shape[0]
+    if nrec <= cap or cap == 0:
+        return rec[: min(nrec, cap)].copy()
+    k = nrec % cap
+    return np.concatenate([rec[k:], rec[:k]])
+
+
+def _new_envelope(n_env: int) -> np.ndarray:
+    env = np.empty((n_env, 2))
+    env[:, 0] = np.inf
+    env[:, 1] = -np.inf
+    return env
+
+
 def integrate(
     system: ODESystem,
     y0: np.ndarray,
@@ -422,6 +495,9 @@ def integrate(
     t_settle: float = 0.0,
     record_dt: float | None = None,
     record_states: np.ndarray | list[int] | None = None,
+    record_window: int | None = None,
+    output_window: int | None = None,
+    envelope_points: int = 0,
     max_records: int = 2_000_000,
     max_steps: int = 50_000_000,
     args: tuple | None = None,
@@ -441,8 +517,20 @@ def integrate(
         Recording interval [s] (a multiple of dt for RK4); ``None`` records nothing.
     record_states : sequence of int, optional
         Indices of state components recorded beside the output [-].
+    record_window : int, optional
+        Most recorded rows kept [-]: the kernel writes rows into a ring buffer of this many and
+        the result holds the *last* ones (memory independent of the span). ``None`` keeps every
+        row of the span.
+    output_window : int, optional
+        The same for the recorded output alone (``t``, ``output``; one float a row, so it can
+        reach further back than the states); default ``record_window``.
+    envelope_points : int
+        Buckets [-] of the output's min/max envelope over the span after settling, updated at
+        every RK4 step (DOPRI5, scipy: every recorded sample); 0 for none. Capped at the
+        number of output samples.
     max_records : int
-        Most recorded rows allowed (memory bound; a longer record is an error).
+        Most recorded rows allowed [-] (memory bound; a longer record is an error: ask for a
+        ``record_window`` or a longer ``record_dt``).
     max_steps : int
         Most DOPRI5 steps before giving up (stiff or diverging system).
     args : tuple, optional
@@ -451,61 +539,106 @@ def integrate(
     Raises
     ------
     ParameterError
-        Bad method, step above the stability limit, inconsistent times.
+        Bad method, step above the stability limit, inconsistent times, a record longer than
+        ``max_records``.
     DivergenceError
         A non-finite state (the result is never returned).
+
+    Notes
+    -----
+    The statistics (min, max, mean, rms) come from the output at every RK4 step after settling
+    (DOPRI5, scipy: at every recording instant), whatever is recorded; so do the envelope's
+    buckets. Only the recorded rows are bounded by ``record_window``.
     """
     t0, t1 = float(t_span[0]), float(t_span[1])
     if not t1 > t0:
         raise ParameterError("t_span", t_span, "end must be after start")
     if not 0.0 <= t_settle < t1 - t0:
         raise ParameterError("t_settle", t_settle, f"must be in [0, {t1 - t0:g}) s")
+    if record_window is not None and record_window < 1:
+        raise ParameterError("record_window", record_window, "must be ≥ 1 row (or None: all)")
+    if output_window is not None and output_window < 1:
+        raise ParameterError("output_window", output_window, "must be ≥ 1 row (or None: all)")
+    out_window = record_window if output_window is None else output_window
+    if envelope_points < 0:
+        raise ParameterError("envelope_points", envelope_points, "must be ≥ 0")
     y0 = np.ascontiguousarray(y0, dtype=float)
     if not np.all(np.isfinite(y0)):
         raise ParameterError("y0", "non-finite", "initial state must be finite")
     a = system.args if args is None else args
     idx = np.asarray([] if record_states is None else record_states, dtype=np.int64)
+
+    def rows(needed: int, window: int | None) -> int:
+        cap = needed if window is None else min(needed, window)
+        if cap > max_records:
+            raise ParameterError(
+                "record_dt",
+                record_dt,
+                f"records {needed} rows over the span, more than max_records = {max_records}; "
+                "give a record_window (the last rows) or a longer recording interval",
+            )
+        return cap
+
     t_start = time.perf_counter()
     if method == "rk4":
         if dt is None or not dt > 0:
             raise ParameterError("dt", dt, "RK4 needs a step > 0 s")
-        if system.stability_eigenvalues is not None:
+        if system.stability_eigenvalues is not None or system.stability_limit is not None:
             lim = _cached_limit(system)
             if dt > lim:
+                big = (
+                    f" (largest |λ| = {np.max(np.abs(system.stability_eigenvalues)):.4g} 1/s)"
+                    if system.stability_eigenvalues is not None
+                    else ""
+                )
                 raise ParameterError(
                     "dt",
                     dt,
-                    f"above the RK4 stability limit {lim:.4g} s of this system (largest "
-                    f"|λ| = {np.max(np.abs(system.stability_eigenvalues)):.4g} 1/s); use dt ≤ "
+                    f"above the RK4 stability limit {lim:.4g} s of this system{big}; use dt ≤ "
                     f"{lim:.4g} s",
                 )
         # end exactly at t1: the step is shortened (never lengthened) to fit the span
         n_steps = max(1, int(np.ceil((t1 - t0) / dt - 1e-9)))
         dt = (t1 - t0) / n_steps
         settle_steps = int(round(t_settle / dt))
+        n_out = n_steps - settle_steps + 1
         if record_dt is None:
-            rec_every, n_rec = 0, 0
+            rec_every, n_trace, n_rec = 0, 0, 0
         else:
             rec_every = max(1, int(round(record_dt / dt)))
-            n_rec = min(max_records, (n_steps - settle_steps) // rec_every + 1)
-        rec = np.zeros((n_rec, 1 + idx.size))
+            needed = (n_steps - settle_steps) // rec_every + 1
+            n_trace = rows(needed, out_window)
+            n_rec = rows(needed, record_window) if idx.size else 0
+        trace = np.zeros(n_trace)
+        rec = np.zeros((n_rec, idx.size))
+        env = _new_envelope(min(envelope_points, n_out))
         rk4, _ = kernels(system.rhs, system.output, system.key)
         y, stats, nrec, status = rk4(
-            y0, t0, dt, n_steps, a, settle_steps, rec_every, idx, rec, system.work_size
+            y0, t0, dt, n_steps, a, settle_steps, rec_every, idx, trace, rec, system.work_size, env
         )
         if status >= 0:
             raise DivergenceError(
                 f"RK4 diverged: non-finite state at t = {t0 + status * dt:.6g} s "
                 f"(step {status} of {n_steps}, dt = {dt:.3g} s)"
             )
-        t_rec = t0 + (settle_steps + rec_every * np.arange(nrec)) * dt
+        records = int(nrec)
+
+        def times(n: int) -> np.ndarray:
+            return t0 + (settle_steps + rec_every * np.arange(max(0, nrec - n), nrec)) * dt
+
+        per = n_out / max(env.shape[0], 1)  # output samples per envelope bucket
+        env_t = t0 + (settle_steps + (np.arange(env.shape[0]) + 0.5) * per - 0.5) * dt
         n_rhs = 4 * n_steps
         steps = n_steps
     elif method == "dopri5":
         h0 = dt if dt is not None else 1e-6
         rec_dt = record_dt if record_dt is not None else (t1 - t0) / 10000
-        n_rec = 0 if record_dt is None else min(max_records, int((t1 - t0 - t_settle) / rec_dt) + 2)
-        rec = np.zeros((n_rec, 1 + idx.size))
+        n_out = int((t1 - t0 - t_settle) / rec_dt) + 1
+        n_trace = 0 if record_dt is None else rows(n_out + 1, out_window)
+        n_rec = 0 if record_dt is None or not idx.size else rows(n_out + 1, record_window)
+        trace = np.zeros(n_trace)
+        rec = np.zeros((n_rec, idx.size))
+        env = _new_envelope(min(envelope_points, n_out))
         atol_arr = np.broadcast_to(np.asarray(atol, dtype=float), y0.shape).copy()
         _, dp = kernels(system.rhs, system.output, system.key)
         y, stats, nrec, counters, status = dp(
@@ -520,15 +653,26 @@ def integrate(
             t0 + t_settle,
             rec_dt,
             idx,
+            trace,
             rec,
             max_steps,
             system.work_size,
+            env,
+            n_out,
         )
         if status == 1:
             raise DivergenceError("DOPRI5 diverged: non-finite state or error estimate")
         if status == -2:
             raise DivergenceError(f"DOPRI5 exceeded {max_steps} steps (stiff or diverging)")
-        t_rec = t0 + t_settle + rec_dt * np.arange(nrec)
+        if record_dt is None:
+            nrec = 0
+        records = int(nrec)
+
+        def times(n: int) -> np.ndarray:
+            return t0 + t_settle + rec_dt * np.arange(max(0, nrec - n), nrec)
+
+        per = n_out / max(env.shape[0], 1)
+        env_t = t0 + t_settle + ((np.arange(env.shape[0]) + 0.5) * per - 0.5) * rec_dt
         n_rhs = int(counters[2])
         steps = int(counters[0])
     elif method == "scipy":
@@ -549,9 +693,27 @@ def integrate(
         outs = np.array([out_fn(tt, sol.y[:, c]) for c, tt in enumerate(sol.t)])
         stats = np.array([outs.size, outs.min(), outs.max(), outs.sum(), np.sum(outs**2)])
         y = sol.y[:, -1]
-        rec = np.column_stack([outs] + [sol.y[i] for i in idx]) if outs.size else np.zeros((0, 1))
-        nrec = outs.size
-        t_rec = sol.t
+        n_env = min(envelope_points, outs.size)
+        env = _new_envelope(n_env)
+        if n_env:
+            b = (np.arange(outs.size) * n_env) // outs.size
+            np.minimum.at(env[:, 0], b, outs)
+            np.maximum.at(env[:, 1], b, outs)
+        per = outs.size / max(n_env, 1)
+        env_t = np.interp((np.arange(n_env) + 0.5) * per - 0.5, np.arange(outs.size), sol.t)
+        records = outs.size
+        n_trace = records if out_window is None else min(records, out_window)
+        n_rec = records if record_window is None else min(records, record_window)
+        trace = outs[records - n_trace :]
+        rec = np.zeros((n_rec, idx.size))
+        for c, i in enumerate(idx):
+            rec[:, c] = sol.y[i, records - n_rec :]
+        t_all = sol.t
+
+        def times(n: int) -> np.ndarray:
+            return t_all[t_all.size - n :] if n else t_all[:0]
+
+        nrec = records
         n_rhs = int(sol.nfev)
         steps = int(sol.t.size)
     else:
@@ -560,14 +722,25 @@ def integrate(
     st = _finish_stats(np.asarray(stats))
     if not np.all(np.isfinite(list(st.values()))):
         raise DivergenceError(f"{method}: non-finite output statistics")
+    if method == "scipy":
+        output_rows, state_rows = trace.copy(), rec.copy()
+    else:
+        output_rows, state_rows = _ring_order(trace, nrec), _ring_order(rec, nrec)
+    del rec, trace
+    if idx.size == 0:  # no states: as many empty rows as the output has
+        state_rows = np.zeros((output_rows.size, 0))
     return ODEResult(
         method=method,
-        t=t_rec[:nrec],
-        output=rec[:nrec, 0].copy(),
-        states=rec[:nrec, 1:].copy(),
+        t=times(output_rows.size),
+        output=output_rows,
+        states=state_rows,
+        states_t=times(state_rows.shape[0]),
         y_final=np.asarray(y).copy(),
         stats=st,
         n_steps=steps,
         n_rhs=n_rhs,
         wall_time=wall,
+        records=records,
+        envelope=env,
+        envelope_t=env_t,
     )

@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit
 
 from gearte.errors import ConvergenceError, ParameterError
+from gearte.solvers.dense import dot, max_abs, solve_spd_into
 
 __all__ = ["ContactLaw", "EquilibriumSolution", "solve_positions", "solve_reference"]
 
@@ -122,14 +123,19 @@ def _law_delta(f, a0, a1):
 
 @njit(cache=True, nogil=True)
 def _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q):
-    e = 0.5 * q @ (K0 @ q) - f0 @ q
-    d = Bc @ q - gc
-    for c in range(d.size):
-        if d[c] > 0.0:
-            e += 0.5 * kc[c] * d[c] * d[c]
+    """Π(q) (scalar loops: no array expressions, cheap to compile; ``docs/numba.md``)."""
+    nd = q.size
+    e = 0.0
+    for a in range(nd):
+        e += 0.5 * q[a] * dot(K0[a], q)
+    e -= dot(f0, q)
+    for c in range(gc.size):
+        d = dot(Bc[c], q) - gc[c]
+        if d > 0.0:
+            e += 0.5 * kc[c] * d * d
     for m in range(kn.size):
-        wx = Bn[m, 0] @ q + en[m, 0]
-        wy = Bn[m, 1] @ q + en[m, 1]
+        wx = dot(Bn[m, 0], q) + en[m, 0]
+        wy = dot(Bn[m, 1], q) + en[m, 1]
         rr = wx * wx + wy * wy
         e += 0.5 * CLEARANCE_RESIDUAL * kn[m] * rr
         r = np.sqrt(rr) - cn[m]
@@ -166,19 +172,31 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
 
     ``Bn, en, kn, cn``: isotropic bearings with radial clearance, energy
     ``ε k |w|²/2 + (1 − ε) k (|w| − c)₊² / 2`` with ``w = (Bn[m,0]·q + en[m,0], Bn[m,1]·q +
-    en[m,1])`` and ``ε = CLEARANCE_RESIDUAL`` (convex: squared distance to a disc).
+    en[m,1])`` and ``ε = CLEARANCE_RESIDUAL`` (convex: squared distance to a disc). The Newton
+    system is solved by Cholesky (:func:`gearte.solvers.dense.solve_spd_into`, as the batched
+    kernel of :mod:`gearte.solvers.rv_batch`); scalar loops throughout (``docs/numba.md``).
     """
     nd = q.size
     nc = gc.size
     nm = kn.size
-    reg = 1e-13 * np.max(np.abs(np.diag(K0)))
+    reg = 0.0
+    for a in range(nd):
+        reg = max(reg, abs(K0[a, a]))
+    reg *= 1e-13
     active = np.zeros(nc, dtype=np.bool_)
-    d = Bc @ q - gc
+    d = np.empty(nc)
+    H = np.empty((nd, nd))
+    L = np.empty((nd, nd))
+    grad = np.empty(nd)
+    dq = np.empty(nd)
     for c in range(nc):
+        d[c] = dot(Bc[c], q) - gc[c]
         active[c] = d[c] > 0.0
     for it in range(maxit):
-        H = K0.copy()
-        grad = K0 @ q - f0
+        for a in range(nd):
+            grad[a] = dot(K0[a], q) - f0[a]
+            for b in range(nd):
+                H[a, b] = K0[a, b]
         for c in range(nc):
             if active[c]:
                 w = kc[c] * d[c]
@@ -188,8 +206,8 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
                     for b in range(nd):
                         H[a, b] += ba * Bc[c, b]
         for m in range(nm):
-            wx = Bn[m, 0] @ q + en[m, 0]
-            wy = Bn[m, 1] @ q + en[m, 1]
+            wx = dot(Bn[m, 0], q) + en[m, 0]
+            wy = dot(Bn[m, 1], q) + en[m, 1]
             gx, gy, hxx, hyy, hxy = _bearing_terms(wx, wy, kn[m], cn[m])
             for a in range(nd):
                 bx, by = Bn[m, 0, a], Bn[m, 1, a]
@@ -200,11 +218,15 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
                     H[a, b] += ta * Bn[m, 0, b] + tb * Bn[m, 1, b]
         for a in range(nd):
             H[a, a] += reg
-        dq = -np.linalg.solve(H, grad)
+        solve_spd_into(H, grad, L, dq)
+        for a in range(nd):
+            dq[a] = -dq[a]
         # backtracking line search on the convex potential
         e0 = _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q)
         step = 1.0
-        qn = q + dq
+        qn = np.empty(nd)
+        for a in range(nd):
+            qn[a] = q[a] + dq[a]
         decreased = False
         e1 = e0
         for _ in range(60):
@@ -213,21 +235,24 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
                 decreased = True
                 break
             step *= 0.5
-            qn = q + step * dq
+            for a in range(nd):
+                qn[a] = q[a] + step * dq[a]
         if not decreased:
             # no descent left at round-off level: q is the minimiser to machine precision
             return q, it + 1, True
         stalled = e0 - e1 <= 1e-14 * abs(e0)
         q = qn
-        d = Bc @ q - gc
         same = True
         for c in range(nc):
+            d[c] = dot(Bc[c], q) - gc[c]
             a_new = d[c] > 0.0
             if a_new != active[c]:
                 same = False
             active[c] = a_new
-        small = np.max(np.abs(step * dq)) < tol
-        if small or (same and step == 1.0 and nm == 0) or (same and stalled and it > 2):
+        big = 0.0
+        for a in range(nd):
+            big = max(big, abs(step * dq[a]))
+        if big < tol or (same and step == 1.0 and nm == 0) or (same and stalled and it > 2):
             return q, it + 1, True
     return q, maxit, False
 
@@ -249,17 +274,17 @@ def _solve_position(
     for c in range(nc):
         kc[c] = kc0[c] if law == LAW_SECANT_PER_CONTACT else k[group[c]]
     total = 0
-    qtol = 1e-13 * max(1.0, np.max(np.abs(q0)))
+    qtol = 1e-13 * max(1.0, max_abs(q0))
     for _outer in range(200):
         q, its, ok = _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, qtol, maxit)
         total += its
         if not ok:
-            return q, k, kc, kc * 0.0, total, False
-        d = Bc @ q - gc
+            return q, k, kc, np.zeros(nc), total, False
         force = np.zeros(nc)
         for c in range(nc):
-            if d[c] > 0.0:
-                force[c] = kc[c] * d[c]
+            d = dot(Bc[c], q) - gc[c]
+            if d > 0.0:
+                force[c] = kc[c] * d
         if law == LAW_LINEAR:
             return q, k, kc, force, total, True
         change = 0.0
@@ -273,7 +298,7 @@ def _solve_position(
                         cm = c
                 if fmax > 0.0:
                     if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
-                        return q, k, kc, kc * 0.0, total, False  # beyond the law's range
+                        return q, k, kc, np.zeros(nc), total, False  # beyond the law's range
                     knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
                     change = max(change, abs(knew / k[g] - 1.0))
                     k[g] = knew
@@ -283,7 +308,7 @@ def _solve_position(
             for c in range(nc):
                 if force[c] > 0.0:
                     if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
-                        return q, k, kc, kc * 0.0, total, False  # beyond the law's range
+                        return q, k, kc, np.zeros(nc), total, False  # beyond the law's range
                     knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
                     change = max(change, abs(knew / kc[c] - 1.0))
                     kc[c] = knew
@@ -295,11 +320,11 @@ def _solve_position(
                 if kg > 0.0:
                     k[g] = kg
         if change < tol:
-            d = Bc @ q - gc
             for c in range(nc):
-                force[c] = kc[c] * d[c] if d[c] > 0.0 else 0.0
+                d = dot(Bc[c], q) - gc[c]
+                force[c] = kc[c] * d if d > 0.0 else 0.0
             return q, k, kc, force, total, True
-    return q, k, kc, kc * 0.0, total, False
+    return q, k, kc, np.zeros(nc), total, False
 
 
 @njit(cache=True, nogil=True)
@@ -327,10 +352,13 @@ def _solve_all(
         if not ok:
             its[p] = -1
             return Q, F, Ks, KC, its
-        Q[p] = q
-        F[p] = f
-        Ks[p] = k
-        KC[p] = kc
+        for a in range(nd):
+            Q[p, a] = q[a]
+        for c in range(nc):
+            F[p, c] = f[c]
+            KC[p, c] = kc[c]
+        for g in range(ngroups):
+            Ks[p, g] = k[g]
         its[p] = n
     return Q, F, Ks, KC, its
 

@@ -76,13 +76,43 @@ class ModalOptions(StrictModel):
 
 
 class DTEOptions(StrictModel):
-    duration_s: float = Field(0.5, gt=0, le=60, description="simulated time after settling [s]")
+    duration_s: float = Field(
+        0.5,
+        gt=0,
+        le=600,
+        description="simulated time after settling [s] (memory does not grow with it: the "
+        "recorded trace keeps its last record_points rows)",
+    )
     settle_s: float = Field(0.1, ge=0, le=10, description="settling time from static equilibrium")
     method: Literal["rk4", "dopri5", "scipy"] = Field(
         "rk4", description="Integrator: fixed-step RK4, adaptive DOPRI5, or scipy's solve_ivp."
     )
     step_fraction: float = Field(0.85, gt=0, le=1, description="RK4 step / stability limit")
-    record_dt_s: float = Field(1e-4, gt=0, le=0.1, description="recording interval [s]")
+    record_dt_s: float = Field(
+        1e-4,
+        gt=0,
+        le=0.1,
+        description="recording interval [s] of the trace, the trajectories and the spectrum "
+        "(rounded to a multiple of the RK4 step; below the step: every step); the spectrum "
+        "reaches 1/(2 record_dt_s)",
+    )
+    record_points: int = Field(
+        65536,  # gearte.runners.rv_dynamics_sim.RECORD_POINTS (not imported: numba at load)
+        ge=0,
+        le=2_000_000,
+        description="most rows of recorded states kept, the last ones: trajectories and phase "
+        "portraits cover the last record_points x record_dt_s seconds; peak-to-peak, RMS and "
+        "the DTE envelope always cover the whole span at every step. 0 keeps every row (memory "
+        "grows with duration_s)",
+    )
+    trace_points: int = Field(
+        262144,  # gearte.runners.rv_dynamics_sim.TRACE_POINTS
+        ge=0,
+        le=20_000_000,
+        description="most samples of the recorded DTE trace kept, the last ones: the spectrum "
+        "covers the last trace_points x record_dt_s seconds (resolution 1/that). 0 keeps every "
+        "sample (memory grows with duration_s)",
+    )
 
 
 class SpeedSweepOptions(StrictModel):
@@ -354,6 +384,8 @@ def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
         method=opts.method,
         dt=dt,
         record_dt=opts.record_dt_s,
+        record_points=opts.record_points or None,
+        trace_points=opts.trace_points or None,
     )
     sources = model.params.frequencies()
     freq, spec, peaks = dte_spectrum(r.t, r.dte, sources)
@@ -375,12 +407,29 @@ def _dte(case, red, model, warnings: list[str]) -> AnalysisResult:
         "rhs_evaluations": r.solver.n_rhs,
         "solver_wall_time [s]": r.solver.wall_time,
     }
-    resolution = 1.0 / opts.duration_s
+    window = r.recorded_span
+    resolution = 1.0 / window
+    values["spectrum_window [s]"] = window
+    values["spectrum_nyquist [Hz]"] = 0.5 / r.record_dt
     notes = [
         "DTE = θ_o − θ_s/i with absolute rotations, from static equilibrium; the mean (static "
         "wind-up under load) is removed before the peak-to-peak.",
         f"Spectrum resolution {resolution:.3g} Hz (Hann window); peaks labelled by the nearest "
         "harmonic of a rotation or mesh frequency, or a mesh ± rotation sideband.",
+        f"Peak-to-peak and RMS from every step over the whole span (DOPRI5, scipy: every "
+        f"recording instant); the spectrum from the DTE recorded every {r.record_dt:.3g} s "
+        + (
+            "over the whole span"
+            if r.covers_span
+            else f"over the last {window:.3g} s ({r.t.size} samples, trace_points; the DTE plot "
+            "draws the full-rate envelope of the whole span)"
+        )
+        + "; the trajectories "
+        + (
+            "over the whole span."
+            if r.states_cover_span
+            else f"over the last {r.states_span:.3g} s ({r.states_t.size} rows, record_points)."
+        ),
         "Paper 004 Fig 11: 0.78″ without errors, 17.25″ with errors (bench 22.56″/23.37″).",
     ]
     if _has_errors(red):

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from gearte.errors import ParameterError
 from gearte.io.schema import CaseBase, StrictModel
@@ -62,6 +62,34 @@ FIGURES = "gearte.plotting.gear_chain"
 _UM = Field(ge=0, le=10_000)
 
 
+def thickness_class_key(v: str | None) -> str | None:
+    """A case key's DIN 3967 class, normalised (``"25 CD"`` → ``"cd25"``); None stays None.
+
+    For a pydantic validator: a bad class is a ``ValueError`` with the reason (the location
+    names the key)."""
+    if v is None:
+        return None
+    from gearte.tolerance.din3967 import parse_thickness_class
+
+    try:
+        series, tol = parse_thickness_class(v)
+    except ParameterError as exc:
+        raise ValueError(exc.reason) from None
+    return f"{series}{tol}"
+
+
+def js_field_key(v: str | None) -> str | None:
+    """A case key's ISO 286 js field, normalised (``"JS 7"`` → ``"js7"``); None stays None."""
+    if v is None:
+        return None
+    from gearte.tolerance.iso286 import parse_js_field
+
+    try:
+        return f"js{parse_js_field(v)}"
+    except ParameterError as exc:
+        raise ValueError(f"{v!r} {exc.reason}") from None
+
+
 class _ThicknessLimits(StrictModel):
     thickness_upper_um: float = Field(
         ge=-10_000, le=10_000, description="Upper tooth-thickness deviation Ess [µm]."
@@ -80,10 +108,29 @@ class _ThicknessLimits(StrictModel):
         return self
 
 
-class SpurGearSpec(_ThicknessLimits):
-    """One spur gear: teeth, tooth-thickness deviations, radial composite tolerance."""
+class SpurGearSpec(StrictModel):
+    """One spur gear: teeth, tooth-thickness deviations (or class), radial composite tolerance."""
 
     teeth: int = Field(ge=5, le=10_000, description="Number of teeth z.")
+    thickness_upper_um: float | None = Field(
+        default=None,
+        ge=-10_000,
+        le=10_000,
+        description="Upper tooth-thickness deviation Ess [µm]. Or give tooth_thickness_allowance.",
+    )
+    thickness_lower_um: float | None = Field(
+        default=None,
+        ge=-10_000,
+        le=10_000,
+        description="Lower tooth-thickness deviation Esi [µm], <= Ess.",
+    )
+    tooth_thickness_allowance: str | None = Field(
+        default=None,
+        description="DIN 3967 tooth-thickness class instead of thickness_upper_um and "
+        "thickness_lower_um, e.g. 'cd25': allowance series a … h (upper allowance A_sne, "
+        "Table 1) and tolerance series 21 … 30 (T_sn, Table 2) at d = m·z; Ess = A_sne, "
+        "Esi = A_sne − T_sn (gearte.tolerance.din3967).",
+    )
     radial_composite_tol_um: float | None = Field(
         default=None,
         gt=0,
@@ -98,11 +145,46 @@ class SpurGearSpec(_ThicknessLimits):
         "(1997 formulas) at the pair's module and d = m·z (gearte.tolerance.iso1328).",
     )
 
+    @field_validator("tooth_thickness_allowance")
+    @classmethod
+    def _thickness_class(cls, v: str | None) -> str | None:
+        return thickness_class_key(v)
+
     @model_validator(mode="after")
     def _one_source(self) -> SpurGearSpec:
         if (self.radial_composite_tol_um is None) == (self.grade is None):
             raise ValueError("give exactly one of radial_composite_tol_um and grade")
+        raw = (self.thickness_upper_um, self.thickness_lower_um)
+        if self.tooth_thickness_allowance is not None:
+            if any(v is not None for v in raw):
+                raise ValueError(
+                    "give either tooth_thickness_allowance or thickness_upper_um and "
+                    "thickness_lower_um, not both"
+                )
+        elif None in raw:
+            raise ValueError(
+                "give thickness_upper_um and thickness_lower_um (both), or "
+                "tooth_thickness_allowance (a DIN 3967 class such as 'cd25')"
+            )
+        elif raw[1] > raw[0]:  # type: ignore[operator]
+            raise ValueError(
+                f"inverted limits: thickness_lower_um = {raw[1]} must be <= "
+                f"thickness_upper_um = {raw[0]}"
+            )
         return self
+
+    def thickness_limits_um(self, module_mm: float, field: str = "") -> tuple[float, float]:
+        """(Ess, Esi) [µm]: as given, or from the DIN 3967 class at ``d = m·z``."""
+        if self.tooth_thickness_allowance is None:
+            return float(self.thickness_upper_um), float(self.thickness_lower_um)  # type: ignore[arg-type]
+        from gearte.tolerance.din3967 import tooth_thickness_allowances
+
+        t = tooth_thickness_allowances(
+            self.tooth_thickness_allowance,
+            module_mm * self.teeth,
+            field=f"{field}tooth_thickness_allowance",
+        )
+        return t.upper_um, t.lower_um
 
     def radial_composite_um(self, module_mm: float) -> float:
         """F''i [µm]: as given, or from the grade (ISO 1328-2:1997, rounded)."""
@@ -268,8 +350,17 @@ class SpurPairSpec(_Clearance, _Distributions):
         ge=0.05, le=100, description="Module m [mm] (0.05 mm: the finest instrument gears)."
     )
     pressure_angle_deg: float = Field(default=20.0, gt=0, lt=45, description="Pressure angle α.")
-    centre_distance_tol_um: float = Field(
-        ge=0, le=10_000, description="Centre-distance limit deviation fa [µm] (±fa)."
+    centre_distance_tol_um: float | None = Field(
+        default=None,
+        ge=0,
+        le=10_000,
+        description="Centre-distance limit deviation fa [µm] (±fa). Or give "
+        "centre_distance_allowance.",
+    )
+    centre_distance_allowance: str | None = Field(
+        default=None,
+        description="ISO 286 field of the centre distance a = m(z1 + z2)/2 instead of "
+        "centre_distance_tol_um (DIN 3964), js5 … js11: fa = IT/2 (gearte.tolerance.iso286).",
     )
     runout_um: float = Field(
         gt=0, le=10_000, description="Runout S of the shaft carrying the driving gear [µm]."
@@ -286,18 +377,74 @@ class SpurPairSpec(_Clearance, _Distributions):
     driving: SpurGearSpec
     driven: SpurGearSpec
 
+    @field_validator("centre_distance_allowance")
+    @classmethod
+    def _js_field(cls, v: str | None) -> str | None:
+        return js_field_key(v)
+
+    @model_validator(mode="after")
+    def _one_centre_distance(self) -> SpurPairSpec:
+        if (self.centre_distance_tol_um is None) == (self.centre_distance_allowance is None):
+            raise ValueError(
+                "give exactly one of centre_distance_tol_um and centre_distance_allowance"
+            )
+        return self
+
     @model_validator(mode="after")
     def _grades_in_range(self) -> SpurPairSpec:
-        for g in (self.driving, self.driven):
+        for name, g in (("driving", self.driving), ("driven", self.driven)):
             g.radial_composite_um(self.module_mm)  # ParameterError naming the field if outside
+            g.thickness_limits_um(self.module_mm, field=f"{name}.")
+        self.centre_distance_fa_um()
         return self
+
+    @property
+    def centre_distance_mm(self) -> float:
+        """Standard centre distance ``a = m(z1 + z2)/2`` [mm]."""
+        return 0.5 * self.module_mm * (self.driving.teeth + self.driven.teeth)
+
+    def centre_distance_fa_um(self) -> float:
+        """fa [µm]: as given, or IT/2 of the js field at the standard centre distance."""
+        if (self.centre_distance_tol_um is None) == (self.centre_distance_allowance is None):
+            raise ValueError(
+                "give exactly one of centre_distance_tol_um and centre_distance_allowance"
+            )
+        if self.centre_distance_allowance is None:
+            return float(self.centre_distance_tol_um)  # type: ignore[arg-type]
+        from gearte.tolerance.iso286 import js_allowances_um
+
+        return js_allowances_um(
+            self.centre_distance_allowance, self.centre_distance_mm, "centre_distance_allowance"
+        )[0]
+
+    def allowance_backlash_um(self) -> dict[str, float]:
+        """Backlash limits of the tooth-thickness and centre-distance allowances alone [µm]
+        (``gearte.tolerance.din3967.pair_backlash_limits`` at the pressure angle)."""
+        from gearte.tolerance.din3967 import pair_backlash_limits
+
+        (u1, l1), (u2, l2) = (
+            self.driving.thickness_limits_um(self.module_mm),
+            self.driven.thickness_limits_um(self.module_mm),
+        )
+        fa = self.centre_distance_fa_um()
+        u1, l1, u2, l2, a_e, a_i = (float(um_to_mm(v)) for v in (u1, l1, u2, l2, fa, -fa))
+        b = pair_backlash_limits(
+            u1, l1, u2, l2, a_e, a_i, float(deg_to_rad(self.pressure_angle_deg))
+        )
+        names = ("normal_min", "normal_max", "circumferential_min", "circumferential_max")
+        return {
+            f"allowance_backlash_{n} [um]": float(mm_to_um(float(getattr(b, n)))) for n in names
+        }
 
     def build(self) -> SpurPair:
         def gear(g: SpurGearSpec) -> SpurGear:
+            upper, lower = g.thickness_limits_um(
+                self.module_mm, field="driving." if g is self.driving else "driven."
+            )
             return SpurGear(
                 g.teeth,
-                float(um_to_mm(g.thickness_upper_um)),
-                float(um_to_mm(g.thickness_lower_um)),
+                float(um_to_mm(upper)),
+                float(um_to_mm(lower)),
                 float(um_to_mm(g.radial_composite_um(self.module_mm))),
             )
 
@@ -306,7 +453,7 @@ class SpurPairSpec(_Clearance, _Distributions):
             gear(self.driven),
             self.module_mm,
             float(deg_to_rad(self.pressure_angle_deg)),
-            float(um_to_mm(self.centre_distance_tol_um)),
+            float(um_to_mm(self.centre_distance_fa_um())),
             (
                 float(um_to_mm(self.bearing_clearance_min_um)),
                 float(um_to_mm(self.bearing_clearance_max_um)),
@@ -512,6 +659,29 @@ def analyse_pair(
             f"Bevel pair through its equivalent cylindrical pair on the back cone; pitch-cone "
             f"angles {math.degrees(d1):.2f}°/{math.degrees(d2):.2f}°; output diameter = mean "
             "diameter dm of the driven gear."
+        )
+    if isinstance(spec, SpurPairSpec) and (
+        spec.centre_distance_allowance is not None
+        or spec.driving.tooth_thickness_allowance is not None
+        or spec.driven.tooth_thickness_allowance is not None
+    ):
+        classes = {
+            "driving": spec.driving.tooth_thickness_allowance,
+            "driven": spec.driven.tooth_thickness_allowance,
+            "centre_distance": spec.centre_distance_allowance,
+        }
+        values["tolerance_classes"] = {k: v for k, v in classes.items() if v is not None}
+        values["thickness_limits [um]"] = {
+            name: list(g.thickness_limits_um(spec.module_mm))
+            for name, g in (("driving", spec.driving), ("driven", spec.driven))
+        }
+        values["centre_distance_fa [um]"] = spec.centre_distance_fa_um()
+        values.update(spec.allowance_backlash_um())
+        notes.append(
+            "Tooth-thickness classes (DIN 3967 Tables 1-2 at d = m·z) and js fields (ISO 286-1, "
+            "fa = IT/2 at a = m(z1 + z2)/2) as given; allowance_backlash_* are the limits of "
+            "these allowances alone (j_t = −(A_s1 + A_s2) + 2 A_a tan α, j_n = j_t cos α), "
+            "without eccentricity, bearing clearance and run-out (docs/tolerance_grades.md)."
         )
     if not summ.meets_min_limit:
         notes.append("WARNING: the minimum backlash falls below the minimum limit backlash.")

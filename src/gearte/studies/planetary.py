@@ -596,7 +596,14 @@ def run(case: Case, options) -> StudyResult:
                     "±1 rule (eq 6, Table 3); paper_rule_assembly_te_exact: exact amplitude at "
                     "those angles with the rule's 'arbitrary' angles at their given values.",
                 ],
-                data={"optimal": optimal, "paper": paper, "terms": terms, "mags": mags},
+                data={
+                    "optimal": optimal,
+                    "paper": paper,
+                    "terms": terms,
+                    "mags": mags,
+                    # the figure draws it: computed here, not again in the report process
+                    "optimal_te": coupled_te(terms, mags, optimal.angles),
+                },
             )
         )
 

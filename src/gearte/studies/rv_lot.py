@@ -31,11 +31,12 @@ from __future__ import annotations
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from gearte.io.schema import CaseBase, StrictModel
+from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult, StudyResult
-from gearte.studies.rv_bench import ReducerRef, _resolve
+from gearte.studies._measured import MeasuredPartsCase
+from gearte.studies.rv_bench import _resolve
 
 KIND = "rv_lot"
 REFERENCES = ["han2023"]
@@ -154,23 +155,12 @@ class Analyses(StrictModel):
     )
 
 
-class Case(CaseBase):
-    _built: Any = PrivateAttr(default=None)
-    reducer: ReducerRef
+class Case(MeasuredPartsCase):
     lot: LotSection
     analyses: Analyses
 
-    @model_validator(mode="after")
-    def _measurements(self) -> Case:
-        """Read the measurement files now, so that ``gearte validate`` refuses a malformed file
-        (one line naming file, line and column) as ``run`` would; the parts are kept for run."""
-        from gearte.errors import GearteError
-
-        try:
-            self._built = build_lot(self)
-        except GearteError as exc:
-            raise ValueError(str(exc)) from None
-        return self
+    def _build(self) -> Any:
+        return build_lot(self)
 
 
 def build_lot(case: Case):
@@ -184,18 +174,9 @@ def build_lot(case: Case):
     from gearte.errors import ParameterError
     from gearte.geometry.measured import MeasuredDisc
     from gearte.io import metrology as mt
-    from gearte.io.case_file import load_case
     from gearte.runners.selective_assembly import Lot
-    from gearte.studies import rv_reducer as rv
 
-    design_case = load_case(case.reducer.case)
-    if design_case.case.kind != "rv_reducer":
-        raise ParameterError(
-            "reducer.case",
-            case.reducer.case,
-            f"is a {design_case.case.kind!r} case; need rv_reducer",
-        )
-    red = rv.build_reducer(design_case.reducer)
+    _, red = case.design()
     m, n, zc = red.cranks.count, red.discs.count, red.cycloid_teeth
     lot, f = case.lot, case.lot.files
     for name, size in (("disc_sets", n), ("crank_sets", m)):

@@ -16,7 +16,9 @@ Case file layout (units in the keys)::
                                material = "steel" | density_kg_per_m3 (derived masses)
     [reducer.first_stage]      sun_teeth, planet_teeth, planets, module_mm, pressure_angle_deg,
                                mesh_stiffness_N_per_mm and/or face_width_mm,
-                               sun_support_stiffness_N_per_mm
+                               sun_support_stiffness_N_per_mm; backlash: DIN 3967 classes
+                               sun/planet_tooth_thickness_allowance + centre_distance_allowance,
+                               or backlash_um (j_t per mesh)
     [reducer.cranks]           count, circle_radius_mm, eccentricity_mm, shaft_diameter_mm,
                                shaft_length_mm, cam_bearing = {stiffness_N_per_mm | rollers,
                                roller_length_mm, reference_load_N; radial_clearance_um},
@@ -41,7 +43,8 @@ Case file layout (units in the keys)::
     [operation]                input_speed_rpm, output_torque_Nm (dynamic analyses)
     [analyses.load_sharing]    torque_Nm, positions, compare_without_errors
     [analyses.transmission_error]  torque_Nm, positions, zero_load_fraction
-    [analyses.catalogue]       position_deg, torque_sweep, steps_per_segment, lost_motion_fraction
+    [analyses.catalogue]       position_deg, torque_sweep, steps_per_segment, lost_motion_fraction,
+                               first_stage_backlash = "additive" | "ignored"
     [analyses.compensation]    torque_Nm, objective, min_backlash_arcmin, positions, bounds_um
     [analyses.geometric_te]    reference_factor
     [analyses.tooth_contact]   torque_Nm, disc_share, mesh_positions, start_force_N,
@@ -49,7 +52,8 @@ Case file layout (units in the keys)::
     [analyses.cycloid_compensation]  target_te_change_arcmin, factors, rule
     [analyses.contact]         positions, load_sweep_Nm
     [analyses.modal]           speed_min_rpm, speed_max_rpm, resonance_margin
-    [analyses.dte]             duration_s, settle_s, method, step_fraction, record_dt_s
+    [analyses.dte]             duration_s, settle_s, method, step_fraction, record_dt_s,
+                               record_points
     [analyses.speed_sweep]     speed_min_rpm, speed_max_rpm, count, duration_s, settle_s
     [analyses.batch]           samples, duration_s, settle_s, seed, chunk_size, tolerance_scale
 """
@@ -59,7 +63,7 @@ from __future__ import annotations
 from typing import Any, Literal, get_args
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.planetary import SunPlanets
@@ -173,12 +177,237 @@ class FirstStageSection(StrictModel):
     sun_support_stiffness_N_per_mm: float = Field(
         gt=0, le=1e9, description="Radial stiffness of the sun's support [N/mm]."
     )
+    sun_tooth_thickness_allowance: str | None = Field(
+        default=None,
+        description="DIN 3967 tooth-thickness class of the sun, e.g. 'cd25' (with "
+        "planet_tooth_thickness_allowance and centre_distance_allowance): the first stage's "
+        "backlash limits are reported (analysis first_stage_backlash), its class midpoint is "
+        "added to the catalogue test's lost motion and backlash and its tolerances drawn in "
+        "the yield (first_stage_backlash = 'additive'); the reducer model's sun–planet mesh "
+        "itself has no clearance",
+    )
+    planet_tooth_thickness_allowance: str | None = Field(
+        default=None, description="DIN 3967 tooth-thickness class of the planets, e.g. 'cd25'"
+    )
+    centre_distance_allowance: str | None = Field(
+        default=None,
+        description="ISO 286 field js5 … js11 of the sun–planet centre distance m(z1 + z2)/2 "
+        "(DIN 3964), e.g. 'js6'",
+    )
+
+    backlash_um: float | list[float] | None = Field(
+        default=None,
+        description="Circumferential backlash j_t of the sun–planet meshes at the pitch circle "
+        "[um], measured or specified: one value for every mesh or one per planet (instead of "
+        "the classes); added at the output by the catalogue test and the yield",
+    )
+
+    @field_validator("backlash_um")
+    @classmethod
+    def _backlash(cls, v: float | list[float] | None) -> float | list[float] | None:
+        vals = [v] if isinstance(v, int | float) else (v or [])
+        if any(not (-1000.0 <= float(x) <= 5000.0) for x in vals):
+            raise ValueError(f"backlash_um {v} must be within [-1000, 5000] um")
+        return v
+
+    @field_validator("sun_tooth_thickness_allowance", "planet_tooth_thickness_allowance")
+    @classmethod
+    def _thickness_class(cls, v: str | None) -> str | None:
+        from gearte.studies.gear_pair import thickness_class_key
+
+        return thickness_class_key(v)
+
+    @field_validator("centre_distance_allowance")
+    @classmethod
+    def _js_field(cls, v: str | None) -> str | None:
+        from gearte.studies.gear_pair import js_field_key
+
+        return js_field_key(v)
 
     @model_validator(mode="after")
     def _mesh(self):
         if self.mesh_stiffness_N_per_mm is None and self.face_width_mm is None:
             raise ValueError("give mesh_stiffness_N_per_mm or face_width_mm (or both)")
+        keys = (
+            "sun_tooth_thickness_allowance",
+            "planet_tooth_thickness_allowance",
+            "centre_distance_allowance",
+        )
+        if 0 < sum(getattr(self, k) is not None for k in keys) < 3:
+            raise ValueError(f"{', '.join(keys)} go together (the first stage's backlash)")
+        if self.backlash_um is not None:
+            if self.sun_tooth_thickness_allowance is not None:
+                raise ValueError("give backlash_um or the tooth-thickness classes, not both")
+            if isinstance(self.backlash_um, list) and len(self.backlash_um) != self.planets:
+                raise ValueError(
+                    f"backlash_um needs one value or one per planet ({self.planets}), got "
+                    f"{len(self.backlash_um)}"
+                )
+        if self.sun_tooth_thickness_allowance is not None:
+            first_stage_backlash(self)  # a diameter outside the tables: an error naming the key
         return self
+
+
+def first_stage_backlash(fs: FirstStageSection) -> dict[str, float]:
+    """Backlash limits of the sun–planet mesh from the DIN 3967 classes and the js field.
+
+    Parameters
+    ----------
+    fs : FirstStageSection
+        The first stage with ``sun_tooth_thickness_allowance``,
+        ``planet_tooth_thickness_allowance`` and ``centre_distance_allowance``.
+
+    Returns
+    -------
+    dict
+        ``j_n``/``j_t`` minimum and maximum [µm] (``gearte.tolerance.din3967``), the allowances
+        [µm] and the sun's free angle ``j_t / r_sun`` [rad].
+    """
+    from gearte.tolerance.din3967 import pair_backlash_limits, tooth_thickness_allowances
+    from gearte.tolerance.iso286 import js_allowances_um
+
+    f = "reducer.first_stage."
+    m = fs.module_mm
+    sun = tooth_thickness_allowances(
+        fs.sun_tooth_thickness_allowance,  # type: ignore[arg-type]
+        m * fs.sun_teeth,
+        field=f + "sun_tooth_thickness_allowance",
+    )
+    planet = tooth_thickness_allowances(
+        fs.planet_tooth_thickness_allowance,  # type: ignore[arg-type]
+        m * fs.planet_teeth,
+        field=f + "planet_tooth_thickness_allowance",
+    )
+    a_e, a_i = js_allowances_um(
+        fs.centre_distance_allowance,  # type: ignore[arg-type]
+        0.5 * m * (fs.sun_teeth + fs.planet_teeth),
+        field=f + "centre_distance_allowance",
+    )
+    u1, l1, u2, l2, e, i = (
+        float(um_to_mm(v))
+        for v in (sun.upper_um, sun.lower_um, planet.upper_um, planet.lower_um, a_e, a_i)
+    )
+    b = pair_backlash_limits(u1, l1, u2, l2, e, i, float(deg_to_rad(fs.pressure_angle_deg)))
+    r_sun = 0.5 * m * fs.sun_teeth
+    out = {
+        f"{n} [um]": float(mm_to_um(float(getattr(b, n))))
+        for n in ("normal_min", "normal_max", "circumferential_min", "circumferential_max")
+    }
+    out["sun_free_angle_min [rad]"] = float(b.circumferential_min) / r_sun
+    out["sun_free_angle_max [rad]"] = float(b.circumferential_max) / r_sun
+    out["sun_allowances [um]"] = [sun.upper_um, sun.lower_um]  # type: ignore[assignment]
+    out["planet_allowances [um]"] = [planet.upper_um, planet.lower_um]  # type: ignore[assignment]
+    out["centre_distance_allowances [um]"] = [a_e, a_i]  # type: ignore[assignment]
+    return out
+
+
+def _first_stage_backlash(case: Case, red: RVReducer) -> AnalysisResult:
+    fs = case.reducer.first_stage
+    b = first_stage_backlash(fs)
+    i = float(red.ratio)
+    values: dict[str, Any] = {
+        "sun_class": fs.sun_tooth_thickness_allowance,
+        "planet_class": fs.planet_tooth_thickness_allowance,
+        "centre_distance_field": fs.centre_distance_allowance,
+        "sun_allowances [um]": b["sun_allowances [um]"],
+        "planet_allowances [um]": b["planet_allowances [um]"],
+        "centre_distance_allowances [um]": b["centre_distance_allowances [um]"],
+        "first_stage_backlash_normal_min [um]": b["normal_min [um]"],
+        "first_stage_backlash_normal_max [um]": b["normal_max [um]"],
+        "first_stage_backlash_circumferential_min [um]": b["circumferential_min [um]"],
+        "first_stage_backlash_circumferential_max [um]": b["circumferential_max [um]"],
+        "first_stage_backlash_at_output_min [arcmin]": rad_to_arcmin(
+            b["sun_free_angle_min [rad]"] / i
+        ),
+        "first_stage_backlash_at_output_max [arcmin]": rad_to_arcmin(
+            b["sun_free_angle_max [rad]"] / i
+        ),
+    }
+    return AnalysisResult(
+        name="first_stage_backlash",
+        title="First-stage backlash from the tooth-thickness classes (DIN 3967)",
+        values=values,
+        references=[],
+        notes=[
+            "Sun–planet mesh: j_t = −(A_s,sun + A_s,planet) + 2 A_a tan α, j_n = j_t cos α "
+            "(DIN 3967 Tables 1-2 at d = m·z; ISO 286 js field of a = m(z1 + z2)/2). At the "
+            "output with the input locked: the sun's free angle j_t / r_sun divided by the ratio "
+            f"i = {i:.6g}. One mesh; with several planets the sun stops at the smallest gap.",
+            "The reducer model's sun–planet mesh has no clearance; the catalogue test and the "
+            "yield add this free angle to lost motion, backlash and hysteresis loss (option "
+            "first_stage_backlash = 'additive', the default; the cranks turn together, so the "
+            "smallest gap of the planets counts), the TE leaves it out (docs/tolerance_grades.md).",
+        ],
+    )
+
+
+FirstStageLaw = Literal["additive", "ignored"]
+
+_FIRST_STAGE_LAW_DOC = (
+    "How the first stage's backlash (reducer.first_stage tooth-thickness classes or "
+    "backlash_um) enters: 'additive' — its free angle at the output, min_k j_t,k / (r_sun i), "
+    "is added to lost motion, backlash and hysteresis loss (docs/tolerance_grades.md); "
+    "'ignored' — the second stage alone. Nothing is added when the case gives neither"
+)
+
+
+def first_stage_terms(fs: FirstStageSection) -> dict[str, Any] | None:
+    """What the first stage's backlash input gives the catalogue test and the yield.
+
+    Parameters
+    ----------
+    fs : FirstStageSection
+
+    Returns
+    -------
+    dict or None
+        ``None`` without classes or ``backlash_um``; else ``given_um`` (per mesh [µm]),
+        ``nominal_um`` (deviation key → class midpoint [µm]), ``limits_um`` (family →
+        (lower, upper) class limits [µm]),
+        ``r_sun`` [mm], ``alpha`` [rad] and ``backlash_um`` (per-mesh j_t at the midpoints,
+        minimum and maximum [µm]).
+    """
+    n = fs.planets
+    alpha = float(deg_to_rad(fs.pressure_angle_deg))
+    r_sun = 0.5 * fs.module_mm * fs.sun_teeth
+    if fs.backlash_um is not None:
+        raw = fs.backlash_um
+        given = [float(x) for x in raw] if isinstance(raw, list) else [float(raw)] * n
+        return {
+            "given_um": given,
+            "nominal_um": {},
+            "limits_um": {},
+            "r_sun": r_sun,
+            "alpha": alpha,
+            "backlash_um": {"mid": given, "min": given, "max": given},
+        }
+    if fs.sun_tooth_thickness_allowance is None:
+        return None
+    bl: dict[str, Any] = first_stage_backlash(fs)
+    sun, planet = bl["sun_allowances [um]"], bl["planet_allowances [um]"]
+    a_e, a_i = bl["centre_distance_allowances [um]"]
+    limits = {  # per family: a planet's key, each planet's instance
+        "first_stage.sun_thickness": (sun[1], sun[0]),
+        "first_stage.planet_thickness": (planet[1], planet[0]),
+        "first_stage.centre_distance": (a_i, a_e),
+    }
+    nominal = {"first_stage.sun_thickness": 0.5 * (sun[0] + sun[1])}
+    for i in range(1, n + 1):
+        nominal[f"first_stage.planet_thickness.c{i}"] = 0.5 * (planet[0] + planet[1])
+        nominal[f"first_stage.centre_distance.c{i}"] = 0.5 * (a_e + a_i)
+    mid = -0.5 * (sun[0] + sun[1] + planet[0] + planet[1]) + (a_e + a_i) * np.tan(alpha)
+    return {
+        "given_um": [0.0] * n,
+        "nominal_um": nominal,
+        "limits_um": limits,
+        "r_sun": r_sun,
+        "alpha": alpha,
+        "backlash_um": {
+            "mid": [float(mid)] * n,
+            "min": [bl["circumferential_min [um]"]] * n,
+            "max": [bl["circumferential_max [um]"]] * n,
+        },
+    }
 
 
 class CranksSection(StrictModel):
@@ -510,6 +739,9 @@ class CatalogueSection(StrictModel):
         description="Lost motion "
         "between ±fraction × rated torque [-] (0.03 or 0.05 in catalogues).",
     )
+    first_stage_backlash: FirstStageLaw = Field(
+        default="additive", description=_FIRST_STAGE_LAW_DOC + " (class midpoint; limits beside)."
+    )
 
     @model_validator(mode="after")
     def _sweep(self):
@@ -611,6 +843,13 @@ class RVYieldSection(YieldSection):
     positions: int = Field(default=36, ge=2, le=3600, description="TE output positions")
     te_torque_Nm: float | None = Field(
         default=None, gt=0, le=1e6, description="torque of the loaded TE; default rated"
+    )
+    first_stage_backlash: FirstStageLaw = Field(
+        default="additive",
+        description=_FIRST_STAGE_LAW_DOC + "; with classes the tooth-thickness and "
+        "centre-distance deviations are drawn (truncated normal, 3σ = half the class width, "
+        "cut at the class limits) as tolerances first_stage.sun_thickness, "
+        "first_stage.planet_thickness, first_stage.centre_distance.",
     )
 
 
@@ -986,8 +1225,44 @@ def _te_csv(te) -> str:
     return "\n".join(rows) + "\n"
 
 
-def _catalogue(red, sec: CatalogueSection, law) -> AnalysisResult:
+def _with_first_stage(cat, free_angle: float, rated: float, fraction: float):
+    """Catalogue values with the first stage's dead zone ``free_angle`` [rad] in the loop and
+    the curve, re-read by the shared definitions (:mod:`gearte.models.rv_first_stage`)."""
+    from dataclasses import replace
+
+    from gearte.models.catalogue import hysteresis_values
+    from gearte.models.rv_catalogue import TorsionTest
+    from gearte.models.rv_first_stage import with_dead_zone
+
+    t = cat.curve.torque
+    rising = np.sign(np.diff(t, prepend=t[0]))
+    rising[rising == 0] = -1.0  # the first point: approached from above (torsion_test)
+    curve = TorsionTest(t, with_dead_zone(t, cat.curve.angle, rising, free_angle))
+    loop = TorsionTest(
+        cat.loop.torque,
+        with_dead_zone(cat.loop.torque, cat.loop.angle, cat.loop_direction, free_angle),
+    )
+    hv = hysteresis_values(
+        loop.torque,
+        loop.angle,
+        rated,
+        direction=cat.loop_direction,
+        lost_motion_fraction=fraction,
+    )
+    return replace(
+        cat,
+        torsional_rigidity=hv.torsional_rigidity,
+        lost_motion=hv.lost_motion,
+        backlash=hv.backlash,
+        hysteresis_loss=hv.hysteresis_loss,
+        curve=curve,
+        loop=loop,
+    )
+
+
+def _catalogue(red, sec: CatalogueSection, law, fs_terms=None) -> AnalysisResult:
     from gearte.models.rv_catalogue import catalogue_values
+    from gearte.models.rv_first_stage import output_free_angle
 
     cat = catalogue_values(
         red,
@@ -997,12 +1272,50 @@ def _catalogue(red, sec: CatalogueSection, law) -> AnalysisResult:
         lost_motion_fraction=sec.lost_motion_fraction,
         law=law,
     )
+    fs_values: dict[str, Any] = {"first_stage_backlash": sec.first_stage_backlash}
+    fs_notes = []
+    if fs_terms is not None and sec.first_stage_backlash == "additive":
+        r, i = fs_terms["r_sun"], float(red.ratio)
+        free = {
+            k: float(output_free_angle(um_to_mm(np.asarray(v)), r, i))
+            for k, v in fs_terms["backlash_um"].items()
+        }
+        base = cat
+        cat = _with_first_stage(
+            base, free["mid"], float(red.rated_torque), sec.lost_motion_fraction
+        )
+        fs_values["first_stage_backlash_at_output [arcmin]"] = rad_to_arcmin(free["mid"])
+        if free["min"] != free["max"]:
+            for tag in ("min", "max"):
+                c = _with_first_stage(
+                    base, free[tag], float(red.rated_torque), sec.lost_motion_fraction
+                )
+                fs_values[f"first_stage_backlash_at_output_{tag} [arcmin]"] = rad_to_arcmin(
+                    free[tag]
+                )
+                fs_values[f"lost_motion_{tag} [arcmin]"] = rad_to_arcmin(c.lost_motion)
+                fs_values[f"backlash_{tag} [arcmin]"] = rad_to_arcmin(c.backlash)
+        fs_notes.append(
+            "First-stage backlash added (first_stage_backlash = 'additive'): the output turns "
+            "freely by min_k j_t,k / (r_sun i) (the cranks turn together, the smallest sun–planet "
+            "gap stops them; gaps centred on the model's contact), a dead zone of the torsion "
+            "curve: lost motion, backlash and hysteresis loss grow by it, rigidity does not. With "
+            "tooth-thickness classes the values are at the class midpoints, _min/_max at the "
+            "limits (docs/tolerance_grades.md)."
+        )
+    elif fs_terms is None:
+        fs_notes.append(
+            "The first stage's backlash is not in these values: the case gives no first-stage "
+            "tooth-thickness classes or backlash_um (the model's sun–planet mesh has no "
+            "clearance)."
+        )
     values = {
         "torsional_rigidity [N*m/arcmin]": Nmm_per_rad_to_Nm_per_arcmin(cat.torsional_rigidity),
         "lost_motion [arcmin]": rad_to_arcmin(cat.lost_motion),
         "backlash [arcmin]": rad_to_arcmin(cat.backlash),
         "hysteresis_loss [arcmin]": rad_to_arcmin(cat.hysteresis_loss),
         "rated_torque [N*m]": None if red.rated_torque is None else Nmm_to_Nm(red.rated_torque),
+        **fs_values,
     }
     return AnalysisResult(
         name="catalogue",
@@ -1015,6 +1328,7 @@ def _catalogue(red, sec: CatalogueSection, law) -> AnalysisResult:
             "curve midpoints; backlash = θ(0+) − θ(0−).",
             "The model is frictionless: loading and unloading branches coincide outside the "
             "backlash, so hysteresis loss = backlash.",
+            *fs_notes,
         ],
         data={"catalogue": cat},
     )
@@ -1132,11 +1446,13 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
     if a.transmission_error is not None:
         out.append(_transmission_error(red, a.transmission_error, law))
     if a.catalogue is not None:
-        out.append(_catalogue(red, a.catalogue, law))
+        out.append(_catalogue(red, a.catalogue, law, first_stage_terms(case.reducer.first_stage)))
     if a.compensation is not None:
         out.append(_compensation(red, a.compensation))
     if a.yield_ is not None:
         out.append(_yield(case, red0 if red0 is not None else red, a.yield_, options))
+    if case.reducer.first_stage.sun_tooth_thickness_allowance is not None:
+        out.append(_first_stage_backlash(case, red))
     if any(getattr(a, k) is not None for k in ("geometric_te", "tooth_contact")) or (
         a.cycloid_compensation is not None
     ):
@@ -1182,6 +1498,31 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         te_torque=None if sec.te_torque_Nm is None else float(Nm_to_Nmm(sec.te_torque_Nm)),
     )
     families = rv_error_keys(red)
+    fs_terms = first_stage_terms(case.reducer.first_stage)
+    defaults: dict[str, Any] = {}
+    fs_model = None
+    if fs_terms is not None and sec.first_stage_backlash == "additive":
+        from gearte.runners.rv_first_stage_yield import (
+            FirstStageBacklashYield,
+            first_stage_error_keys,
+        )
+        from gearte.studies._yield import ToleranceEntry
+
+        model = fs_model = FirstStageBacklashYield(  # type: ignore[assignment]
+            model,
+            fs_terms["given_um"],
+            fs_terms["r_sun"],
+            float(red.ratio),
+            fs_terms["alpha"],
+            nominal_um=fs_terms["nominal_um"],
+        )
+        fs_keys = first_stage_error_keys(case.reducer.first_stage.planets)
+        families = {**families, **fs_keys}
+        for key, (lo, hi) in fs_terms["limits_um"].items():
+            # a class is a drawing limit: truncated normal, 3σ = half its width, cut there
+            defaults[key] = ToleranceEntry(
+                kind="truncated_normal", tolerance_um=0.5 * (hi - lo), nominal_um=0.5 * (lo + hi)
+            )
     units = {k: "um" for k in families} | {k: "um" for v in families.values() for k in v}
 
     def worst_case(errors):
@@ -1217,6 +1558,15 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
                 old = pins.get(f"{f}_um") or [0.0] * len(keys)
                 pins[f"{f}_um"] = [float(errors.get(k, old[i])) for i, k in enumerate(keys)]
         te_torque = sec.te_torque_Nm or case.reducer.rated_torque_Nm
+        if fs_model is not None and any(k.startswith("first_stage.") for k in errors):
+            fsd = d["reducer"]["first_stage"]
+            for k in (
+                "sun_tooth_thickness_allowance",
+                "planet_tooth_thickness_allowance",
+                "centre_distance_allowance",
+            ):
+                fsd.pop(k, None)
+            fsd["backlash_um"] = fs_model.mesh_backlash_um(errors)
         d["analyses"] = {
             "catalogue": {"lost_motion_fraction": 0.03},
             "transmission_error": {"torque_Nm": te_torque, "positions": max(8, sec.positions)},
@@ -1232,7 +1582,7 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
             return None
         return 0.5 * runout_tolerance(grade, fs.module_mm, fs.module_mm * fs.planet_teeth)
 
-    return yield_analysis(
+    res = yield_analysis(
         sec,
         model,
         units,
@@ -1240,6 +1590,18 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         options=options,
         worst_case=worst_case,
         references=["han2023", "hu2020"],
+        defaults=defaults,
         families=families,
         grade_um=grade_um,
     )
+    res.values["first_stage_backlash"] = sec.first_stage_backlash
+    if fs_terms is not None and sec.first_stage_backlash == "additive":
+        res.notes.append(
+            "First-stage backlash added to lost motion, backlash and hysteresis loss: "
+            "min_k j_t,k / (r_sun i) per sample, j_t,k = j_k − (E_sun + E_planet,k) + "
+            "2 A_a,k tan α (first_stage_backlash_at_output [arcmin]); with classes the "
+            "tooth-thickness and centre-distance deviations are drawn truncated normal within "
+            "the class limits (3σ = half the width) unless [analyses.yield.tolerances] gives "
+            "them (docs/tolerance_grades.md)."
+        )
+    return res

@@ -28,12 +28,13 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import Field, PrivateAttr, ValidationInfo, field_validator, model_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from gearte.io.schema import CaseBase, StrictModel
+from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies import rv_reducer as rv
-from gearte.studies.rv_bench import ReducerRef, _resolve
+from gearte.studies._measured import MeasuredPartsCase
+from gearte.studies.rv_bench import _resolve
 
 KIND = "rv_serial"
 REFERENCES = ["han2023", "hu2020"]
@@ -138,23 +139,12 @@ class Analyses(StrictModel):
     )
 
 
-class Case(CaseBase):
-    _built: Any = PrivateAttr(default=None)
-    reducer: ReducerRef
+class Case(MeasuredPartsCase):
     serial: SerialSection
     analyses: Analyses
 
-    @model_validator(mode="after")
-    def _measurements(self) -> Case:
-        """Read the measurement files now, so that ``gearte validate`` refuses a malformed file
-        (one line naming file, line and column) as ``run`` would; the parts are kept for run."""
-        from gearte.errors import GearteError
-
-        try:
-            self._built = build_serial(self)
-        except GearteError as exc:
-            raise ValueError(str(exc)) from None
-        return self
+    def _build(self) -> Any:
+        return build_serial(self)
 
 
 def _pick(table: dict, serials: list[str], file: str, what: str) -> list:
@@ -182,14 +172,8 @@ def build_serial(case: Case):
     from gearte.errors import ParameterError
     from gearte.geometry.measured import MeasuredDisc, apply_measurements
     from gearte.io import metrology as mt
-    from gearte.io.case_file import load_case
 
-    design = load_case(case.reducer.case)
-    if design.case.kind != "rv_reducer":
-        raise ParameterError(
-            "reducer.case", case.reducer.case, f"is a {design.case.kind!r} case; need rv_reducer"
-        )
-    red = rv.build_reducer(design.reducer)
+    design, red = case.design()
     s, f = case.serial, case.serial.files
     m, n, zc, zp = red.cranks.count, red.discs.count, red.cycloid_teeth, red.pins.count
     kw: dict = {}

@@ -2,10 +2,11 @@
 
 Every distribution knows its analytic mean and variance, its *limits* (the range a designer
 states for it: the limit deviations of a normal, the tolerance of a Rayleigh, ...) and how to
-draw samples, both vectorised (``sample(rng, n)``) and one at a time (``draw_one(rng)``). The
-scalar draw is the plain reference that the compiled Monte-Carlo kernel of
-:mod:`gearte.tolerance.montecarlo` reproduces bit for bit (same calls on the same
-``numpy.random.Generator``, in the same order).
+draw samples, both vectorised (``sample(rng, n)``) and one at a time (``draw_one(rng)``), from a
+``numpy.random.Generator``. The compiled Monte-Carlo kernel of
+:mod:`gearte.tolerance.montecarlo` draws the kernel-drawable ones from its own streams
+(:mod:`gearte.tolerance.rng`) with the same laws; its plain reference is
+:func:`gearte.tolerance.montecarlo.linear_stack_reference`.
 
 The conventions follow Jiang et al. (2024) §2.1 and the tolerance literature they cite: a
 dimension between limit deviations is normal with its mean at the middle and ``σ = range / 6``

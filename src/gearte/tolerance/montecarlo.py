@@ -1,24 +1,25 @@
 """Monte-Carlo tolerance simulation with a fixed seed and bounded memory.
 
 The sample count is split into fixed-size chunks, independent of how many workers run them;
-chunk ``k`` draws from its own ``numpy.random.Generator`` (``SeedSequence(seed).spawn``), so a
-seed gives the same statistics on any backend. Each chunk is reduced on the spot to sums,
+chunk ``k`` draws from its own child of ``SeedSequence(seed)`` (``spawn``), so a seed gives the
+same statistics on any backend and any worker count. Each chunk is reduced on the spot to sums,
 extremes, out-of-spec counts and a fixed-edge histogram, so memory does not grow with the
 sample count; percentiles come from that histogram (resolution: one bin, ``16σ/n_bins``).
 
 Linear stacks whose contributors the compiled kernel can draw (normal, uniform, Rayleigh,
 Rayleigh magnitude × uniform phase — as the exactly equivalent normal, or drawn in polar form —,
-empirical, constant) run in a numba kernel that draws from
-the chunk's Generator directly and reduces without storing samples. The independent normal
-contributors form one Gaussian group: their sum is drawn as *one* normal per sample (exact, a sum
-of independent normals is normal with the summed mean and variance); the others are drawn one
-by one. Its plain reference, :func:`linear_stack_reference`, is a per-sample Python loop making
-the same Generator calls in the same order: the two give bit-identical samples (tested), so a
-seed gives the same result on every backend. (Before issue 12 each normal contributor was drawn
-separately: the samples of a seed changed once then, the distribution did not.) Per-contributor
-values (contributions, variance shares) come from :mod:`gearte.tolerance.stackup`, not from
-these samples. Everything else (function stacks, truncated distributions) runs vectorised in
-numpy, contributor by contributor, chunk by chunk.
+empirical, constant) run in a numba kernel with its own generator
+(:mod:`gearte.tolerance.rng`: xoshiro256++ streams seeded from the chunk's seed, a ziggurat
+normal), generated and reduced block by block without storing samples. The independent normal
+contributors form one Gaussian group: their sum is drawn as *one* normal per sample (exact, a
+sum of independent normals is normal with the summed mean and variance); the others are drawn
+one by one. Its plain reference, :func:`linear_stack_reference`, is a per-sample Python loop
+drawing the same numbers in the same order: the two give bit-identical samples (tested).
+(Issue 12 changed the samples of a seed twice — once when the normals were grouped, once when
+the kernel got its own generator; the distribution did not change.) Per-contributor values
+(contributions, variance shares) come from :mod:`gearte.tolerance.stackup`, not from these
+samples. Everything else (function stacks, truncated distributions) runs vectorised in numpy
+(``numpy.random.default_rng`` of the chunk's seed), contributor by contributor, chunk by chunk.
 """
 
 from __future__ import annotations
@@ -29,10 +30,21 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import njit, uint64
 
 from gearte.errors import ParameterError
-from gearte.execution import spawn_generators
+from gearte.execution import spawn_seeds
+from gearte.tolerance.rng import (
+    Xoshiro256pp,
+    ZigguratTables,
+    next_u64,
+    reference_normal,
+    stream_states,
+    u64_to_unit,
+    zig_fast,
+    zig_slow,
+    ziggurat_tables,
+)
 from gearte.tolerance.stackup import FunctionStack, LinearStack
 
 __all__ = [
@@ -53,78 +65,122 @@ DEFAULT_BINS = 4000
 # ------------------------------------------------------------------------------------------------
 # compiled kernel
 # ------------------------------------------------------------------------------------------------
-# The draw of one contributor is written out inline (a helper function taking the Generator per
-# draw costs a factor of ~5 in numba 0.6x); samples are drawn in blocks, then reduced.
-# Codes: see distributions.KERNEL_CODES.
-_BLOCK = 2048
+# Streams (gearte.tolerance.rng): 0 main — one 64-bit number per sample for the Gaussian group's
+# normal; 1 tail — the ziggurat's rejections; 2 draws — the other contributors, in order. Each
+# sample takes exactly one main number, so the kernel draws them in blocks of _BLOCK and the
+# samples do not depend on the block size. Codes: see distributions.KERNEL_CODES.
+_BLOCK = 1024  # a multiple of 4 (the reduction runs four lanes)
 
 
-@njit(cache=True, nogil=True)
-def _normal_group(codes, params, sens):  # pragma: no cover - compiled
+def _group(codes: np.ndarray, params: np.ndarray, sens: np.ndarray) -> tuple[float, float, bool]:
     """Mean and standard deviation of the sum of the independent normal contributors (codes 0
-    and 3) with their sensitivities, and how many there are."""
+    and 3) with their sensitivities, and whether there is any."""
     gmu = 0.0
     gv = 0.0
     nn = 0
     for i in range(codes.shape[0]):
         if codes[i] == 0:
-            gmu += sens[i] * params[i, 0]
-            t = sens[i] * params[i, 1]
+            gmu += float(sens[i]) * float(params[i, 0])
+            t = float(sens[i]) * float(params[i, 1])
             gv += t * t
             nn += 1
         elif codes[i] == 3:
-            t = sens[i] * params[i, 0]
+            t = float(sens[i]) * float(params[i, 0])
             gv += t * t
             nn += 1
-    return gmu, math.sqrt(gv), nn
+    return gmu, math.sqrt(gv), nn > 0
+
+
+@njit(inline="always")
+def _draw_other(code, p0, p1, d0, d1, d2, d3, pool):  # pragma: no cover - compiled
+    """One draw of a contributor outside the Gaussian group from the draws stream."""
+    if code == 1:  # uniform
+        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+        return p0 + (p1 - p0) * u64_to_unit(r), d0, d1, d2, d3
+    if code == 2:  # rayleigh
+        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+        return p0 * math.sqrt(-2.0 * math.log1p(-u64_to_unit(r))), d0, d1, d2, d3
+    if code == 6:  # rayleigh magnitude x sin(uniform phase), drawn as magnitude and phase
+        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+        mag = p0 * math.sqrt(-2.0 * math.log1p(-u64_to_unit(r)))
+        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+        return mag * math.sin(_TWO_PI * u64_to_unit(r)), d0, d1, d2, d3
+    if code == 4:  # empirical: pool[offset + uniform integer below count] (exact rejection)
+        c = uint64(int(p1))
+        thr = (uint64(0) - c) % c
+        while True:
+            r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+            if r >= thr:
+                return pool[int(p0) + int(r % c)], d0, d1, d2, d3
+    return p0, d0, d1, d2, d3  # constant
 
 
 @njit(cache=True, nogil=True)
-def _fill(rng, out, m, codes, params, sens, const, pool):  # pragma: no cover - compiled
-    """Draw ``m`` samples of the stack into ``out[:m]``, sample by sample: one standard normal
-    for the sum of the independent normal contributors (exact: a sum of independent normals is
-    normal), then the other contributors in order (the order of
-    :func:`linear_stack_reference`)."""
-    k = codes.shape[0]
-    gmu, gsd, nn = _normal_group(codes, params, sens)
-    base = const + gmu
-    if nn == k:  # every contributor normal: one draw per sample
+def _fill_block(
+    z, m, raw, rej, st, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
+):  # pragma: no cover - compiled
+    """``z[:m]`` <- the next ``m`` samples of the stack; the stream states ``st`` advance.
+
+    Per sample: the Gaussian group's normal from one main number (ziggurat; rejections from the
+    tail stream), ``y = base + gsd·z``, then each other contributor in order from the draws
+    stream (the order of :func:`linear_stack_reference`). The ziggurat's fast path runs over the
+    whole block first and lists the ≈ 1.2 % rejected draws, which are then redrawn in sample
+    order (the tail stream is read in the same order as one sample at a time)."""
+    if group:
+        s0, s1, s2, s3 = st[0, 0], st[0, 1], st[0, 2], st[0, 3]
         for j in range(m):
-            out[j] = base + gsd * rng.standard_normal()
-        return
-    for j in range(m):
-        y = base
-        if nn > 0:
-            y += gsd * rng.standard_normal()
-        for i in range(k):
-            c = codes[i]
-            if c == 0 or c == 3:  # in the normal group
-                continue
-            elif c == 1:  # uniform
-                v = rng.uniform(params[i, 0], params[i, 1])
-            elif c == 2:  # rayleigh
-                v = rng.rayleigh(params[i, 0])
-            elif c == 6:  # rayleigh magnitude x sin(uniform phase), drawn as magnitude and phase
-                r = rng.rayleigh(params[i, 0])
-                v = r * math.sin(rng.uniform(0.0, _TWO_PI))
-            elif c == 4:  # empirical: pool[offset + integers(0, count)]
-                v = pool[int(params[i, 0]) + rng.integers(0, int(params[i, 1]))]
-            else:  # constant
-                v = params[i, 0]
-            y += sens[i] * v
-        out[j] = y
+            r, s0, s1, s2, s3 = next_u64(s0, s1, s2, s3)
+            raw[j] = r
+        st[0, 0], st[0, 1], st[0, 2], st[0, 3] = s0, s1, s2, s3
+        nr = 0
+        for j in range(m):  # fast path, branch-free: the rejected ones are listed
+            x, ok, idx, v = zig_fast(raw[j], tk, tw)
+            z[j] = x
+            rej[nr] = j
+            nr += not ok
+        t0, t1, t2, t3 = st[1, 0], st[1, 1], st[1, 2], st[1, 3]
+        for i in range(nr):
+            j = rej[i]
+            x, ok, idx, v = zig_fast(raw[j], tk, tw)
+            z[j], t0, t1, t2, t3 = zig_slow(x, idx, v, t0, t1, t2, t3, tk, tw, tf)
+        st[1, 0], st[1, 1], st[1, 2], st[1, 3] = t0, t1, t2, t3
+        for j in range(m):
+            z[j] = base + gsd * z[j]
+    else:
+        for j in range(m):
+            z[j] = base
+    if others.shape[0]:
+        d0, d1, d2, d3 = st[2, 0], st[2, 1], st[2, 2], st[2, 3]
+        for j in range(m):
+            y = z[j]
+            for i in others:
+                v, d0, d1, d2, d3 = _draw_other(
+                    codes[i], params[i, 0], params[i, 1], d0, d1, d2, d3, pool
+                )
+                y += sens[i] * v
+            z[j] = y
+        st[2, 0], st[2, 1], st[2, 2], st[2, 3] = d0, d1, d2, d3
 
 
 @njit(cache=True, nogil=True)
 def _linear_stack_kernel(
-    rng, n, codes, params, sens, const, pool, shift, lo, hi, nbins, lsl, usl, keep
-):  # pragma: no cover - compiled
+    states, n, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool,
+    shift, lo, hi, nbins, lsl, usl, keep,
+):  # pragma: no cover - compiled  # fmt: skip
+    """Draw ``n`` samples block by block and reduce each block on the spot: sums of
+    ``y − shift`` and of its square (four lanes), extremes, spec counts, histogram; the first
+    ``keep`` samples kept. No sample array beyond one block."""
+    st = states.copy()
     counts = np.zeros(nbins + 2, np.int64)
     kept = np.empty(min(keep, n))
-    buf = np.empty(_BLOCK)
+    z = np.empty(_BLOCK)
+    raw = np.empty(_BLOCK, np.uint64)
+    rej = np.empty(_BLOCK, np.int64)
+    bins = np.empty(_BLOCK, np.int64)
     inv_width = nbins / (hi - lo)
-    s1 = 0.0
-    s2 = 0.0
+    top = float(nbins)
+    a0 = a1 = a2 = a3 = 0.0
+    b0 = b1 = b2 = b3 = 0.0
     mn = np.inf
     mx = -np.inf
     below = 0
@@ -132,94 +188,174 @@ def _linear_stack_kernel(
     done = 0
     while done < n:
         m = min(_BLOCK, n - done)
-        _fill(rng, buf, m, codes, params, sens, const, pool)
+        _fill_block(
+            z, m, raw, rej, st, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
+        )
+        for j in range(min(m, keep - done)):
+            kept[done + j] = z[j]
+        for j in range(0, m - 3, 4):  # four lanes: independent adds the CPU overlaps
+            d0 = z[j] - shift
+            d1 = z[j + 1] - shift
+            d2 = z[j + 2] - shift
+            d3 = z[j + 3] - shift
+            a0 += d0
+            a1 += d1
+            a2 += d2
+            a3 += d3
+            b0 += d0 * d0
+            b1 += d1 * d1
+            b2 += d2 * d2
+            b3 += d3 * d3
+        for j in range(m - m % 4, m):
+            d0 = z[j] - shift
+            a0 += d0
+            b0 += d0 * d0
         for j in range(m):
-            y = buf[j]
-            if done + j < keep:
-                kept[done + j] = y
-            d = y - shift
-            s1 += d
-            s2 += d * d
-            mn = min(mn, y)
-            mx = max(mx, y)
-            if y < lsl:
-                below += 1
-            if y > usl:
-                above += 1
-            b = math.floor((y - lo) * inv_width)
-            if b < 0:
-                counts[0] += 1
-            elif b >= nbins:
-                counts[nbins + 1] += 1
-            else:
-                counts[b + 1] += 1
+            y = z[j]
+            mn = y if y < mn else mn
+            mx = y if y > mx else mx
+            below += y < lsl
+            above += y > usl
+            t = min(max((y - lo) * inv_width, -1.0), top)
+            bins[j] = int(math.floor(t)) + 1  # 0 underflow, nbins + 1 overflow
+        for j in range(m):
+            counts[bins[j]] += 1
         done += m
+    s1 = (a0 + a1) + (a2 + a3)
+    s2 = (b0 + b1) + (b2 + b3)
     return s1, s2, mn, mx, below, above, counts, kept
 
 
 @njit(cache=True, nogil=True)
-def _linear_stack_samples(rng, n, codes, params, sens, const, pool):  # pragma: no cover
+def _linear_stack_samples(
+    states, n, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
+):  # pragma: no cover - compiled
+    st = states.copy()
     out = np.empty(n)
-    _fill(rng, out, n, codes, params, sens, const, pool)
+    raw = np.empty(_BLOCK, np.uint64)
+    rej = np.empty(_BLOCK, np.int64)
+    done = 0
+    while done < n:
+        m = min(_BLOCK, n - done)
+        _fill_block(
+            out[done:],
+            m,
+            raw,
+            rej,
+            st,
+            tk,
+            tw,
+            tf,
+            group,
+            base,
+            gsd,
+            others,
+            params,
+            codes,
+            sens,
+            pool,
+        )
+        done += m
     return out
 
 
-def linear_stack_reference(stack: LinearStack, rng: np.random.Generator, n: int) -> np.ndarray:
+@dataclass(frozen=True)
+class _KernelInput:
+    """What the kernel needs of a stack, computed once in the caller (and shipped to workers
+    with the ziggurat tables, so every worker draws with the same tables)."""
+
+    group: bool
+    base: float
+    gsd: float
+    others: np.ndarray
+    params: np.ndarray
+    codes: np.ndarray
+    sens: np.ndarray
+    pool: np.ndarray
+    tables: ZigguratTables
+
+    @classmethod
+    def of(cls, stack: LinearStack) -> _KernelInput | None:
+        arrays = stack.kernel_arrays()
+        if arrays is None:
+            return None
+        codes, params, sens, pool = arrays
+        gmu, gsd, group = _group(codes, params, sens)
+        others = np.array([i for i in range(codes.size) if codes[i] not in (0, 3)], np.int64)
+        return cls(
+            group, stack.constant + gmu, gsd, others, params, codes, sens, pool, ziggurat_tables()
+        )
+
+    def args(self) -> tuple:
+        t = self.tables
+        return (
+            t.k, t.w, t.f, self.group, self.base, self.gsd,
+            self.others, self.params, self.codes, self.sens, self.pool,
+        )  # fmt: skip
+
+
+def _draw_other_ref(code: int, p: np.ndarray, d: Xoshiro256pp, pool: np.ndarray) -> float:
+    """Plain twin of ``_draw_other``."""
+    if code == 1:
+        return float(p[0]) + (float(p[1]) - float(p[0])) * d.unit()
+    if code == 2:
+        return float(p[0]) * math.sqrt(-2.0 * math.log1p(-d.unit()))
+    if code == 6:
+        mag = float(p[0]) * math.sqrt(-2.0 * math.log1p(-d.unit()))
+        return mag * math.sin(_TWO_PI * d.unit())
+    if code == 4:
+        c = int(p[1])
+        thr = ((1 << 64) - c) % c
+        while True:
+            r = d.next()
+            if r >= thr:
+                return float(pool[int(p[0]) + r % c])
+    return float(p[0])
+
+
+def linear_stack_reference(
+    stack: LinearStack, seed: int | np.random.SeedSequence, n: int
+) -> np.ndarray:
     """Plain per-sample Python loop: the basic reference of the compiled kernel.
 
-    ``n`` samples [the stack's unit] of ``stack`` drawn from ``rng``.
+    ``n`` samples [the stack's unit] of ``stack`` drawn from the chunk streams of ``seed``
+    (:func:`gearte.tolerance.rng.stream_states`).
 
-    Makes the same Generator calls in the same order as the kernel — per sample one standard
-    normal for the sum of the independent normal contributors (mean ``Σ s_i μ_i``, standard
-    deviation ``sqrt(Σ (s_i σ_i)²)``), then each other contributor in order — so its samples
-    are identical to the kernel's for the same Generator state. A stack the kernel cannot draw
-    is drawn contributor by contributor.
+    Per sample: one standard normal for the sum of the independent normal contributors (mean
+    ``Σ s_i μ_i``, standard deviation ``sqrt(Σ (s_i σ_i)²)``) from one number of the main
+    stream (:func:`gearte.tolerance.rng.reference_normal`), then each other contributor in
+    order from the draws stream — the kernel's numbers, so its samples are identical to the
+    kernel's. A stack the kernel cannot draw is drawn contributor by contributor from
+    ``numpy.random.default_rng(seed)``.
     """
     out = np.empty(n)
-    contributors = stack.contributors
-    arrays = stack.kernel_arrays()
-    if arrays is None:
+    ki = _KernelInput.of(stack)
+    if ki is None:
+        rng = np.random.default_rng(seed)
         for j in range(n):
             y = stack.constant
-            for c in contributors:
+            for c in stack.contributors:
                 y += c.sensitivity * c.distribution.draw_one(rng)
             out[j] = y
         return out
-    codes, params, sens, _ = arrays
-    gmu = 0.0
-    gv = 0.0
-    others = []
-    for i, c in enumerate(contributors):
-        if codes[i] == 0:
-            gmu += float(sens[i]) * float(params[i, 0])
-            t = float(sens[i]) * float(params[i, 1])
-            gv += t * t
-        elif codes[i] == 3:
-            t = float(sens[i]) * float(params[i, 0])
-            gv += t * t
-        else:
-            others.append((float(sens[i]), c.distribution))
-    gsd = math.sqrt(gv)
-    grouped = len(others) < len(contributors)
-    base = stack.constant + gmu
+    main, tail, draws = (Xoshiro256pp(row) for row in stream_states(seed))
     for j in range(n):
-        y = base
-        if grouped:
-            y += gsd * rng.standard_normal()
-        for si, d in others:
-            y += si * d.draw_one(rng)
+        y = ki.base
+        if ki.group:
+            y = ki.base + ki.gsd * reference_normal(main, tail, ki.tables)
+        for i in ki.others:
+            y += float(ki.sens[i]) * _draw_other_ref(int(ki.codes[i]), ki.params[i], draws, ki.pool)
         out[j] = y
     return out
 
 
-def kernel_samples(stack: LinearStack, rng: np.random.Generator, n: int) -> np.ndarray:
+def kernel_samples(stack: LinearStack, seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
     """``n`` samples [the stack's unit] of a linear ``stack`` drawn by the compiled kernel from
-    ``rng`` (for tests and plots)."""
-    arrays = stack.kernel_arrays()
-    if arrays is None:
+    the chunk streams of ``seed`` (for tests and plots)."""
+    ki = _KernelInput.of(stack)
+    if ki is None:
         raise ParameterError("stack", stack.name, "has contributors the kernel cannot draw")
-    codes, params, sens, pool = arrays
-    return _linear_stack_samples(rng, int(n), codes, params, sens, stack.constant, pool)
+    return _linear_stack_samples(stream_states(seed), int(n), *ki.args())
 
 
 # ------------------------------------------------------------------------------------------------
@@ -386,7 +522,7 @@ def _map_chunks(func, tasks: Sequence[Any], *, options: Any, progress: bool, des
 
 @dataclass(frozen=True)
 class _Task:
-    rng: np.random.Generator
+    seed: np.random.SeedSequence
     n: int
     keep: int
 
@@ -394,39 +530,26 @@ class _Task:
 class _ChunkRunner:
     """Picklable per-chunk function (kernel or numpy path)."""
 
-    def __init__(self, stack, arrays, shift, lo, hi, nbins, lsl, usl, sub_chunk):
+    def __init__(self, stack, kernel, shift, lo, hi, nbins, lsl, usl, sub_chunk):
         self.stack = stack
-        self.arrays = arrays
+        self.kernel = kernel
         self.shift, self.lo, self.hi, self.nbins = shift, lo, hi, nbins
         self.lsl, self.usl = lsl, usl
         self.sub_chunk = sub_chunk
 
     def __call__(self, task: _Task) -> ChunkStats:
         kw = dict(shift=self.shift, lo=self.lo, hi=self.hi, nbins=self.nbins)
-        if self.arrays is not None:
-            codes, params, sens, pool = self.arrays
-            out = _linear_stack_kernel(
-                task.rng,
-                task.n,
-                codes,
-                params,
-                sens,
-                self.stack.constant,
-                pool,
-                self.shift,
-                self.lo,
-                self.hi,
-                self.nbins,
-                self.lsl,
-                self.usl,
-                task.keep,
-            )
+        if self.kernel is not None:
+            reduction = (self.shift, self.lo, self.hi, self.nbins, self.lsl, self.usl, task.keep)
+            args = (stream_states(task.seed), task.n, *self.kernel.args(), *reduction)
+            out = _linear_stack_kernel(*args)
             return ChunkStats(task.n, *out)
+        rng = np.random.default_rng(task.seed)
         acc: ChunkStats | None = None
         done = 0
         while done < task.n:
             m = min(self.sub_chunk, task.n - done)
-            y = self.stack.sample(task.rng, m)
+            y = self.stack.sample(rng, m)
             keep = max(0, task.keep - done)
             part = reduce_samples(y, lsl=self.lsl, usl=self.usl, keep=keep, **kw)
             acc = part if acc is None else acc.merge(part, task.keep)
@@ -489,11 +612,11 @@ def monte_carlo(
         raise ParameterError(
             "spec_limits", (lower_spec, upper_spec), "inverted: upper spec must be >= lower spec"
         )
-    arrays = stack.kernel_arrays() if isinstance(stack, LinearStack) else None
-    if engine == "numba" and arrays is None:
+    kernel = _KernelInput.of(stack) if isinstance(stack, LinearStack) else None
+    if engine == "numba" and kernel is None:
         raise ParameterError("engine", engine, "the stack has contributors the kernel cannot draw")
     if engine == "numpy":
-        arrays = None
+        kernel = None
 
     if isinstance(stack, LinearStack):
         centre, spread = stack.mean, stack.sd
@@ -507,14 +630,14 @@ def monte_carlo(
     usl = math.inf if upper_spec is None else float(upper_spec)
 
     n_chunks = math.ceil(n / chunk_size)
-    rngs = spawn_generators(seed, n_chunks)
+    seeds = spawn_seeds(seed, n_chunks)
     tasks = []
     remaining_keep = keep
     for k in range(n_chunks):
         m = min(chunk_size, n - k * chunk_size)
-        tasks.append(_Task(rngs[k], m, max(0, min(remaining_keep, m))))
+        tasks.append(_Task(seeds[k], m, max(0, min(remaining_keep, m))))
         remaining_keep -= m
-    runner = _ChunkRunner(stack, arrays, centre, lo, hi, nbins, lsl, usl, min(chunk_size, 250_000))
+    runner = _ChunkRunner(stack, kernel, centre, lo, hi, nbins, lsl, usl, min(chunk_size, 250_000))
     parts = _map_chunks(
         runner, tasks, options=options, progress=progress, description=f"Monte-Carlo {stack.name}"
     )
@@ -548,5 +671,5 @@ def monte_carlo(
         samples=total.kept,
         seed=seed,
         chunk_size=chunk_size,
-        engine="numba" if arrays is not None else "numpy",
+        engine="numba" if kernel is not None else "numpy",
     )

@@ -384,11 +384,11 @@ class SpecLimit:
 def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
     """Wilson score interval of a binomial proportion ``k/n`` (Wilson 1927); ``confidence``
     [-] its two-sided level."""
-    from scipy.stats import norm
+    from statistics import NormalDist  # not scipy.stats: a ~1 s import
 
     if n <= 0:
         raise ParameterError("n", n, "needs >= 1 trial")
-    z = float(norm.isf((1.0 - confidence) / 2.0))
+    z = -NormalDist().inv_cdf((1.0 - confidence) / 2.0)
     p = k / n
     den = 1.0 + z * z / n
     centre = (p + z * z / (2 * n)) / den

@@ -138,6 +138,7 @@ class RVDynamicModel:
         self.body_names = names
         self.dof_names = [f"{b}.{c}" for b in names for c in ("x", "y", "theta")]
         self._lu_cache: dict = {}
+        self._eig_cache: dict = {}
         self._beta_r = 0.0
         self._beta_r = stiffness_proportional_damping(self)
 
@@ -542,8 +543,17 @@ class RVDynamicModel:
         return self._beta_r
 
     def damped_eigenvalues(self, t: float = 0.0, *, mesh: str = "max") -> np.ndarray:
-        """Eigenvalues [1/s] of the first-order state matrix (:func:`.modal.damped_eigenvalues`)."""
-        return damped_eigenvalues(self, t, mesh=mesh)
+        """Eigenvalues [1/s] of the first-order state matrix (:func:`.modal.damped_eigenvalues`).
+
+        Computed once per (t, mesh) and handed back as the same read-only array (K and the
+        damping do not depend on the errors, so :meth:`with_errors` copies share it).
+        """
+        ev = self._eig_cache.get((t, mesh))
+        if ev is None:
+            ev = damped_eigenvalues(self, t, mesh=mesh)
+            ev.flags.writeable = False
+            self._eig_cache[(t, mesh)] = ev
+        return ev
 
     def resonance_warnings(
         self, margin: float = 0.1, harmonics: tuple[int, ...] = (1,)

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearte.errors import ConvergenceError, ParameterError
+from gearte.errors import ParameterError
 from gearte.geometry.rv import (
     ManufacturingErrors,
     PinContacts,
@@ -36,7 +36,7 @@ from gearte.geometry.rv import (
     RVReducer,
     pin_contacts,
 )
-from gearte.models.contact_law import force_from_coefficients
+from gearte.solvers.contact import solve_rotation
 
 __all__ = ["disc_rotation_error", "has_pin_errors", "loaded_disc_rotation"]
 
@@ -80,8 +80,8 @@ def loaded_disc_rotation(
     torque_per_disc : float
         Torque each disc carries [N·mm], > 0.
     guess : numpy.ndarray, optional
-        ``(P, N)`` elastic rotation [rad] near the answer (e.g. without the errors); speeds up
-        the bracketing only.
+        ``(P, N)`` elastic rotation [rad] near the answer (e.g. without the errors): the start
+        of each Newton iteration; by default each row starts from the previous row's answer.
     rtol : float
         Relative tolerance on the elastic rotation [-].
 
@@ -98,8 +98,9 @@ def loaded_disc_rotation(
     ``δ_k = l_k φ − g_k`` and equilibrium ``Σ F(δ_k) l_k = T`` (Li 2023 eq 3–4; Hu 2020
     eq 37–44), ``F(δ)`` the inverse of the contact law
     (:func:`gearte.models.contact_law.force_from_coefficients`). ``T(φ)`` increases; the root
-    is bracketed from ``guess`` and found by safeguarded Newton (``dT/dφ = Σ k_t l²``), as
-    :func:`gearte.models.cycloid_loaded_contact.solve_rotation` does from a fixed start.
+    is found by the compiled safeguarded Newton iteration of
+    :func:`gearte.solvers.contact.solve_rotation` (``dT/dφ = Σ k_t l²``), the one that the
+    cycloid tooth contact and the Li 2023 loaded contact use.
 
     References
     ----------
@@ -115,45 +116,18 @@ def loaded_disc_rotation(
     first = np.min(ratio, axis=1)
     clear = np.where(lv > 0.0, g - first[:, None] * lv, 0.0)
 
-    def torque_at(rot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        f = force_from_coefficients(np.where(lv > 0.0, rot[:, None] * lv - clear, 0.0), b0, b1)
-        return np.sum(f * lv, axis=1), f
-
-    lo = np.zeros(P * N)
-    hi = np.full(P * N, 1e-6) if guess is None else 1.5 * np.asarray(guess).reshape(P * N)
-    for _ in range(200):
-        t_hi, _ = torque_at(hi)
-        short = t_hi < torque_per_disc
-        if not np.any(short):
-            break
-        lo = np.where(short, hi, lo)
-        hi = np.where(short, 2.0 * hi, hi)
-    else:  # pragma: no cover - only for absurd loads
-        raise ConvergenceError("loaded_disc_rotation: could not bracket the rotation")
-    rot = hi.copy()  # T(φ) is convex where pins engage: Newton from above stays above
-    for it in range(100):  # noqa: B007 - reported on failure
-        t, f = torque_at(rot)
-        hi = np.where(t >= torque_per_disc, rot, hi)
-        lo = np.where(t < torque_per_disc, rot, lo)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            kt = np.where(f > 0.0, 1.0 / (b0 - b1 * np.log(np.where(f > 0.0, f, 1.0)) - b1), 0.0)
-        slope = np.sum(kt * lv * lv, axis=1)
-        new = rot - (t - torque_per_disc) / np.where(slope > 0.0, slope, np.inf)
-        new = np.where((new > lo) & (new <= hi) & (slope > 0.0), new, 0.5 * (lo + hi))
-        done = np.abs(new - rot) <= rtol * np.abs(new)
-        rot = new
-        if np.all(done):
-            break
-    else:  # pragma: no cover
-        raise ConvergenceError(
-            f"loaded_disc_rotation: Newton did not converge in {it + 1} iterations"
-        )
-    if not np.all(np.isfinite(torque_at(rot)[1])):
-        raise ParameterError(
-            "torque_per_disc",
+    try:
+        rot, _ = solve_rotation(
+            lv,
+            clear,
+            b0,
+            b1,
             torque_per_disc,
-            "[N·mm] loads a pin beyond the range of the elastic contact law",
+            rtol=rtol,
+            rot_start=None if guess is None else np.asarray(guess, dtype=float).reshape(P * N),
         )
+    except ParameterError as exc:
+        raise ParameterError("torque_per_disc", torque_per_disc, exc.reason) from None
     return (first + rot).reshape(P, N), rot.reshape(P, N)
 
 

@@ -1,0 +1,51 @@
+"""Shared base of the case kinds built from measurement files (``rv_serial``, ``rv_lot``)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import PrivateAttr, model_validator
+
+from gearte.io.schema import CaseBase
+from gearte.studies.rv_bench import ReducerRef
+
+
+class MeasuredPartsCase(CaseBase):
+    """A case that refers to an ``rv_reducer`` design and reads measured parts.
+
+    The measurement files are read when the case is validated (:meth:`_build` of the kind), so
+    ``gearte validate`` refuses a malformed file (one line naming file, line and column) as
+    ``run`` would; what they give is kept for ``run`` in ``_built``.
+    """
+
+    _built: Any = PrivateAttr(default=None)
+    reducer: ReducerRef
+
+    def _build(self) -> Any:  # pragma: no cover - every kind overrides it
+        raise NotImplementedError
+
+    def design(self) -> tuple[Any, Any]:
+        """``(design case, RVReducer)`` of ``reducer.case``, which must be an ``rv_reducer``
+        case (a :class:`~gearte.errors.ParameterError` naming ``reducer.case`` otherwise)."""
+        from gearte.errors import ParameterError
+        from gearte.io.case_file import load_case
+        from gearte.studies import rv_reducer as rv
+
+        design = load_case(self.reducer.case)
+        if design.case.kind != "rv_reducer":
+            raise ParameterError(
+                "reducer.case",
+                self.reducer.case,
+                f"is a {design.case.kind!r} case; need rv_reducer",
+            )
+        return design, rv.build_reducer(design.reducer)
+
+    @model_validator(mode="after")
+    def _measurements(self) -> MeasuredPartsCase:
+        from gearte.errors import GearteError
+
+        try:
+            self._built = self._build()
+        except GearteError as exc:
+            raise ValueError(str(exc)) from None
+        return self

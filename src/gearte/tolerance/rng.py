@@ -1,0 +1,281 @@
+"""Compiled random streams for the Monte-Carlo kernels: xoshiro256++ and a ziggurat normal.
+
+The linear-stack kernel of :mod:`gearte.tolerance.montecarlo` draws its numbers here rather than
+through ``numpy.random.Generator``: a numba kernel calling a Generator pays an indirect call per
+number, which cost about as much as the whole rest of a sample. Here the generator state lives
+in registers inside the kernel.
+
+* **Generator**: xoshiro256++ (Blackman & Vigna 2021), 256 bits of state, period 2²⁵⁶ − 1,
+  64-bit outputs that pass BigCrush and PractRand. Each chunk of a Monte-Carlo run seeds its
+  streams from its own ``SeedSequence`` child (:func:`stream_states`), so a seed gives the same
+  numbers whatever the backend or the number of workers.
+* **Uniform** ``[0, 1)``: the top 53 bits of an output times 2⁻⁵³ (every double of the form
+  ``k·2⁻⁵³``).
+* **Standard normal**: the ziggurat of Marsaglia & Tsang (2000) with 256 layers, the layout of
+  numpy's ``Generator.standard_normal``: one 64-bit output gives the layer (low 8 bits) and a
+  signed 53-bit integer ``v`` (the top 53 bits); ``x = v·x_i/2⁵²`` is accepted when
+  ``|v| < k_i`` (≈ 98.8 % of draws, no transcendental function). Rejected draws go to the wedge
+  test or, in the base layer, to Marsaglia's exact tail method beyond ``r = 3.6541528853610088``,
+  drawing from a second stream (the *tail* stream): so every sample takes exactly one number of
+  the main stream, which lets the kernel draw the main numbers in blocks.
+
+Exactness: the ziggurat is an exact rejection method (up to the 2⁻⁵² resolution of ``v``); the
+tests check the moments, a Kolmogorov–Smirnov test against the normal CDF and the tail masses.
+
+:class:`Xoshiro256pp` and :func:`reference_normal` are the plain Python twins (Python integers):
+they give bit-identical numbers (tested).
+
+References
+----------
+D. Blackman, S. Vigna, "Scrambled linear pseudorandom number generators", ACM Trans. Math.
+Softw. 47(4) 36 (2021), https://doi.org/10.1145/3460772.
+G. Marsaglia, W. W. Tsang, "The ziggurat method for generating random variables", J. Stat.
+Softw. 5(8) (2000), https://doi.org/10.18637/jss.v005.i08.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import int64, njit, uint64
+
+__all__ = [
+    "ZigguratTables",
+    "ziggurat_tables",
+    "stream_states",
+    "standard_normals",
+    "Xoshiro256pp",
+    "reference_normal",
+    "STREAMS",
+]
+
+#: Streams per chunk: 0 main (one number per sample), 1 tail (ziggurat rejections),
+#: 2 draws (contributors other than the Gaussian group).
+STREAMS = 3
+_MASK = (1 << 64) - 1
+ZIG_R = 3.6541528853610088  # right edge of the last layer, Marsaglia & Tsang (2000)
+ZIG_V = 0.00492867323399  # area of each layer
+_INV_2_53 = 1.0 / 9007199254740992.0
+
+
+class ZigguratTables(NamedTuple):
+    """The 256-layer ziggurat: ``k`` acceptance thresholds on ``|v|`` [-] (int64), ``w`` layer
+    widths per unit of ``v`` [-], ``f`` the density ``exp(−x²/2)`` at the layer edges [-]."""
+
+    k: np.ndarray
+    w: np.ndarray
+    f: np.ndarray
+
+
+def ziggurat_tables() -> ZigguratTables:
+    """The ziggurat tables of Marsaglia & Tsang (2000), 256 layers, for 52-bit ``|v|``.
+
+    Layer 0 is the base strip (width ``v/f(r)``, its part beyond ``r`` is the tail); layer 1
+    the top one; layer ``i`` spans ``[0, x_i]``.
+    """
+    m = 2.0**52
+    dn = ZIG_R
+    tn = dn
+    q = ZIG_V / math.exp(-0.5 * dn * dn)
+    k = np.zeros(256, np.int64)
+    w = np.zeros(256)
+    f = np.zeros(256)
+    k[0] = int((dn / q) * m)
+    k[1] = 0
+    w[0] = q / m
+    w[255] = dn / m
+    f[0] = 1.0
+    f[255] = math.exp(-0.5 * dn * dn)
+    for i in range(254, 0, -1):
+        dn = math.sqrt(-2.0 * math.log(ZIG_V / dn + math.exp(-0.5 * dn * dn)))
+        k[i + 1] = int((dn / tn) * m)
+        tn = dn
+        f[i] = math.exp(-0.5 * dn * dn)
+        w[i] = dn / m
+    return ZigguratTables(k, w, f)
+
+
+def stream_states(seed: int | np.random.SeedSequence, streams: int = STREAMS) -> np.ndarray:
+    """The xoshiro256++ states of one chunk: ``(streams, 4)`` uint64 from a seed sequence.
+
+    Parameters
+    ----------
+    seed : int or SeedSequence
+        The chunk's seed (a child of the study's ``SeedSequence``).
+    streams : int
+        Number of independent streams [-].
+
+    A state of all zeros (probability 2⁻²⁵⁶) would stay zero; its first word is set to 1.
+    """
+    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    st = ss.generate_state(4 * streams, np.uint64).reshape(streams, 4)
+    for row in st:
+        if not row.any():  # pragma: no cover - probability 2**-256
+            row[0] = 1
+    return st
+
+
+# ------------------------------------------------------------------------------------------------
+# compiled draws (inlined into the kernels; state as four uint64 locals)
+# ------------------------------------------------------------------------------------------------
+@njit(inline="always")
+def _rotl(x, k):  # pragma: no cover - compiled
+    return (x << uint64(k)) | (x >> uint64(64 - k))
+
+
+@njit(inline="always")
+def next_u64(s0, s1, s2, s3):  # pragma: no cover - compiled
+    """xoshiro256++: ``(output, s0, s1, s2, s3)``."""
+    r = _rotl(s0 + s3, 23) + s0
+    t = s1 << uint64(17)
+    s2 ^= s0
+    s3 ^= s1
+    s1 ^= s2
+    s0 ^= s3
+    s2 ^= t
+    s3 = _rotl(s3, 45)
+    return r, s0, s1, s2, s3
+
+
+@njit(inline="always")
+def u64_to_unit(r):  # pragma: no cover - compiled
+    """Uniform ``[0, 1)`` from the top 53 bits."""
+    return float(r >> uint64(11)) * _INV_2_53
+
+
+@njit(inline="always")
+def zig_fast(r, k, w):  # pragma: no cover - compiled
+    """Fast path of the ziggurat: ``(x, accepted, layer, v)`` from one 64-bit output."""
+    idx = int(r & uint64(0xFF))
+    v = int64(r) >> 11
+    x = float(v) * w[idx]
+    return x, abs(v) < k[idx], idx, v
+
+
+@njit(inline="always")
+def zig_slow(x, idx, v, t0, t1, t2, t3, k, w, f):  # pragma: no cover - compiled
+    """A draw rejected by the fast path: wedge test (layers ≥ 1) or tail (layer 0) with the
+    tail stream; when the wedge test rejects, a fresh ziggurat draw from the tail stream.
+    Returns ``(x, t0, t1, t2, t3)``."""
+    while True:
+        if idx == 0:
+            while True:
+                u1, t0, t1, t2, t3 = next_u64(t0, t1, t2, t3)
+                u2, t0, t1, t2, t3 = next_u64(t0, t1, t2, t3)
+                xx = -math.log1p(-u64_to_unit(u1)) / ZIG_R
+                yy = -math.log1p(-u64_to_unit(u2))
+                if yy + yy > xx * xx:
+                    if v < 0:
+                        return -(ZIG_R + xx), t0, t1, t2, t3
+                    return ZIG_R + xx, t0, t1, t2, t3
+        u, t0, t1, t2, t3 = next_u64(t0, t1, t2, t3)
+        if (f[idx - 1] - f[idx]) * u64_to_unit(u) + f[idx] < math.exp(-0.5 * x * x):
+            return x, t0, t1, t2, t3
+        r, t0, t1, t2, t3 = next_u64(t0, t1, t2, t3)
+        x, ok, idx, v = zig_fast(r, k, w)
+        if ok:
+            return x, t0, t1, t2, t3
+
+
+@njit(cache=True, nogil=True)
+def _standard_normals(st, n, k, w, f):  # pragma: no cover - compiled
+    s0, s1, s2, s3 = st[0, 0], st[0, 1], st[0, 2], st[0, 3]
+    t0, t1, t2, t3 = st[1, 0], st[1, 1], st[1, 2], st[1, 3]
+    out = np.empty(n)
+    for j in range(n):
+        r, s0, s1, s2, s3 = next_u64(s0, s1, s2, s3)
+        x, ok, idx, v = zig_fast(r, k, w)
+        if not ok:
+            x, t0, t1, t2, t3 = zig_slow(x, idx, v, t0, t1, t2, t3, k, w, f)
+        out[j] = x
+    return out
+
+
+def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
+    """``n`` standard normal numbers [-] from the chunk streams of ``seed`` (compiled).
+
+    Parameters
+    ----------
+    seed : int or SeedSequence
+        Seed of the streams (:func:`stream_states`).
+    n : int
+        How many numbers [-].
+
+    The same numbers as the Gaussian group of :mod:`gearte.tolerance.montecarlo`'s kernel for
+    a stack of one standard normal contributor.
+    """
+    t = ziggurat_tables()
+    return _standard_normals(stream_states(seed), int(n), t.k, t.w, t.f)
+
+
+# ------------------------------------------------------------------------------------------------
+# plain twins
+# ------------------------------------------------------------------------------------------------
+class Xoshiro256pp:
+    """Plain Python xoshiro256++ stream (the reference of the compiled one).
+
+    Parameters
+    ----------
+    state : sequence of 4 int
+        The 256-bit state as four unsigned 64-bit words (a row of :func:`stream_states`).
+    """
+
+    def __init__(self, state) -> None:
+        self.s = [int(x) & _MASK for x in state]
+
+    def next(self) -> int:
+        """The next 64-bit output (an int in ``[0, 2⁶⁴)``)."""
+        s = self.s
+        x = (s[0] + s[3]) & _MASK
+        r = ((((x << 23) | (x >> 41)) & _MASK) + s[0]) & _MASK
+        t = (s[1] << 17) & _MASK
+        s[2] ^= s[0]
+        s[3] ^= s[1]
+        s[1] ^= s[2]
+        s[0] ^= s[3]
+        s[2] ^= t
+        s[3] = ((s[3] << 45) | (s[3] >> 19)) & _MASK
+        return r
+
+    def unit(self) -> float:
+        """Uniform in ``[0, 1)``: the top 53 bits times 2⁻⁵³."""
+        return (self.next() >> 11) * _INV_2_53
+
+
+def _fast_ref(r: int, t: ZigguratTables) -> tuple[float, bool, int, int]:
+    idx = r & 0xFF
+    v = (r - (1 << 64) if r >> 63 else r) >> 11
+    x = float(v) * float(t.w[idx])
+    return x, abs(v) < int(t.k[idx]), idx, v
+
+
+def reference_normal(
+    main: Xoshiro256pp, tail: Xoshiro256pp, tables: ZigguratTables | None = None
+) -> float:
+    """One standard normal [-], plain Python: one number of ``main``, rejections from ``tail``.
+
+    Parameters
+    ----------
+    main, tail : Xoshiro256pp
+        The main and the tail streams.
+    tables : ZigguratTables, optional
+        :func:`ziggurat_tables` (computed when omitted).
+    """
+    t = tables if tables is not None else ziggurat_tables()
+    x, ok, idx, v = _fast_ref(main.next(), t)
+    while not ok:
+        if idx == 0:
+            while True:
+                xx = -math.log1p(-tail.unit()) / ZIG_R
+                yy = -math.log1p(-tail.unit())
+                if yy + yy > xx * xx:
+                    return -(ZIG_R + xx) if v < 0 else ZIG_R + xx
+        f = t.f
+        if (float(f[idx - 1]) - float(f[idx])) * tail.unit() + float(f[idx]) < math.exp(
+            -0.5 * x * x
+        ):
+            return x
+        x, ok, idx, v = _fast_ref(tail.next(), t)
+    return x
