@@ -36,6 +36,7 @@ import numpy as np
 from numba import njit
 
 from gearte.errors import ConvergenceError, ParameterError
+from gearte.solvers.dense import solve_spd_into as _spd_solve
 from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
     LAW_LINEAR,
@@ -200,37 +201,6 @@ def _rows_times(idx, val, x, out):
             i0, i1, i2 = idx[r, 0], idx[r, 1], idx[r, 2]
             x0, x1, x2 = x[i0], x[i1], x[i2]
         out[r] = val[r, 0] * x0 + val[r, 1] * x1 + val[r, 2] * x2
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _spd_solve(H, b, L, x):
-    """Solve ``H x = b`` for symmetric positive definite ``H`` (Cholesky into the work array
-    ``L``, result in ``x``); LU where a pivot is not positive."""
-    n = b.size
-    for j in range(n):
-        s = H[j, j]
-        for k in range(j):
-            s -= L[j, k] * L[j, k]
-        if not s > 0.0:
-            x[:] = np.linalg.solve(H, b)
-            return
-        d = np.sqrt(s)
-        L[j, j] = d
-        for i in range(j + 1, n):
-            t = H[i, j]
-            for k in range(j):
-                t -= L[i, k] * L[j, k]
-            L[i, j] = t / d
-    for i in range(n):
-        t = b[i]
-        for k in range(i):
-            t -= L[i, k] * x[k]
-        x[i] = t / L[i, i]
-    for i in range(n - 1, -1, -1):
-        t = x[i]
-        for k in range(i + 1, n):
-            t -= L[k, i] * x[k]
-        x[i] = t / L[i, i]
 
 
 def law_limit(a0: np.ndarray, a1: np.ndarray) -> np.ndarray:
