@@ -139,3 +139,31 @@ def test_iso286_values_and_errors():
         js_allowances_um("js12", 100.0)
     with pytest.raises(ParameterError, match="not extrapolated"):
         js_allowances_um("js7", 4000.0)
+
+
+def test_helical_backlash_normal_allowances_to_transverse_by_hand():
+    """cd25 pinion and wheel (−54/−84, −70/−110 µm), js7 ±20 µm, α_n 20°, β 15°:
+    α_t = atan(tan 20° / cos 15°) = 20.6469°; j_t,max = 194 / cos 15° + 40 tan α_t
+    = 200.846 + 15.075 = 215.92 µm; j_n = j_t cos 20° cos 15°; at the nominal centre distance
+    j_n = −(A_sn,1 + A_sn,2) cos α_n, the spur law in the normal section; β = 0 is the spur pair."""
+    from gearte.tolerance.din3967 import helical_pair_backlash_limits, pair_backlash_limits
+
+    an, b = math.radians(20.0), math.radians(15.0)
+    h = helical_pair_backlash_limits(-0.054, -0.084, -0.070, -0.110, 0.020, -0.020, an, b)
+    at = math.atan(math.tan(an) / math.cos(b))
+    assert math.degrees(at) == pytest.approx(20.6469, abs=1e-4)
+    assert float(h.circumferential_max) == pytest.approx(0.194 / math.cos(b) + 0.040 * math.tan(at))
+    assert float(h.circumferential_max) == pytest.approx(0.21592, abs=1e-5)
+    assert float(h.normal_min) == pytest.approx(
+        float(h.circumferential_min) * math.cos(an) * math.cos(b)
+    )
+    # cos α_n cos β = cos α_t cos β_b (ISO 21771's form of the same factor)
+    beta_b = math.asin(math.sin(b) * math.cos(an))
+    assert math.cos(an) * math.cos(b) == pytest.approx(math.cos(at) * math.cos(beta_b))
+    h0 = helical_pair_backlash_limits(-0.054, -0.084, -0.070, -0.110, 0, 0, an, b)
+    assert float(h0.normal_min) == pytest.approx(0.124 * math.cos(an))
+    s = pair_backlash_limits(-0.054, -0.084, -0.070, -0.110, 0.020, -0.020, an)
+    z = helical_pair_backlash_limits(-0.054, -0.084, -0.070, -0.110, 0.020, -0.020, an, 0.0)
+    assert float(z.normal_max) == pytest.approx(float(s.normal_max))
+    with pytest.raises(ParameterError, match="helix_angle"):
+        helical_pair_backlash_limits(0, 0, 0, 0, 0, 0, an, math.pi / 2)

@@ -199,3 +199,17 @@ def test_yield_with_raw_first_stage_backlash_adds_the_same_closed_form_to_every_
     st = y.values["quantities"]["first_stage_backlash_at_output [arcmin]"]
     add = rad_to_arcmin(0.040 / (R_SUN * RATIO))
     assert st["min"] == pytest.approx(add) and st["max"] == pytest.approx(add)
+
+
+def test_bundled_first_stage_example_adds_its_f24_js5_midpoint_to_the_catalogue():
+    """han2023_rv110e_first_stage_yield (catalogue only here): f24/f24/js5 → j_t midpoint
+    (14 + 34 + 19 + 44)/2 = 55.5 µm → 0.0555 / (15 · 81) rad = 0.1570′ at the output."""
+    data = tomllib.loads(case_path("han2023_rv110e_first_stage_yield").read_text())
+    data["analyses"].pop("yield")
+    data["analyses"]["catalogue"]["steps_per_segment"] = 2
+    v = _catalogue(data)
+    assert v["first_stage_backlash"] == "additive"
+    assert v["first_stage_backlash_at_output [arcmin]"] == pytest.approx(
+        rad_to_arcmin(0.0555 / (R_SUN * RATIO))
+    )
+    assert v["lost_motion_min [arcmin]"] < v["lost_motion [arcmin]"] < v["lost_motion_max [arcmin]"]

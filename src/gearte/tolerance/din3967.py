@@ -35,7 +35,17 @@ Sources as read (the standard itself is not in gearte's reference corpus):
   (``A_Ae = +15 µm`` at ``α_wt = 21.46251°`` → ``Δj_t = 0.012 mm``, ``Δj_n = 0.011 mm``), the
   same ``2 Δa sin α`` as Jiang et al. (2024) eq. 1 (:mod:`gearte.models.backlash`).
 
-Not implemented: helical gears (normal → transverse conversion of the allowances); the
+Helical pairs (:func:`helical_pair_backlash_limits`): the allowances are normal-section values;
+on the reference cylinder a normal circular arc is the transverse one times ``cos β``
+(``j_nt = j_tt cos β``), so ``A_st = A_sn / cos β``; the centre-distance term acts in the
+transverse plane (``2 A_a tan α_t``); ``j_n = j_t cos α_n cos β`` (``= j_t cos α_t cos β_b``,
+``cos β_b = cos β cos α_n / cos α_t``). The backlash relations ``j_nn = j_nt cos α_n``,
+``j_nt = j_tt cos β``, ``j_nn = j_tt cos α_n cos β`` are as the Autodesk Inventor help page
+"Backlash types (defined for each gear in a gear set)" states them; the same law gives
+``j_n = −(A_sn,1 + A_sn,2) cos α_n`` at the nominal centre distance, the form the gear-geometry
+service's test above states (with ``α_n``). ISO 21771's own text was not available.
+
+Not implemented: the
 conversion of ``A_sn`` to span-measurement or ball-dimension allowances (DIN 3967 Appendix B);
 DIN 3967's own recommendation of a class for a given use. See ``docs/tolerance_grades.md``.
 
@@ -58,6 +68,7 @@ from gearte.errors import ParameterError
 
 __all__ = [
     "ALLOWANCE_SERIES",
+    "helical_pair_backlash_limits",
     "TOLERANCE_SERIES",
     "DIAMETER_UPPER_BOUNDS_MM",
     "ToothThicknessAllowances",
@@ -344,3 +355,73 @@ def pair_backlash_limits(
     jt_max = -(np.add(lower_1, lower_2)) + 2.0 * np.multiply(centre_upper, tan_a)
     jt_min = -(np.add(upper_1, upper_2)) + 2.0 * np.multiply(centre_lower, tan_a)
     return BacklashLimits(jt_min, jt_max, jt_min * cos_a, jt_max * cos_a)
+
+
+def helical_pair_backlash_limits(
+    upper_1: ArrayLike,
+    lower_1: ArrayLike,
+    upper_2: ArrayLike,
+    lower_2: ArrayLike,
+    centre_upper: ArrayLike,
+    centre_lower: ArrayLike,
+    normal_pressure_angle: float,
+    helix_angle: float,
+) -> BacklashLimits:
+    """Backlash limits of a helical pair at its standard centre distance from the normal-section
+    allowances.
+
+    Parameters
+    ----------
+    upper_1, lower_1, upper_2, lower_2 : array_like
+        Normal tooth-thickness allowances ``A_sne``, ``A_sni`` of gears 1 and 2 [mm].
+    centre_upper, centre_lower : array_like
+        Centre-distance allowances ``A_ae``, ``A_ai`` [mm].
+    normal_pressure_angle : float
+        ``α_n`` [rad].
+    helix_angle : float
+        ``β`` on the reference cylinder [rad], ``|β| < 90°``.
+
+    Returns
+    -------
+    BacklashLimits
+        ``circumferential_*``: transverse circumferential backlash ``j_t`` on the reference
+        circle; ``normal_*``: normal backlash ``j_n`` [mm].
+
+    Notes
+    -----
+    ``α_t = atan(tan α_n / cos β)``, ``A_st = A_sn / cos β``,
+    ``j_t = −(A_st,1 + A_st,2) + 2 A_a tan α_t``, ``j_n = j_t cos α_n cos β``; ``β = 0`` is
+    :func:`pair_backlash_limits` (module docstring: sources).
+
+    References
+    ----------
+    DIN 3967:1978-08. Autodesk Inventor Help, "Backlash types (defined for each gear in a gear
+    set)" (backlash relations of a helical mesh).
+
+    Examples
+    --------
+    >>> b = helical_pair_backlash_limits(-0.054, -0.084, -0.070, -0.110, 0, 0, 0.3490658504, 0)
+    >>> round(float(b.normal_max), 5)
+    0.1823
+    """
+    beta = float(helix_angle)
+    if not abs(beta) < 0.5 * math.pi:
+        raise ParameterError("helix_angle", beta, "must be within (-90°, 90°) [rad]")
+    cos_b = math.cos(beta)
+    alpha_t = math.atan(math.tan(float(normal_pressure_angle)) / cos_b)
+    t = pair_backlash_limits(
+        np.divide(upper_1, cos_b),
+        np.divide(lower_1, cos_b),
+        np.divide(upper_2, cos_b),
+        np.divide(lower_2, cos_b),
+        centre_upper,
+        centre_lower,
+        alpha_t,
+    )
+    k = math.cos(float(normal_pressure_angle)) * cos_b
+    return BacklashLimits(
+        t.circumferential_min,
+        t.circumferential_max,
+        np.multiply(t.circumferential_min, k),
+        np.multiply(t.circumferential_max, k),
+    )
