@@ -54,8 +54,12 @@ def _resolve(path: str, base_dir: str | None) -> Path:
     from gearte.cases import case_path
 
     p = Path(path)
-    if not p.is_absolute() and base_dir is not None and (Path(base_dir) / p).is_file():
-        return Path(base_dir) / p
+    if not p.is_absolute() and base_dir is not None:
+        try:
+            if (Path(base_dir) / p).is_file():
+                return Path(base_dir) / p
+        except (OSError, ValueError):  # a name too long, a NUL byte: not a file; case_path says
+            pass
     return case_path(path)
 
 
