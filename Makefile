@@ -62,14 +62,21 @@ docs: $(DEV_STAMP)
 	@echo "docs: site/index.html"
 
 # The long fuzzing job (issue 13): FUZZ_COUNT mutants of the bundled cases through validation,
-# the first FUZZ_RUNS accepted ones also through `gearte run`, and FUZZ_FILES mutated measurement
-# files through their readers (docs/errors.md, "Fuzzing").
+# the accepted ones also through `gearte run` (FUZZ_RUNS of them; -1: every one) in children of
+# a warm fork server (one per core), FUZZ_EQUIVALENCE of them also as real `gearte run`
+# processes, and FUZZ_FILES mutated measurement files through their readers (docs/errors.md,
+# "Fuzzing"). Every mutant and run is recorded in out/fuzz.jsonl.
 FUZZ_COUNT ?= 10000
 FUZZ_FILES ?= 10000
-FUZZ_RUNS ?= 300
+FUZZ_RUNS ?= -1
+FUZZ_EQUIVALENCE ?= 20
+FUZZ_RUN_CPU ?= 60
 fuzz: $(DEV_STAMP)
-	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python tests/fuzzing.py \
-		--count $(FUZZ_COUNT) --files $(FUZZ_FILES) --runs $(FUZZ_RUNS)
+	mkdir -p out
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test nice -n 10 $(BIN)/python tests/fuzzing.py \
+		--count $(FUZZ_COUNT) --files $(FUZZ_FILES) --runs $(FUZZ_RUNS) \
+		--run-cpu-limit $(FUZZ_RUN_CPU) --run-timeout 600 \
+		--equivalence $(FUZZ_EQUIVALENCE) --record out/fuzz.jsonl
 
 test-slow: $(DEV_STAMP)
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q -m slow

@@ -11,13 +11,21 @@ and is classified:
 * ``rejected``: a ``CaseFileError``; every line must be one line naming a key;
 * ``crash``: any other exception (would be exit 3 "bug" in the CLI).
 
-Accepted mutants can also go through ``gearte run`` (``--runs N``): in this process, through the
-CLI's own entry point (its exit codes), with ``--samples 4 --workers 1`` and tight time/memory
-budgets (``GEARTE_MAX_SECONDS``/``GEARTE_MAX_MEMORY_GB``, so an oversized mutant is refused at
-validation as it would be for a user), under an address-space limit (:data:`RUN_MEMORY_LIMIT`, the
-memory bound) and a per-run alarm. Exit 0, 1 or 2 is fine; exit 3 (a bug), a timeout or a run
-past the memory bound is not; and the input recorded in ``results.json`` must keep every given
-value's type (no coercion through ``run`` either).
+Accepted mutants also go through ``gearte run`` (``--runs N``, ``-1``: every accepted mutant),
+through the CLI's own entry point (its exit codes, its output writing into a temporary folder),
+with ``--samples 4 --workers 1`` (``--samples`` sets every Monte-Carlo count and caps every other
+count of sampled work) and tight time/memory budgets (``GEARTE_MAX_SECONDS``/
+``GEARTE_MAX_MEMORY_GB``, so an oversized mutant is refused at validation as it would be for a
+user), under an address-space limit (:data:`RUN_MEMORY_LIMIT`, the memory bound) and a time-out.
+The long job runs them in a **fork server** (:class:`ForkServer`): one parent imports gearte and
+runs every bundled case once (every kind's kernels loaded or compiled), then forks a child per
+mutant, ``--workers`` at a time; a child past the time-out is killed and reaped; per run the exit
+code, the message, peak RSS, CPU and wall time are recorded (``--record``). ``--equivalence N``
+runs N further accepted mutants both as real ``gearte run`` processes and through the fork
+server and compares the outcomes. Exit 0, 1 or 2 with one error line (naming the key for bad
+input) is fine; exit 3 (a bug), a crash, a time-out, a run past the memory bound or a malformed
+message is not; and the input recorded in ``results.json`` must keep every given value's type
+(no coercion through ``run`` either).
 
 Measurement files are fuzzed too (``--files N``): the bundled bench files (TE traces, hysteresis
 curve, :mod:`gearte.io.bench`), one file of each metrology format written from seeded parts and
@@ -28,13 +36,14 @@ numbers, or one ``BenchFileError``/``MeasurementFileError`` line naming the file
 is a crash.
 
 Small runs are part of the test suite (``tests/test_fuzz_cases.py``, hypothesis-driven); the long
-job is ``make fuzz`` (``python tests/fuzzing.py --count 10000 --files 10000 --runs 300``), which
+job is ``make fuzz`` (``python tests/fuzzing.py --count 10000 --files 10000 --runs -1``), which
 prints the tallies.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import random
@@ -43,6 +52,7 @@ import sys
 import time
 import tomllib
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -276,6 +286,7 @@ def check_text(text: str, tmp: Path) -> Outcome:
     from gearte.errors import CaseFileError
     from gearte.io.case_file import load_case
 
+    link_case_data(tmp)
     path = tmp / "mutant.toml"
     path.write_text(text, encoding="utf-8", errors="surrogatepass")
     try:
@@ -296,37 +307,105 @@ def check_text(text: str, tmp: Path) -> Outcome:
     return Outcome("coerced", "; ".join(found)[:300]) if found else Outcome("accepted")
 
 
-#: Address-space limit of the fuzzing process while it runs mutants (``--runs``) [bytes]: the
-#: memory bound. A run past it fails to allocate (exit 3 or a crash), which the harness counts.
+#: Address-space limit of each run (``--runs``) [bytes]: the memory bound. A run past it fails to
+#: allocate (``MemoryError``), which the harness counts as ``run_memory``.
 RUN_MEMORY_LIMIT = 6 * 2**30
-#: ``--samples`` of fuzzed runs (Monte-Carlo, yield, dynamics batches).
+#: ``--samples`` of fuzzed runs: sets every Monte-Carlo / yield / batch count and caps every other
+#: count of sampled work (Sobol, bootstrap, allocation, sweeps: ``gearte.studies.sample_cap``).
 RUN_SAMPLES = 4
 #: Budgets of fuzzed runs (gearte.limits): an oversized mutant is refused at validation.
 RUN_BUDGETS = {"GEARTE_MAX_SECONDS": "20", "GEARTE_MAX_MEMORY_GB": "2"}
+#: Outcomes of a run that fail the harness.
+BAD_RUN = (
+    "run_bug",
+    "run_crash",
+    "run_timeout",
+    "run_memory",
+    "run_coerced",
+    "run_bad_message",
+)
+
+
+_LINKED: set[Path] = set()
+
+
+def link_case_data(tmp: Path) -> None:
+    """Make the bundled cases' data folders (bench files, the lot's metrology files) reachable
+    from ``tmp`` as from ``examples/``, so mutants of the data-backed cases written there still
+    find their files (otherwise they could only ever be rejected)."""
+    from gearte.cases import case_path
+
+    if tmp in _LINKED:
+        return
+    _LINKED.add(tmp)
+    examples = case_path("synthetic_rv_bench").parent
+    for entry in examples.iterdir():
+        link = tmp / entry.name
+        if entry.is_dir() and not link.exists():
+            link.symlink_to(entry, target_is_directory=True)
+
+
+def run_args(path: Path, out: Path, report: bool = False) -> list[str]:
+    """Arguments of ``gearte run`` for a fuzzed case file (small samples, one worker)."""
+    args = ["run", str(path), "--out", str(out), "--no-progress"]
+    args += ["--samples", str(RUN_SAMPLES), "--workers", "1"]
+    return args if report else [*args, "--no-report"]
+
+
+_KEYED = re.compile(r"^error \((invalid parameter|invalid case|not found)\): \S")
+
+
+def classify_run(code: int, stderr: str, text: str, out: Path) -> Outcome:
+    """The outcome of one ``gearte run`` of an accepted mutant from its exit code, its stderr and
+    its output folder: exit 0, 1 (analysis failed) or 2 (bad input) with one error line (naming
+    the key for bad input) are fine; exit 3 (a bug), a ``MemoryError`` (past the memory bound), a
+    malformed message or a coerced input in ``results.json`` are not."""
+    errors = [ln for ln in stderr.splitlines() if ln.startswith("error (")]
+    last = (errors or stderr.strip().splitlines() or [""])[-1][:200]
+    if "MemoryError" in stderr:
+        return Outcome("run_memory", last)
+    if code not in (0, 1, 2):
+        return Outcome("run_bug", f"exit {code}: {stderr[-300:]}")
+    if code in (1, 2):
+        if len(errors) != 1 or (code == 2 and not _KEYED.match(errors[0])):
+            return Outcome("run_bad_message", f"exit {code}: {stderr[-300:]}")
+        if errors[0].startswith("error (invalid parameter)") and " = " not in errors[0]:
+            return Outcome("run_bad_message", errors[0][:300])
+    if code == 0:
+        doc = json.loads((out / "results.json").read_text(encoding="utf-8"))
+        found = _coercions(tomllib.loads(text), doc["case"]["input"])
+        if found:
+            return Outcome("run_coerced", "; ".join(found)[:300])
+    return Outcome(f"run_exit_{code}", last)
 
 
 class _Alarm(KeyboardInterrupt):
-    """The per-run alarm: stops the run as Ctrl-C would (also inside a compiled kernel, where
-    CPython reports it as a SystemError caused by it); the run's exit is then a time-out."""
+    """The per-run alarm of :func:`run_cli`: stops the run as Ctrl-C would (also inside a
+    compiled kernel, where CPython reports it as a SystemError caused by it)."""
 
 
-def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
-    """``gearte run`` of an accepted mutant through the CLI entry point, in this process:
-    exit 0, 1 (analysis failed) or 2 (bad input) are fine; 3 (bug) or a timeout are not; the
-    case input recorded in ``results.json`` must keep the given types (``run_coerced``)."""
-    import contextlib
+def _cli_exit_code(args: list[str]) -> int:
+    """``gearte run`` through the CLI's entry point in this process; its exit code."""
+    from gearte.cli import main as cli_main
+
+    try:
+        cli_main(args, standalone_mode=False)
+    except SystemExit as exc:
+        return int(exc.code or 0)
+    return 0
+
+
+def run_cli(text: str, tmp: Path, timeout_s: float, report: bool = False) -> Outcome:
+    """``gearte run`` of an accepted mutant through the CLI entry point, in this process, with a
+    per-run alarm (the small in-suite share; :class:`ForkServer` for the long job)."""
     import io
     import os
     import signal
 
-    from gearte.cli import main as cli_main
-
+    link_case_data(tmp)
     path = tmp / "run.toml"
     path.write_text(text, encoding="utf-8")
     out = tmp / "out"
-    args = ["run", str(path), "--out", str(out), "--no-report", "--no-progress"]
-    args += ["--samples", str(RUN_SAMPLES), "--workers", "1"]
-
     fired = []
 
     def alarm(_signum: int, _frame: Any) -> None:
@@ -341,10 +420,7 @@ def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
     err = io.StringIO()
     try:
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-            cli_main(args, standalone_mode=False)
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
+            code = _cli_exit_code(run_args(path, out, report))
     except _Alarm:
         return Outcome("run_timeout", f"over {timeout_s} s")
     except MemoryError:
@@ -360,17 +436,225 @@ def run_cli(text: str, tmp: Path, timeout_s: float) -> Outcome:
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
-    last = (err.getvalue().strip().splitlines() or [""])[-1][:200]
     if fired:
         return Outcome("run_timeout", f"over {timeout_s} s (exit {code})")
-    if code not in (0, 1, 2):
-        return Outcome("run_bug", f"exit {code}: {err.getvalue()[-300:]}")
-    if code == 0:
-        doc = json.loads((out / "results.json").read_text(encoding="utf-8"))
-        found = _coercions(tomllib.loads(text), doc["case"]["input"])
-        if found:
-            return Outcome("run_coerced", "; ".join(found)[:300])
-    return Outcome(f"run_exit_{code}", last)
+    return classify_run(code, err.getvalue(), text, out)
+
+
+def run_subprocess(text: str, tmp: Path, timeout_s: float, report: bool = False) -> Outcome:
+    """``gearte run`` of a mutant as a real process (``python -m gearte``), same arguments,
+    budgets and memory bound as the fork server: the reference the fork server is checked
+    against (:func:`main`'s ``--equivalence``)."""
+    import os
+    import resource
+    import subprocess
+
+    tmp.mkdir(parents=True, exist_ok=True)
+    link_case_data(tmp)
+    path = tmp / "run.toml"
+    path.write_text(text, encoding="utf-8")
+    out = tmp / "out"
+    env = {**os.environ, **RUN_BUDGETS}
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (RUN_MEMORY_LIMIT, RUN_MEMORY_LIMIT))
+
+    cmd = [sys.executable, "-m", "gearte", *run_args(path, out, report)]
+    try:
+        p = subprocess.run(
+            cmd, capture_output=True, text=True, env=env, timeout=timeout_s, preexec_fn=limit
+        )
+    except subprocess.TimeoutExpired:
+        return Outcome("run_timeout", f"over {timeout_s} s")
+    if p.returncode < 0:
+        return Outcome("run_crash", f"killed by signal {-p.returncode}: {p.stderr[-300:]}")
+    return classify_run(p.returncode, p.stderr, text, out)
+
+
+# ----------------------------------------------------------------------------- fork server
+@dataclass
+class RunRecord:
+    """One fuzzed run: which mutant, its outcome, and what it cost."""
+
+    index: int
+    base: str
+    done: str
+    status: str
+    code: int | None
+    message: str
+    peak_rss_mb: float
+    wall_s: float
+    cpu_s: float
+
+
+def _single_threaded() -> None:
+    """One thread per library before numpy/numba load: forked children must not inherit a BLAS
+    or numba thread pool (a fork copies only the calling thread), and the machine is shared."""
+    import os
+
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
+
+
+class ForkServer:
+    """Runs accepted mutants through ``gearte run`` in forked children of one warm parent.
+
+    The parent imports gearte and runs every bundled case once (:meth:`warm`: every kind's
+    module imported, every kernel loaded or compiled), then forks one child per mutant. The
+    child is ``gearte run`` in-process — the CLI's entry point, its exit codes and its output
+    writing into a temporary folder — under an address-space limit (:data:`RUN_MEMORY_LIMIT`,
+    the memory bound) with its stdout/stderr in files. At most ``workers`` children run at once;
+    a child past ``timeout_s`` is killed (SIGKILL) and reaped. Per run the parent records the
+    exit code, the message, the child's peak RSS and CPU time (``wait4``) and the wall time.
+    """
+
+    def __init__(
+        self,
+        root: Path,
+        workers: int,
+        timeout_s: float,
+        report: bool = False,
+        on_record: Callable[[RunRecord], None] | None = None,
+        cpu_limit_s: int | None = None,
+    ) -> None:
+        self.root, self.workers, self.timeout_s, self.report = root, workers, timeout_s, report
+        self.cpu_limit_s = cpu_limit_s
+        self.running: dict[int, tuple[tuple[int, str, str, str], float, Path]] = {}
+        self.records: list[RunRecord] = []
+        self.on_record = on_record
+        link_case_data(root)
+
+    def warm(self, names: list[str] | None = None) -> dict[str, str]:
+        """Run each bundled case once in this process (small samples); ``{name: outcome}``."""
+        import tempfile
+
+        bases = corpus()
+        got = {}
+        for name in names if names is not None else sorted(bases):
+            with tempfile.TemporaryDirectory(dir=self.root) as d:
+                got[name] = run_cli(to_toml(bases[name]), Path(d), 600.0, self.report).status
+        return got
+
+    def submit(self, index: int, base: str, done: str, text: str) -> None:
+        """Fork a child that runs ``text`` (waits for a free slot first)."""
+        import os
+        import tempfile
+
+        while len(self.running) >= self.workers:
+            self._reap(block=True)
+        d = Path(tempfile.mkdtemp(prefix=f"run{index}-", dir=self.root))
+        (d / "run.toml").write_text(text, encoding="utf-8")
+        sys.stdout.flush()
+        sys.stderr.flush()
+        pid = os.fork()
+        if pid == 0:  # the child: never returns
+            self._child(d, text)
+        self.running[pid] = ((index, base, done, text), time.monotonic(), d)
+
+    def _child(self, d: Path, text: str) -> None:
+        import os
+        import resource
+
+        code = 99
+        try:
+            resource.setrlimit(resource.RLIMIT_AS, (RUN_MEMORY_LIMIT, RUN_MEMORY_LIMIT))
+            if self.cpu_limit_s is not None:  # CPU time: fair on a machine shared with others
+                used = resource.getrusage(resource.RUSAGE_SELF)
+                lim = int(used.ru_utime + used.ru_stime) + self.cpu_limit_s
+                resource.setrlimit(resource.RLIMIT_CPU, (lim, lim + 5))
+            os.environ.update(RUN_BUDGETS)
+            for fd, name in ((1, "stdout"), (2, "stderr")):
+                f = os.open(d / name, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+                os.dup2(f, fd)
+                os.close(f)
+            # Python's streams onto those files (under pytest they point at its capture)
+            sys.stdout = open(1, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
+            sys.stderr = open(2, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
+            code = _cli_exit_code(run_args(d / "run.toml", d / "out", self.report))
+        except BaseException as exc:  # noqa: BLE001 - a click usage error or anything else
+            what = "MemoryError" if isinstance(exc, MemoryError) else type(exc).__name__
+            print(f"harness: {what}: {exc}", file=sys.stderr)
+            code = 98
+        finally:
+            with contextlib.suppress(Exception):
+                sys.stdout.flush()
+                sys.stderr.flush()
+            os._exit(code)
+
+    def _finish(self, pid: int, status: int, ru: Any, timed_out: bool) -> None:
+        import os
+        import shutil
+        import signal
+
+        (index, base, done, text), t0, d = self.running.pop(pid)
+        wall = time.monotonic() - t0
+        stderr = (d / "stderr").read_text("utf-8", "replace") if (d / "stderr").exists() else ""
+        code: int | None = None
+        if timed_out:
+            out = Outcome("run_timeout", f"over {self.timeout_s} s, killed")
+        elif os.WIFSIGNALED(status) and (
+            os.WTERMSIG(status) == signal.SIGXCPU
+            or (  # the hard CPU limit
+                os.WTERMSIG(status) == signal.SIGKILL
+                and self.cpu_limit_s is not None
+                and ru.ru_utime + ru.ru_stime >= self.cpu_limit_s
+            )
+        ):
+            out = Outcome("run_timeout", f"over {self.cpu_limit_s} s of CPU, stopped")
+        elif os.WIFSIGNALED(status):
+            out = Outcome("run_crash", f"signal {os.WTERMSIG(status)}: {stderr[-300:]}")
+        else:
+            code = os.WEXITSTATUS(status)
+            try:
+                out = classify_run(code, stderr, text, d / "out")
+            except Exception as exc:  # noqa: BLE001 - an unreadable results.json
+                out = Outcome("run_bug", f"exit {code}, results unreadable: {exc}")
+        self.records.append(
+            RunRecord(
+                index,
+                base,
+                done,
+                out.status,
+                code,
+                out.detail.splitlines()[0][:200] if out.detail else "",
+                ru.ru_maxrss / 1024,
+                wall,
+                ru.ru_utime + ru.ru_stime,
+            )
+        )
+        shutil.rmtree(d, ignore_errors=True)
+        if self.on_record is not None:
+            self.on_record(self.records[-1])
+
+    def _reap(self, block: bool) -> None:
+        import os
+        import signal
+
+        while True:
+            done = False
+            for pid, (_job, t0, _d) in list(self.running.items()):
+                got, status, ru = os.wait4(pid, os.WNOHANG)
+                if got:
+                    self._finish(pid, status, ru, False)
+                    done = True
+                elif time.monotonic() - t0 > self.timeout_s:
+                    os.kill(pid, signal.SIGKILL)
+                    _, status, ru = os.wait4(pid, 0)
+                    self._finish(pid, status, ru, True)
+                    done = True
+            if done or not block or not self.running:
+                return
+            time.sleep(0.02)
+
+    def poll(self) -> None:
+        """Reap finished children and kill those past the time-out, without waiting."""
+        self._reap(block=False)
+
+    def drain(self) -> list[RunRecord]:
+        """Wait for every child; the records of all runs so far."""
+        while self.running:
+            self._reap(block=True)
+        return self.records
 
 
 # ----------------------------------------------------------------------------- measurement files
@@ -607,22 +891,33 @@ def run(
     verbose: bool = False,
     runs: int = 0,
     run_timeout_s: float = 120.0,
+    server: ForkServer | None = None,
+    records: Any = None,
 ) -> Counter[str]:
     """Fuzz ``count`` mutants; returns the tally of outcomes (examples printed if verbose).
-    The first ``runs`` accepted mutants also go through ``gearte run`` (:func:`run_cli`)."""
+    The first ``runs`` accepted mutants (``-1``: every one) also go through ``gearte run``: in
+    children of ``server`` when given, else in this process (:func:`run_cli`)."""
     rng = random.Random(seed)
     bases = corpus()
     names = sorted(bases)
     tally: Counter[str] = Counter()
+    link_case_data(tmp)
     for i in range(count):
         name = names[i % len(names)]
         text, done = mutant_text(bases[name], rng)
         out = check_text(text, tmp)
         tally[out.status] += 1
+        if server is not None:
+            server.poll()
         if verbose and out.status in ("crash", "coerced", "bad_message"):
             print(f"[{out.status}] {name}: {done}\n    {out.detail}", file=sys.stderr)
-        if out.status == "accepted" and tally["run_total"] < runs:
+        if records is not None:
+            records.write(json.dumps({"index": i, "base": name, "done": done, **vars(out)}) + "\n")
+        if out.status == "accepted" and (runs < 0 or tally["run_total"] < runs):
             tally["run_total"] += 1
+            if server is not None:
+                server.submit(i, name, done, text)
+                continue
             r = run_cli(text, tmp, run_timeout_s)
             tally[r.status] += 1
             if verbose and r.status in BAD_RUN:
@@ -632,10 +927,47 @@ def run(
 
 #: Outcomes that fail the harness.
 BAD = ("crash", "coerced", "bad_message", "file_crash", "file_bad_message", "file_nonfinite")
-BAD_RUN = ("run_bug", "run_timeout", "run_memory", "run_coerced")
+
+
+def equivalence(
+    count: int, seed: int, tmp: Path, server: ForkServer, timeout_s: float
+) -> list[str]:
+    """The first ``count`` accepted mutants of ``seed``, run both as real ``gearte run``
+    processes (:func:`run_subprocess`) and through the fork server: their outcomes must agree
+    (status and message). Returns the disagreements."""
+    import tempfile
+
+    rng = random.Random(seed)
+    bases = corpus()
+    names = sorted(bases)
+    jobs = []
+    i = 0
+    while len(jobs) < count and i < 100 * count:
+        name = names[i % len(names)]
+        text, done = mutant_text(bases[name], rng)
+        if check_text(text, tmp).status == "accepted":
+            jobs.append((i, name, done, text))
+        i += 1
+    first = len(server.records)
+    server.on_record = None  # not part of the fuzzed runs
+    for job in jobs:
+        server.submit(*job)
+    forked = {r.index: r for r in server.drain()[first:]}
+    bad = []
+    for i, name, done, text in jobs:
+        with tempfile.TemporaryDirectory(dir=tmp) as d:
+            ref = run_subprocess(text, Path(d), timeout_s, server.report)
+        got = forked[i]
+        ref_msg = ref.detail.splitlines()[0][:200] if ref.detail else ""
+        same_msg = ref_msg == got.message or ref.status == "run_exit_0"
+        if ref.status != got.status or not same_msg:
+            bad.append(f"{name}: {done}: subprocess {ref.status} {ref_msg!r} != fork {got}")
+    return bad
 
 
 def main(argv: list[str] | None = None) -> int:
+    _single_threaded()
+    import os
     import resource
     import tempfile
 
@@ -644,25 +976,91 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--files", type=int, default=0, help="mutated measurement files")
     ap.add_argument("--seed", type=int, default=13)
     ap.add_argument("--quiet", action="store_true")
-    ap.add_argument("--runs", type=int, default=0, help="accepted mutants also run (gearte run)")
-    ap.add_argument("--run-timeout", type=float, default=120.0)
+    ap.add_argument(
+        "--runs",
+        type=int,
+        default=0,
+        help="accepted mutants also run through gearte run (-1: every accepted mutant)",
+    )
+    ap.add_argument("--run-timeout", type=float, default=120.0, help="per run, wall [s]")
+    ap.add_argument(
+        "--run-cpu-limit",
+        type=int,
+        default=None,
+        help="per run, CPU time [s] (RLIMIT_CPU of the fork server's child); with it the wall "
+        "time-out is only a backstop: give a larger --run-timeout on a shared machine",
+    )
+    ap.add_argument(
+        "--workers", type=int, default=os.cpu_count() or 1, help="runs at once (fork server)"
+    )
+    ap.add_argument(
+        "--in-process",
+        action="store_true",
+        help="run mutants in this process one by one (no fork server)",
+    )
+    ap.add_argument(
+        "--equivalence",
+        type=int,
+        default=0,
+        help="accepted mutants also run as real `gearte run` processes, compared to the fork",
+    )
+    ap.add_argument("--report", action="store_true", help="runs also write report.html")
+    ap.add_argument("--record", type=Path, default=None, help="JSON lines: every mutant and run")
     a = ap.parse_args(argv)
-    if a.runs:
-        resource.setrlimit(resource.RLIMIT_AS, (RUN_MEMORY_LIMIT, RUN_MEMORY_LIMIT))
     t0 = time.perf_counter()
+    records = a.record.open("w", encoding="utf-8") if a.record else None
     with tempfile.TemporaryDirectory() as d:
-        tally = run(a.count, a.seed, Path(d), not a.quiet, a.runs, a.run_timeout)
+        tmp = Path(d)
+        server = None
+        warm_s = 0.0
+        if a.runs and not a.in_process:
+
+            def on_record(r: RunRecord) -> None:  # as each run ends: a long job can be followed
+                if records is not None:
+                    records.write(json.dumps({"run": vars(r)}) + "\n")
+                    records.flush()
+                if not a.quiet and r.status in BAD_RUN:
+                    print(f"[{r.status}] {r.base}: {r.done}\n    {r.message}", file=sys.stderr)
+
+            server = ForkServer(tmp, a.workers, a.run_timeout, a.report, on_record, a.run_cpu_limit)
+            warmed = server.warm()
+            warm_s = time.perf_counter() - t0
+            if not a.quiet:
+                print(f"warm parent in {warm_s:.1f} s: {warmed}", file=sys.stderr)
+        elif a.runs:
+            resource.setrlimit(resource.RLIMIT_AS, (RUN_MEMORY_LIMIT, RUN_MEMORY_LIMIT))
+        tally = run(a.count, a.seed, tmp, not a.quiet, a.runs, a.run_timeout, server, records)
+        if server is not None:
+            for r in server.drain():
+                tally[r.status] += 1
         t1 = time.perf_counter()
-        tally += fuzz_measurements(a.files, a.seed, Path(d), not a.quiet)
-    t2 = time.perf_counter()
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # kB -> GB
+        mismatches: list[str] = []
+        if a.equivalence and server is not None:
+            mismatches = equivalence(a.equivalence, a.seed + 1, tmp, server, a.run_timeout)
+            tally["equivalence_checked"] = a.equivalence
+            tally["equivalence_mismatch"] = len(mismatches)
+            for m in mismatches:
+                print(f"[equivalence] {m}", file=sys.stderr)
+        t2 = time.perf_counter()
+        tally += fuzz_measurements(a.files, a.seed, tmp, not a.quiet)
+    t3 = time.perf_counter()
+    if records is not None:
+        records.close()
+    runs = server.records if server is not None else []
+    peak_self = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # kB -> GB
+    peak_run = max((r.peak_rss_mb for r in runs), default=0.0) / 1024
+    slowest = max((r.wall_s for r in runs), default=0.0)
+    cpu = sum(r.cpu_s for r in runs)
     print(
-        f"{a.count} fuzzed case files ({tally['run_total']} also run) in {t1 - t0:.1f} s, "
-        f"{a.files} fuzzed measurement files in {t2 - t1:.1f} s (seed {a.seed}); peak memory "
-        f"{peak:.2f} GB (bound {RUN_MEMORY_LIMIT / 2**30:.0f} GB when running): "
+        f"{a.count} fuzzed case files ({tally['run_total']} accepted mutants also run, "
+        f"{'fork server, ' + str(a.workers) + ' workers' if server else 'in process'}) in "
+        f"{t1 - t0:.1f} s (warm-up {warm_s:.1f} s; runs {cpu:.1f} s CPU, slowest {slowest:.1f} s "
+        f"wall, peak RSS of a run {peak_run:.2f} GB, bound {RUN_MEMORY_LIMIT / 2**30:.0f} GiB "
+        f"address space); equivalence {t2 - t1:.1f} s; {a.files} fuzzed measurement files in "
+        f"{t3 - t2:.1f} s (seed {a.seed}); peak RSS of the harness {peak_self:.2f} GB: "
         f"{dict(sorted(tally.items()))}"
     )
-    bad = sum(tally[k] for k in BAD + BAD_RUN)
+    bad = sum(tally[k] for k in BAD + BAD_RUN) + len(mismatches)
     return 1 if bad else 0
 
 

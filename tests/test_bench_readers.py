@@ -239,6 +239,8 @@ def test_unreadable_and_binary_files_and_folders(tmp_path):
         read_te_trace(tmp_path / "missing.csv")
     with pytest.raises(BenchFileError, match="folder"):
         read_te_trace(tmp_path)
+    with pytest.raises(BenchFileError, match="cannot read: embedded null byte"):
+        read_te_trace(str(tmp_path / "a\x00b.csv"))
     (tmp_path / "empty").mkdir()
     with pytest.raises(BenchFileError, match="no file matching"):
         read_te_folder(tmp_path / "empty")

@@ -8,10 +8,13 @@ from __future__ import annotations
 
 import random
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+import fuzzing
 from fuzzing import (
+    ForkServer,
     check_measurement,
     check_text,
     corpus,
@@ -19,6 +22,7 @@ from fuzzing import (
     mutant_text,
     mutate_csv,
     run_cli,
+    run_subprocess,
     to_toml,
 )
 
@@ -83,3 +87,124 @@ def test_fuzzed_case_files_run_with_exit_0_1_or_2_and_no_coercion(tmp_path):
         if len(ran) == 4:
             break
     assert len(ran) == 4
+
+
+def _accepted(tmp_path, names, n, seed):
+    rng = random.Random(seed)
+    got = []
+    for i in range(100 * n):
+        name = names[i % len(names)]
+        text, done = mutant_text(CORPUS[name], rng)
+        if check_text(text, tmp_path).status == "accepted":
+            got.append((i, name, done, text))
+            if len(got) == n:
+                break
+    return got
+
+
+@pytest.fixture
+def forked(monkeypatch):
+    """The pids the fork server forks; :func:`_reaped` checks they are all reaped."""
+    import os
+
+    pids: list[int] = []
+    real_fork = os.fork
+
+    def fork() -> int:
+        pid = real_fork()
+        if pid:
+            pids.append(pid)
+        return pid
+
+    monkeypatch.setattr(os, "fork", fork)
+    return pids
+
+
+def _reaped(pids):
+    import os
+
+    for pid in pids:
+        try:
+            os.waitpid(pid, os.WNOHANG)
+        except ChildProcessError:
+            continue
+        return False
+    return bool(pids)
+
+
+def test_fork_server_runs_accepted_mutants_as_gearte_run_and_records_each(tmp_path, forked):
+    """The long job's path: a forked child per accepted mutant runs the CLI entry point; each
+    run is recorded with its exit code, message, peak RSS and CPU time, and every child is
+    reaped."""
+    server = ForkServer(tmp_path, workers=2, timeout_s=120)
+    assert server.warm(FAST[:1]) == {FAST[0]: "run_exit_0"}  # the parent: imports and kernels
+    jobs = _accepted(tmp_path, FAST[:1], 2, 7)
+    for job in jobs:
+        server.submit(*job)
+    records = server.drain()
+    assert [r.index for r in sorted(records, key=lambda r: r.index)] == [j[0] for j in jobs]
+    for r in records:
+        assert r.status in ("run_exit_0", "run_exit_1", "run_exit_2"), r
+        assert r.code in (0, 1, 2) and r.peak_rss_mb > 0 and r.cpu_s > 0 and r.wall_s > 0
+    assert _reaped(forked)
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith("run")] == []
+
+
+def test_fork_server_kills_and_reaps_a_run_past_its_time_out(tmp_path, monkeypatch, forked):
+    import time
+
+    monkeypatch.setattr(fuzzing, "_cli_exit_code", lambda args: time.sleep(60) or 0)
+    server = ForkServer(tmp_path, workers=1, timeout_s=1.0)
+    server.submit(0, "jiang2024_spur_pair", "none", to_toml(CORPUS["jiang2024_spur_pair"]))
+    (r,) = server.drain()
+    assert r.status == "run_timeout" and r.code is None and r.wall_s < 30
+    assert _reaped(forked)
+
+
+def test_fork_server_counts_a_run_past_the_memory_bound(tmp_path, monkeypatch):
+    """A child that allocates past the address-space limit (the memory bound) fails to
+    allocate and is counted as ``run_memory`` — a failure of the harness."""
+
+    def hog(args):  # reserved, never touched: fails at the limit without using memory
+        import numpy as np
+
+        blocks = [np.empty(2**30, np.uint8) for _ in range(fuzzing.RUN_MEMORY_LIMIT // 2**30 + 1)]
+        return len(blocks)
+
+    monkeypatch.setattr(fuzzing, "_cli_exit_code", hog)
+    server = ForkServer(tmp_path, workers=1, timeout_s=60)
+    server.submit(0, "jiang2024_spur_pair", "none", to_toml(CORPUS["jiang2024_spur_pair"]))
+    (r,) = server.drain()
+    assert r.status == "run_memory" and r.status in fuzzing.BAD_RUN
+    assert r.peak_rss_mb < fuzzing.RUN_MEMORY_LIMIT / 2**20
+
+
+@pytest.mark.slow
+def test_fork_server_and_real_gearte_run_processes_agree(tmp_path):
+    """The same accepted mutants as real ``gearte run`` processes and through the fork server:
+    same outcome and message."""
+    server = ForkServer(tmp_path, workers=2, timeout_s=120)
+    jobs = _accepted(tmp_path, ["jiang2024_spur_pair", "wang2013_2kh_eq9"], 2, 11)
+    for job in jobs:
+        server.submit(*job)
+    forked = {r.index: r for r in server.drain()}
+    for i, name, done, text in jobs:
+        ref = run_subprocess(text, tmp_path / f"sub{i}", 120)
+        assert ref.status == forked[i].status, (name, done, ref, forked[i])
+        if ref.status != "run_exit_0":
+            assert ref.detail.splitlines()[0][:200] == forked[i].message
+
+
+def test_fork_server_stops_a_run_past_its_cpu_time_limit(tmp_path, monkeypatch, forked):
+    """On a shared machine the limit is CPU time (RLIMIT_CPU), the wall time-out a backstop."""
+
+    def spin(args):
+        while True:
+            pass
+
+    monkeypatch.setattr(fuzzing, "_cli_exit_code", spin)
+    server = ForkServer(tmp_path, workers=1, timeout_s=120, cpu_limit_s=1)
+    server.submit(0, "jiang2024_spur_pair", "none", to_toml(CORPUS["jiang2024_spur_pair"]))
+    (r,) = server.drain()
+    assert r.status == "run_timeout" and "CPU" in r.message and r.cpu_s > 0.5
+    assert _reaped(forked)

@@ -239,6 +239,16 @@ def test_binary_file_is_refused(tmp_path):
         mt.read_runout(p)
 
 
+def test_folder_and_nul_path_give_one_plain_error(tmp_path):
+    """A folder is named as such (not wrapped in "cannot read: <file>: ..."), and a path with a
+    NUL byte is a MeasurementFileError, not a bare ValueError (io/_textfile.py)."""
+    with pytest.raises(MeasurementFileError, match="is a folder") as ei:
+        mt.read_runout(tmp_path)
+    assert "cannot read" not in str(ei.value)
+    with pytest.raises(MeasurementFileError, match="cannot read: embedded null byte"):
+        mt.read_runout(str(tmp_path / "a\x00b.csv"))
+
+
 _ALPHABET = st.sampled_from(list("serial,toothpfiledv_[]um1234567890.-#: \nDnaNx;\t"))
 
 

@@ -283,3 +283,15 @@ def test_nonfinite_values_are_written_as_null_with_a_warning():
     doc = json.loads(result.to_json())
     assert doc["analyses"]["demo"]["values"]["ratio"] is None
     assert any("ratio" in w and "null" in w for w in doc["warnings"])
+
+
+def test_table_named_after_a_long_label_gets_a_file_name_that_fits():
+    """Found by the fuzzing run: a gear-chain stage named with 300 characters named a CSV table
+    whose file name the file system refused (exit 4 after the whole run). Long names are cut
+    and made unique by a hash."""
+    from gearte.report.tables import _file_name
+
+    a, b = _file_name("x" * 300 + "_a"), _file_name("x" * 300 + "_b")
+    assert len(a.encode()) <= 255 and len(b.encode()) <= 255 and a != b
+    assert _file_name("stage_1_lost_motion") == "stage_1_lost_motion.csv"
+    assert len(_file_name("é" * 300).encode()) <= 255

@@ -114,3 +114,17 @@ def test_true_is_not_a_sign():
     data["errors"]["terms"][5]["angle_coeff"] = True
     field, msg = _one_error(data)
     assert field == "errors.terms.5.angle_coeff" and "boolean" in msg
+
+
+@pytest.mark.parametrize("name", ["x" * 300, "a\x00b"])
+def test_chain_drive_case_that_cannot_be_a_file_name_is_a_case_error(name):
+    """Found by the fuzzing run through the fork server: ``drive.case = "xxx…"`` (300
+    characters) raised ``OSError: File name too long`` out of validation (exit 3); it is a
+    case error naming the stage's drive."""
+    data = _bundled("robot_joint_spur_rv_yield")
+    (stage,) = [s for s in data["chain"]["stages"] if "case" in s.get("drive", {})]
+    stage["drive"]["case"] = name
+    with pytest.raises(CaseFileError) as err:
+        load_case_dict(data, base_dir=str(case_path("robot_joint_spur_rv_yield").parent))
+    (field, msg), *_ = err.value.errors
+    assert field.startswith("chain.stages.") and field.endswith(".drive") and "\n" not in msg

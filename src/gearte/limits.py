@@ -15,6 +15,12 @@ points of a sweep          1000                     ``GEARTE_MAX_SWEEP_POINTS``
 Dask cluster with no       300 s, then the cluster  ``GEARTE_NO_WORKER_TIMEOUT_S`` (0: forever)
 worker                     counts as lost
 =========================  =======================  ===========================================
+
+``--samples N`` sets each kind's main sample count (bounded by that field's cap,
+``gearte.studies.check_samples_override``) and caps every other count of sampled work — Sobol
+base samples, bootstrap, kept worst samples, allocation search and verification, random
+assemblies, diagnosis draws, speed-sweep points, quasi-random starts — at ``N``, never below the
+field's own minimum (``gearte.studies.sample_cap``; docs/errors.md, "``--samples N``").
 """
 
 from __future__ import annotations

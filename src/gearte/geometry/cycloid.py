@@ -123,6 +123,11 @@ def geometry_radii(
     raise ParameterError("k1_definition", k1_definition, "must be 'ground' or 'nominal'")
 
 
+def _k1(z_p: int, r_p: float, a: float, dr_p: float, k1_definition: str) -> float:
+    """K1 = a z_p / R [-], R the pin-circle radius of the K1 definition (:func:`geometry_radii`)."""
+    return a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
+
+
 def _S(K1: float, phi: ArrayLike) -> np.ndarray:
     """S(φ) = (1 + K1² − 2 K1 cos φ)^(1/2) (eq 4, Φ(K1, φ)⁻¹)."""
     return np.sqrt(1.0 + K1 * K1 - 2.0 * K1 * np.cos(phi))
@@ -465,7 +470,7 @@ def normal_clearance_unclosed(
     Hu et al. (2020) eq 32 (its unclosed part), doi:10.3390/app10020481.
     """
     phi = np.asarray(phi, dtype=float)
-    K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
+    K1 = _k1(z_p, r_p, a, dr_p, k1_definition)
     S = _S(K1, phi)
     l_abs = np.abs(normal_arm(phi, z_p=z_p, a=a, K1=K1))
     return dr_rp - dr_p * (1.0 - K1 * np.cos(phi)) / S + l_abs * rotation
@@ -510,7 +515,7 @@ def closing_rotation(
     ----------
     Hu et al. (2020) eq 32–34, doi:10.3390/app10020481.
     """
-    K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
+    K1 = _k1(z_p, r_p, a, dr_p, k1_definition)
     return (dr_rp - dr_p * math.sqrt(1.0 - K1 * K1)) / (a * (z_p - 1)) + rotation
 
 
@@ -582,7 +587,7 @@ def initial_clearance(
     Hu et al. (2020) eq 32–34, doi:10.3390/app10020481.
     """
     phi = np.asarray(phi, dtype=float)
-    K1 = a * z_p / geometry_radii(r_p, 0.0, 0.0, dr_p, k1_definition)[0]
+    K1 = _k1(z_p, r_p, a, dr_p, k1_definition)
     S = _S(K1, phi)
     s = np.sin(phi)
     return (
@@ -638,9 +643,7 @@ def envelope_gaps(
     px, py = theoretical_profile_xy(t0, z_p=zp, R=stage.r_p, a=stage.a)
     c, s = np.cos(-beta)[:, None], np.sin(-beta)[:, None]
     qx, qy = c * px - s * py, s * px + c * py
-    kw: dict[str, Any] = dict(
-        z_p=zp, r_p=stage.r_p, r_rp=stage.r_rp, a=stage.a, dr_rp=stage.dr_rp, dr_p=stage.dr_p
-    )
+    kw = stage._profile_kw
     t = t0.copy()
     h = 1e-4
     for _ in range(newton_steps):
@@ -833,8 +836,7 @@ class CycloidStage:
     @property
     def K1(self) -> float:  # noqa: N802 - paper symbol
         """Short-width coefficient (eq 3, or a z_p / r_p with ``k1_definition="nominal"``) [-]."""
-        R_k1 = geometry_radii(self.r_p, self.r_rp, self.dr_rp, self.dr_p, self.k1_definition)[0]
-        return self.a * self.z_p / R_k1
+        return _k1(self.z_p, self.r_p, self.a, self.dr_p, self.k1_definition)
 
     @property
     def i_h(self) -> float:
@@ -869,15 +871,7 @@ class CycloidStage:
     @property
     def backlash_per_flank(self) -> float:
         """Closing rotation β0 = Δ_n(φ0)/r_c + δ_rot [rad] (negative: preloaded)."""
-        return closing_rotation(
-            z_p=self.z_p,
-            r_p=self.r_p,
-            a=self.a,
-            dr_rp=self.dr_rp,
-            dr_p=self.dr_p,
-            rotation=self.rotation,
-            k1_definition=self.k1_definition,
-        )
+        return closing_rotation(rotation=self.rotation, **self._clearance_kw)
 
     @property
     def curvature_cap(self) -> float:
@@ -890,6 +884,25 @@ class CycloidStage:
         return self.tip_radius
 
     # bound functions -------------------------------------------------------------------------
+    @property
+    def _profile_kw(self) -> dict[str, Any]:
+        """The stage's sizes and radial modifications as keywords of :func:`profile_xy`."""
+        return dict(
+            z_p=self.z_p, r_p=self.r_p, r_rp=self.r_rp, a=self.a, dr_rp=self.dr_rp, dr_p=self.dr_p
+        )
+
+    @property
+    def _clearance_kw(self) -> dict[str, Any]:
+        """The keywords the clearance functions (eq 32–34, 40) take from the stage."""
+        return dict(
+            z_p=self.z_p,
+            r_p=self.r_p,
+            a=self.a,
+            dr_rp=self.dr_rp,
+            dr_p=self.dr_p,
+            k1_definition=self.k1_definition,
+        )
+
     def pin_phases(self, mesh_angle: ArrayLike = 0.0) -> np.ndarray:
         """Meshing phase of every pin [rad] at the given mesh position(s)."""
         return meshing_phase(self.z_p, mesh_angle)
@@ -897,31 +910,12 @@ class CycloidStage:
     def profile_xy(self, phi: ArrayLike, *, modified: bool = True, flank: int = 0):
         """Profile coordinates [mm]; ``modified=False`` gives the unmodified profile."""
         if modified:
-            return profile_xy(
-                phi,
-                z_p=self.z_p,
-                r_p=self.r_p,
-                r_rp=self.r_rp,
-                a=self.a,
-                dr_rp=self.dr_rp,
-                dr_p=self.dr_p,
-                rotation=self.rotation,
-                flank=flank,
-            )
+            return profile_xy(phi, rotation=self.rotation, flank=flank, **self._profile_kw)
         return profile_xy(phi, z_p=self.z_p, r_p=self.r_p, r_rp=self.r_rp, a=self.a)
 
     def curvature_radius(self, phi: ArrayLike) -> np.ndarray:
         """Curvature radius (eq 40) [mm]."""
-        return curvature_radius(
-            phi,
-            z_p=self.z_p,
-            r_p=self.r_p,
-            r_rp=self.r_rp,
-            a=self.a,
-            dr_rp=self.dr_rp,
-            dr_p=self.dr_p,
-            k1_definition=self.k1_definition,
-        )
+        return curvature_radius(phi, r_rp=self.r_rp, **self._clearance_kw)
 
     def S(self, phi: ArrayLike) -> np.ndarray:  # noqa: N802 - paper symbol
         """S(φ) = (1 + K1² − 2 K1 cos φ)^½ [-] (eq 4); |pitch point − pin centre| = r_p S."""
@@ -933,25 +927,8 @@ class CycloidStage:
 
     def initial_clearance(self, phi: ArrayLike) -> np.ndarray:
         """Initial normal clearance after the closing rotation, eq 32 [mm]."""
-        return initial_clearance(
-            phi,
-            z_p=self.z_p,
-            r_p=self.r_p,
-            a=self.a,
-            dr_rp=self.dr_rp,
-            dr_p=self.dr_p,
-            k1_definition=self.k1_definition,
-        )
+        return initial_clearance(phi, **self._clearance_kw)
 
     def normal_clearance_unclosed(self, phi: ArrayLike) -> np.ndarray:
         """Normal clearance of each flank before the closing rotation [mm]."""
-        return normal_clearance_unclosed(
-            phi,
-            z_p=self.z_p,
-            r_p=self.r_p,
-            a=self.a,
-            dr_rp=self.dr_rp,
-            dr_p=self.dr_p,
-            rotation=self.rotation,
-            k1_definition=self.k1_definition,
-        )
+        return normal_clearance_unclosed(phi, rotation=self.rotation, **self._clearance_kw)

@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from gearte.errors import BenchFileError
+from gearte.io._textfile import read_header, read_text_file
 from gearte.models.bench_data import HysteresisCurve, TETrace
 from gearte.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, Nm_to_Nmm, rad_to_deg
 
@@ -111,33 +112,9 @@ class _Table:
         unit = f" [{self.units[j]}]" if self.units[j] else ""
         return f"{j + 1} '{self.names[j]}{unit}'"
 
-
-def _read_text(path: str | os.PathLike) -> tuple[str, str]:
-    src = str(path)
-    p = Path(path)
-    try:
-        if p.is_dir():
-            raise BenchFileError(src, None, None, "is a folder, expected a CSV file")
-        size = p.stat().st_size
-    except OSError as exc:
-        raise BenchFileError(src, None, None, f"cannot read: {exc.strerror or exc}") from None
-    if size > MAX_FILE_BYTES:
-        raise BenchFileError(
-            src, None, None, f"is {size} bytes; the limit is {MAX_FILE_BYTES} bytes"
-        )
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise BenchFileError(src, None, None, f"cannot read: {exc.strerror or exc}") from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise BenchFileError(src, line, None, "is not UTF-8 text (a binary file?)") from None
-    if "\x00" in text:
-        line = text[: text.index("\x00")].count("\n") + 1
-        raise BenchFileError(src, line, None, "contains a NUL byte (a binary file?)")
-    return src, text
+    def meta_error(self, key: str, reason: str) -> BenchFileError:
+        """The error of metadata ``key``, naming the line that declares it."""
+        return BenchFileError(self.source, self.meta_lines[key], None, reason)
 
 
 def _split_unit(cell: str) -> tuple[str, str | None]:
@@ -149,7 +126,7 @@ def _split_unit(cell: str) -> tuple[str, str | None]:
 
 
 def _parse(path, allowed, aliases, text_columns=()) -> _Table:
-    src, text = _read_text(path)
+    src, text = read_text_file(path, BenchFileError, MAX_FILE_BYTES)
     lines = text.splitlines()
     if not any(ln.strip() for ln in lines):
         raise BenchFileError(src, 1, None, "is empty (no header, no data)")
@@ -194,11 +171,7 @@ def _parse(path, allowed, aliases, text_columns=()) -> _Table:
                 meta[key] = value
             meta_lines[key] = i + 1
         i += 1
-    if i >= len(lines):
-        raise BenchFileError(src, len(lines), None, "has a header but no column names and no data")
-    header_line = i + 1
-    header = lines[i]
-    delim = "," if "," in header else ("\t" if "\t" in header else (";" if ";" in header else ","))
+    header_line, header, delim = read_header(lines, i, src, BenchFileError)
     cells = header.split(delim)
     names: list[str] = []
     units: list[str | None] = []
@@ -337,30 +310,20 @@ def _meta_fields(t: _Table) -> dict:
     m = t.meta
     if "speed_rpm" in m:
         if m["speed_rpm"] <= 0:
-            raise BenchFileError(
-                t.source,
-                t.meta_lines["speed_rpm"],
-                None,
-                f"speed_rpm must be > 0, got {m['speed_rpm']}",
-            )
+            raise t.meta_error("speed_rpm", f"speed_rpm must be > 0, got {m['speed_rpm']}")
         out["speed_rpm"] = m["speed_rpm"]
     if "oil_temperature_C" in m:
         if not -60.0 <= m["oil_temperature_C"] <= 250.0:
-            raise BenchFileError(
-                t.source,
-                t.meta_lines["oil_temperature_C"],
-                None,
+            raise t.meta_error(
+                "oil_temperature_C",
                 f"oil_temperature_C must be in [-60, 250] °C, got {m['oil_temperature_C']}",
             )
         out["oil_temperature"] = m["oil_temperature_C"]
     if "torque_Nm" in m:
         out["torque"] = float(Nm_to_Nmm(m["torque_Nm"]))
     if "sample_rate_Hz" in m and m["sample_rate_Hz"] <= 0:
-        raise BenchFileError(
-            t.source,
-            t.meta_lines["sample_rate_Hz"],
-            None,
-            f"sample_rate_Hz must be > 0, got {m['sample_rate_Hz']}",
+        raise t.meta_error(
+            "sample_rate_Hz", f"sample_rate_Hz must be > 0, got {m['sample_rate_Hz']}"
         )
     return out
 
@@ -368,9 +331,7 @@ def _meta_fields(t: _Table) -> dict:
 def _check_kind(t: _Table, want: str) -> None:
     kind = t.meta.get("kind")
     if kind is not None and kind != want:
-        raise BenchFileError(
-            t.source, t.meta_lines["kind"], None, f"declares kind {kind!r}; expected {want!r}"
-        )
+        raise t.meta_error("kind", f"declares kind {kind!r}; expected {want!r}")
 
 
 # ---- TE traces ---------------------------------------------------------------------------

@@ -56,6 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from gearte.errors import MeasurementFileError
+from gearte.io._textfile import read_header, read_text_file
 from gearte.units import DEG_PER_RAD, mm_to_um, rad_to_deg
 
 __all__ = [
@@ -221,34 +222,9 @@ def _err(src: str, line: int | None, col: str | None, reason: str) -> Measuremen
     return MeasurementFileError(src, line, col, reason)
 
 
-def _read_text(path: str | os.PathLike) -> tuple[str, str]:
-    src = str(path)
-    p = Path(path)
-    try:
-        if p.is_dir():
-            raise _err(src, None, None, "is a folder, expected a CSV file")
-        size = p.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise _err(src, None, None, f"is {size} bytes; the limit is {MAX_FILE_BYTES} bytes")
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise _err(src, None, None, f"cannot read: {exc.strerror or exc}") from None
-    except ValueError as exc:  # a NUL byte in the path
-        raise _err(src, None, None, f"cannot read: {exc}") from None
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise _err(src, line, None, "is not UTF-8 text (a binary file?)") from None
-    if "\x00" in text:
-        line = text[: text.index("\x00")].count("\n") + 1
-        raise _err(src, line, None, "contains a NUL byte (a binary file?)")
-    return src, text
-
-
 def _parse(path: str | os.PathLike, fmt: str) -> _Table:
     spec = FORMATS[fmt]
-    src, text = _read_text(path)
+    src, text = read_text_file(path, MeasurementFileError, MAX_FILE_BYTES)
     lines = text.splitlines()
     if not any(ln.strip() for ln in lines):
         raise _err(src, 1, None, "is empty (no header, no data)")
@@ -292,11 +268,7 @@ def _parse(path: str | os.PathLike, fmt: str) -> _Table:
                         f"temperature_C must be a number in [-60, 250], got {value!r}",
                     )
         i += 1
-    if i >= len(lines):
-        raise _err(src, len(lines), None, "has a header but no column names and no data")
-    header_line = i + 1
-    header = lines[i]
-    delim = "," if "," in header else ("\t" if "\t" in header else (";" if ";" in header else ","))
+    header_line, header, delim = read_header(lines, i, src, MeasurementFileError)
     names: list[str] = []
     units: list[str | None] = []
     for j, cell in enumerate(header.split(delim)):

@@ -282,6 +282,34 @@ def _limits(field: str, lower: float, upper: float, *, nonneg: bool = False) -> 
         raise ParameterError(field, (lower, upper), "a clearance cannot be negative (>= 0)")
 
 
+def _validate_gear(gear: SpurGear | BevelGear, prefix: str) -> None:
+    """The checks every gear of a pair shares: its teeth and its tooth-thickness limits."""
+    if gear.teeth < 5:
+        raise ParameterError(f"{prefix}.teeth", gear.teeth, "must be >= 5")
+    _limits(f"{prefix}.thickness", gear.thickness_lower, gear.thickness_upper)
+
+
+def _validate_pair(pair: SpurPair | BevelPair) -> None:
+    """The checks every pair shares: both gears, the module and the pressure angle."""
+    pair.driving.validate("driving")
+    pair.driven.validate("driven")
+    _pos("module", pair.module)
+    if not 0 < pair.pressure_angle < math.pi / 2:
+        raise ParameterError("pressure_angle", pair.pressure_angle, "must be in (0, π/2) rad")
+
+
+def _thickness_contributor(
+    gear: SpurGear | BevelGear, prefix: str, cos_alpha: float, group: str | None = None
+) -> Contributor:
+    """The tooth-thickness contributor of ``gear`` (sensitivity −cos α, eq. 2 / eq. 15)."""
+    return Contributor(
+        f"{prefix} gear tooth thickness",
+        Normal.from_limits(gear.thickness_lower, gear.thickness_upper, field=f"{prefix}.thickness"),
+        -cos_alpha,
+        group,
+    )
+
+
 @dataclass(frozen=True)
 class SpurGear:
     """One spur gear of a pair.
@@ -304,9 +332,7 @@ class SpurGear:
     radial_composite_tol: float
 
     def validate(self, prefix: str) -> None:
-        if self.teeth < 5:
-            raise ParameterError(f"{prefix}.teeth", self.teeth, "must be >= 5")
-        _limits(f"{prefix}.thickness", self.thickness_lower, self.thickness_upper)
+        _validate_gear(self, prefix)
         _pos(f"{prefix}.radial_composite_tol", self.radial_composite_tol)
 
 
@@ -341,11 +367,7 @@ class SpurPair:
     min_backlash_limit: float = 0.0
 
     def __post_init__(self) -> None:
-        self.driving.validate("driving")
-        self.driven.validate("driven")
-        _pos("module", self.module)
-        if not 0 < self.pressure_angle < math.pi / 2:
-            raise ParameterError("pressure_angle", self.pressure_angle, "must be in (0, π/2) rad")
+        _validate_pair(self)
         _nonneg("centre_distance_tol", self.centre_distance_tol)
         _limits("bearing_clearance", *self.bearing_clearance, nonneg=True)
         _pos("runout", self.runout)
@@ -374,22 +396,8 @@ class SpurPair:
         sa, ca = math.sin(a), math.cos(a)
         g1, g2 = self.driving, self.driven
         cs = [
-            Contributor(
-                "driving gear tooth thickness",
-                Normal.from_limits(
-                    g1.thickness_lower, g1.thickness_upper, field="driving.thickness"
-                ),
-                -ca,
-                "tooth thickness",
-            ),
-            Contributor(
-                "driven gear tooth thickness",
-                Normal.from_limits(
-                    g2.thickness_lower, g2.thickness_upper, field="driven.thickness"
-                ),
-                -ca,
-                "tooth thickness",
-            ),
+            _thickness_contributor(g1, "driving", ca, "tooth thickness"),
+            _thickness_contributor(g2, "driven", ca, "tooth thickness"),
             Contributor(
                 "centre distance",
                 Normal.from_tolerance(self.centre_distance_tol, field="centre_distance_tol"),
@@ -455,9 +463,7 @@ class BevelGear:
     seat_profile_tol: float
 
     def validate(self, prefix: str) -> None:
-        if self.teeth < 5:
-            raise ParameterError(f"{prefix}.teeth", self.teeth, "must be >= 5")
-        _limits(f"{prefix}.thickness", self.thickness_lower, self.thickness_upper)
+        _validate_gear(self, prefix)
         _limits(f"{prefix}.bearing_clearance", *self.bearing_clearance, nonneg=True)
         _nonneg(f"{prefix}.face_profile_tol", self.face_profile_tol)
         _nonneg(f"{prefix}.seat_profile_tol", self.seat_profile_tol)
@@ -500,11 +506,7 @@ class BevelPair:
     min_backlash_limit: float = 0.0
 
     def __post_init__(self) -> None:
-        self.driving.validate("driving")
-        self.driven.validate("driven")
-        _pos("module", self.module)
-        if not 0 < self.pressure_angle < math.pi / 2:
-            raise ParameterError("pressure_angle", self.pressure_angle, "must be in (0, π/2) rad")
+        _validate_pair(self)
         _pos("face_width", self.face_width)
         _nonneg("shaft_distance_tol", self.shaft_distance_tol)
         _nonneg("shaft_angle_tol", self.shaft_angle_tol)
@@ -545,20 +547,8 @@ class BevelPair:
             self.composite_tol, factor=math.sqrt(2.0), field="composite_tol"
         )
         cs = [
-            Contributor(
-                "driving gear tooth thickness",
-                Normal.from_limits(
-                    g1.thickness_lower, g1.thickness_upper, field="driving.thickness"
-                ),
-                -ca,
-            ),
-            Contributor(
-                "driven gear tooth thickness",
-                Normal.from_limits(
-                    g2.thickness_lower, g2.thickness_upper, field="driven.thickness"
-                ),
-                -ca,
-            ),
+            _thickness_contributor(g1, "driving", ca),
+            _thickness_contributor(g2, "driven", ca),
             Contributor("driving gear eccentricity", RadialPhase(ecc), 2 * sa * math.cos(d1)),
             Contributor("driven gear eccentricity", RadialPhase(ecc), 2 * sa * math.cos(d2)),
         ]

@@ -122,6 +122,21 @@ def _play(p: dict, model: ReducedRV) -> float:
     return g_cam * p["cam_bearing_clearance"] + g_car * p["carrier_bearing_clearance"]
 
 
+def _loading_branch(
+    model: ReducedRV, params: dict, torque: ArrayLike, direction: ArrayLike
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """The terms :func:`hysteresis_angle` and its Jacobian share: ``T`` [N·mm], ``s`` [-],
+    ``u = T − s T_fr`` [N·mm], ``x = u / T_r`` [-] and the elastic scale
+    ``e = T_r c_p / (f K_nom)`` [rad] (module docstring)."""
+    t = np.asarray(torque, dtype=float)
+    s = np.asarray(direction, dtype=float)
+    tr = model.rated_torque
+    u = t - s * params["friction_torque"]
+    cp = 0.5 / (1.0 - 0.5**STIFFNESS_EXPONENT)
+    e = tr * cp / (params["contact_stiffness_factor"] * model.nominal_rigidity)
+    return t, s, u, u / tr, e
+
+
 def hysteresis_angle(
     model: ReducedRV, params: dict, torque: ArrayLike, direction: ArrayLike
 ) -> np.ndarray:
@@ -144,15 +159,8 @@ def hysteresis_angle(
     numpy.ndarray
         θ(T, s) [rad] (module docstring).
     """
-    t = np.asarray(torque, dtype=float)
-    s = np.asarray(direction, dtype=float)
-    tr = model.rated_torque
-    u = t - s * params["friction_torque"]
-    p = STIFFNESS_EXPONENT
-    cp = 0.5 / (1.0 - 0.5**p)
-    x = u / tr
-    elastic = tr * cp / (params["contact_stiffness_factor"] * model.nominal_rigidity)
-    elastic = elastic * np.sign(x) * np.abs(x) ** p
+    t, _, u, x, e = _loading_branch(model, params, torque, direction)
+    elastic = e * np.sign(x) * np.abs(x) ** STIFFNESS_EXPONENT
     play = 0.5 * _play(params, model) * np.tanh(u / params["play_transition_torque"])
     return params["angle_offset"] + play + elastic + params["rig_compliance"] * t
 
@@ -183,17 +191,12 @@ def hysteresis_jacobian(
     dict
         Parameter name → ∂θ/∂parameter, shape (K,).
     """
-    t = np.asarray(torque, dtype=float)
-    s = np.asarray(direction, dtype=float)
+    t, s, u, x, e = _loading_branch(model, params, torque, direction)
     tr = model.rated_torque
     g_cam, g_car = model.backlash_per_clearance
     tb = params["play_transition_torque"]
     f = params["contact_stiffness_factor"]
-    u = t - s * params["friction_torque"]
-    x = u / tr
     p = STIFFNESS_EXPONENT
-    cp = 0.5 / (1.0 - 0.5**p)
-    e = tr * cp / (f * model.nominal_rigidity)
     ax = np.maximum(np.abs(x), 1e-12)
     th = np.tanh(u / tb)
     sech2 = 1.0 - th**2

@@ -67,6 +67,11 @@ def phasor_figure(result: Any) -> Figure | None:
     )
 
 
+def _output_te_arcsec(te: Any, u: np.ndarray) -> np.ndarray:
+    """Σe(u) of a coupled TE converted to output TE [arcsec]."""
+    return rad_to_arcsec(te.signal(u) * abs(te.scale))
+
+
 def te_period_figure(result: Any) -> Figure | None:
     """Σe(t) converted to output TE over one common period.
 
@@ -85,10 +90,9 @@ def te_period_figure(result: Any) -> Figure | None:
     a = result["coupled_te"]
     te = a.data["te"]
     u = a.data["u"]
-    per = float(1 / te.q0)  # input revolutions per common period
-    y = rad_to_arcsec(te.signal(u) * abs(te.scale))
+    revs = u / (2 * np.pi) * float(1 / te.q0)  # input revolutions (1 / q0 per common period)
     fig, ax = new_figure()
-    ax.plot(u / (2 * np.pi) * per, y, color=PALETTE[0], lw=1.2, label="Σ e(t) (coupled)")
+    ax.plot(revs, _output_te_arcsec(te, u), color=PALETTE[0], lw=1.2, label="Σ e(t) (coupled)")
     amp = a["coupled_te_amplitude [arcsec]"]
     ax.axhline(amp, color=PALETTE[1], ls="--", lw=1, label=f"± amplitude {amp:.1f}″")
     ax.axhline(-amp, color=PALETTE[1], ls="--", lw=1)
@@ -101,10 +105,9 @@ def te_period_figure(result: Any) -> Figure | None:
             from gearte.models.planetary_errors import coupled_te
 
             opt = coupled_te(d["terms"], d["mags"], d["optimal"].angles)
-        yo = rad_to_arcsec(opt.signal(u) * abs(opt.scale))
         ax.plot(
-            u / (2 * np.pi) * per,
-            yo,
+            revs,
+            _output_te_arcsec(opt, u),
             color=PALETTE[3],
             lw=1.0,
             label=f"optimal assembly (amplitude {result['assembly'][_OPT]:.1f}″)",

@@ -418,4 +418,9 @@ def csv_files(result: Any) -> dict[str, str]:
 
 def _file_name(key: str) -> str:
     safe = "".join(c if c.isalnum() or c in "-_" else "_" for c in key)
+    if len(safe.encode()) > 120:  # a table named after a long label: a file name must fit in 255
+        import hashlib
+
+        digest = hashlib.sha1(key.encode("utf-8", "surrogatepass")).hexdigest()[:12]
+        safe = safe.encode()[:100].decode("utf-8", "ignore") + "_" + digest
     return f"{safe}.csv"

@@ -35,6 +35,10 @@ from numba import njit
 
 from gearte.errors import DivergenceError, ParameterError
 
+#: Lower estimate of the time of one compiled RK4 step of a 30-DOF system [s], for the time
+#: budget (``gearte.limits.check_time``) checked before an integration.
+_RK4_STEP_S = 1e-6
+
 __all__ = [
     "ODESystem",
     "ODEResult",
@@ -598,7 +602,19 @@ def integrate(
                     f"{lim:.4g} s",
                 )
         # end exactly at t1: the step is shortened (never lengthened) to fit the span
-        n_steps = max(1, int(np.ceil((t1 - t0) / dt - 1e-9)))
+        steps = (t1 - t0) / dt
+        from gearte.limits import check_time
+
+        # before any step (found by fuzzing: a stiff model's tiny step made ~1e150 steps, an
+        # integer the compiled kernel cannot take, or a run of hours)
+        check_time(
+            "dt",
+            dt,
+            steps * _RK4_STEP_S,
+            f"an RK4 integration of {steps:.3g} steps of {dt:.3g} s over {t1 - t0:g} s (a stiff "
+            "model: check its masses, inertias and stiffnesses)",
+        )
+        n_steps = max(1, int(np.ceil(steps - 1e-9)))
         dt = (t1 - t0) / n_steps
         settle_steps = int(round(t_settle / dt))
         n_out = n_steps - settle_steps + 1

@@ -27,6 +27,7 @@ __all__ = [
     "register_kind",
     "run_case",
     "check_samples_override",
+    "sample_cap",
 ]
 
 
@@ -92,6 +93,32 @@ def check_samples_override(case: Any, samples: int | None) -> None:
     for path, cap in _sample_caps(case):
         if samples > cap:
             raise ParameterError("--samples", samples, f"over the cap of {path} (<= {cap})")
+
+
+def sample_cap(section: Any, name: str, options: Any, low: int | None = None) -> Any:
+    """The count ``section.<name>`` of a sampled analysis under ``--samples N``
+    (``options.samples``): ``min(count, N)``, never below the field's own lower bound (so a
+    quasi-random search keeps its fewest starts); the count itself without an override.
+
+    ``--samples`` sets the main sample count of each kind (yield, Monte-Carlo, batch) and caps
+    every other count of sampled work with this (Sobol base samples, bootstrap resamples, kept
+    worst samples, allocation and verification samples, random assemblies, diagnosis draws,
+    speed-sweep points, quasi-random starts): docs/errors.md, "Resource bounds". ``low``
+    replaces the field's lower bound where the analysis needs more than the schema says (a
+    Sobol estimate needs a minimum of base samples unless its count is 0: none).
+    """
+    value = getattr(section, name)
+    n = getattr(options, "samples", None)
+    if n is None or value is None:
+        return value
+    if low is None:
+        low = 0
+        for m in type(section).model_fields[name].metadata:
+            if getattr(m, "ge", None) is not None:
+                low = int(m.ge)
+            elif getattr(m, "gt", None) is not None:
+                low = int(m.gt) + 1
+    return max(low, min(int(value), int(n)))
 
 
 def run_case(case: Any, options: RunOptions | None = None) -> Any:

@@ -207,7 +207,21 @@ def build_dynamic_model(case, red: RVReducer):
         output_bearing_clearance_mm=red.supports.main_bearing_clearance,
         output_torque_Nm=op.output_torque_Nm,
     )
-    return RVDynamicModel(params, errors), mp
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            model = RVDynamicModel(params, errors)
+    except (IndexError, FloatingPointError, OverflowError, np.linalg.LinAlgError) as exc:
+        # found by fuzzing: a mass, inertia or length such as 1e-300 passes its schema bound
+        # (> 0) and leaves no finite elastic mode (the damping's ω1 does not exist)
+        from gearte.errors import ParameterError
+
+        raise ParameterError(
+            "reducer.dynamics",
+            type(exc).__name__,
+            "the 30-DOF model has no finite elastic mode: a mass, inertia, stiffness or length "
+            "of the reducer is out of physical proportion (e.g. 1e-300)",
+        ) from None
+    return model, mp
 
 
 def batch_tolerances(red: RVReducer, scale: float = 1.0):
@@ -464,9 +478,10 @@ def _sweep_one(task) -> float:
 
 def _speed_sweep(case, model, options) -> AnalysisResult:
     from gearte.execution import map_chunks
+    from gearte.studies import sample_cap
 
     o = case.analyses.speed_sweep
-    speeds = np.linspace(o.speed_min_rpm, o.speed_max_rpm, o.count)
+    speeds = np.linspace(o.speed_min_rpm, o.speed_max_rpm, sample_cap(o, "count", options))
     p2p = np.array(
         map_chunks(
             _sweep_one,

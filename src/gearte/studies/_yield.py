@@ -223,6 +223,18 @@ class AllocationEntry(StrictModel):
     )
 
 
+#: Fewest base samples of a Sobol estimate (``sobol_tolerances``).
+SOBOL_MIN_SAMPLES = 50
+#: Two-sided 95 % normal quantile of the allocation search's Wilson bound (``allocate``).
+_Z95 = 1.959963984540054
+
+
+def allocation_min_samples(target_yield: float) -> int:
+    """Fewest search samples that can show ``target_yield`` [-]: the 95 % Wilson lower bound of
+    ``n`` passes in ``n`` draws is ``n / (n + z²)``, so ``n >= t z² / (1 - t)``."""
+    return math.ceil(target_yield * _Z95**2 / (1.0 - target_yield) - 1e-9)
+
+
 class YieldSection(StrictModel):
     """``[analyses.yield]`` (module docstring)."""
 
@@ -262,6 +274,29 @@ class YieldSection(StrictModel):
     allocation: AllocationEntry | None = Field(
         None, description="Optional: the cheapest tolerances for a target yield."
     )
+
+    @model_validator(mode="after")
+    def _sample_counts_can_run(self) -> YieldSection:
+        if self.allocation is not None and not self.spec:
+            raise ValueError("allocation needs at least one spec limit (analyses.yield.spec)")
+        if 0 < self.sobol_samples < SOBOL_MIN_SAMPLES:
+            raise ValueError(
+                f"sobol_samples = {self.sobol_samples}: Sobol estimation needs 0 (none) or >= "
+                f"{SOBOL_MIN_SAMPLES} base samples"
+            )
+        if self.allocation is None:
+            return self
+        n = self.allocation.samples or self.samples
+        need = allocation_min_samples(self.allocation.target_yield)
+        if n < need:
+            which = "allocation.samples" if self.allocation.samples else "samples"
+            raise ValueError(
+                f"{which} = {n} cannot show allocation.target_yield = "
+                f"{self.allocation.target_yield}: even with every sample passing the 95 % "
+                f"Wilson lower bound is {n / (n + _Z95**2):.4g}; give allocation.samples >= "
+                f"{need}"
+            )
+        return self
 
 
 def _tolerances(
@@ -421,6 +456,7 @@ def yield_analysis(
         for the others): how ``grade = N`` reads for this drive.
     """
     from gearte.errors import ParameterError
+    from gearte.studies import sample_cap
     from gearte.tolerance.allocation import CostModel, PriceTable, allocate
     from gearte.tolerance.yield_contributions import (
         linear_prediction,
@@ -434,6 +470,16 @@ def yield_analysis(
     defaults = dict(defaults or {})
     ts = _tolerances(section, units, nominal, defaults, dict(families or {}), grade_um)
     spec = [SpecLimit(q, s.lower, s.upper) for q, s in section.spec.items()]
+    costs: dict[str, CostModel | PriceTable] = {}  # checked before any work
+    for key, c in (section.allocation.costs if section.allocation else {}).items():
+        if key not in ts.families:
+            raise ParameterError(
+                f"analyses.yield.allocation.costs.{key}", key, "has no tolerance to allocate"
+            )
+        if c.b is not None:
+            costs[key] = CostModel(c.a, c.b, c.k)
+        else:
+            costs[key] = PriceTable(tuple(c.widths or ()), tuple(c.prices or ()))
     progress = getattr(options, "progress", False)
     res = run_yield(
         model,
@@ -444,7 +490,7 @@ def yield_analysis(
         chunk_size=section.chunk_size,
         confidence=section.confidence,
         ci_method=section.ci_method,
-        keep_worst=section.keep_worst,
+        keep_worst=sample_cap(section, "keep_worst", options),
         options=options,
         progress=progress,
     )
@@ -482,14 +528,17 @@ def yield_analysis(
     data: dict[str, Any] = {"yield": res}
     files: dict[str, str] = {}
     sobol_q = spec[0].quantity if spec else next(iter(res.quantities), None)
-    if section.sobol_samples and sobol_q is not None and ts.tolerances:
+    sobol_n = section.sobol_samples and sample_cap(
+        section, "sobol_samples", options, low=SOBOL_MIN_SAMPLES
+    )
+    if sobol_n and sobol_q is not None and ts.tolerances:
         sob = sobol_tolerances(
             model,
             ts,
             [sobol_q],
-            section.sobol_samples,
+            sobol_n,
             seed=seed + 1,
-            bootstrap=section.bootstrap,
+            bootstrap=sample_cap(section, "bootstrap", options),
             options=options,
             progress=progress,
         )[sobol_q]
@@ -531,23 +580,17 @@ def yield_analysis(
             files[f"worst_sample_{i + 1}.toml"] = header + to_toml(case)
     values["worst_samples"] = worst
     if section.allocation is not None:
-        costs: dict[str, CostModel | PriceTable] = {}
-        for key, c in section.allocation.costs.items():
-            if key not in ts.families:
-                raise ParameterError(
-                    f"analyses.yield.allocation.costs.{key}", key, "has no tolerance to allocate"
-                )
-            if c.b is not None:
-                costs[key] = CostModel(c.a, c.b, c.k)
-            else:
-                costs[key] = PriceTable(tuple(c.widths or ()), tuple(c.prices or ()))
+        # under --samples: capped, but never below what can show the target (validated above)
+        alloc_n = sample_cap(section.allocation, "samples", options) or n
+        if getattr(options, "samples", None) is not None:
+            alloc_n = max(alloc_n, allocation_min_samples(section.allocation.target_yield))
         al = allocate(
             model,
             ts,
             spec,
             costs,
             section.allocation.target_yield,
-            n=section.allocation.samples or n,
+            n=alloc_n,
             seed=seed + 2,
             chunk_size=section.chunk_size,
             options=options,

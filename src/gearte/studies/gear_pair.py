@@ -533,6 +533,10 @@ class BevelPairSpec(_Distributions):
 PairSpec = Annotated[SpurPairSpec | BevelPairSpec, Field(discriminator="type")]
 
 
+#: Fewest base samples of the stack's Sobol estimate (``tolerance.contributions``).
+PAIR_SOBOL_MIN_SAMPLES = 100
+
+
 class PairAnalysisSpec(StrictModel):
     """How to analyse a pair."""
 
@@ -558,6 +562,15 @@ class PairAnalysisSpec(StrictModel):
         le=100_000,
         description="Optional upper spec of the normal backlash [µm] (for Cp and out-of-spec).",
     )
+
+    @model_validator(mode="after")
+    def _sobol_can_run(self) -> PairAnalysisSpec:
+        if 0 < self.sobol_samples < PAIR_SOBOL_MIN_SAMPLES:
+            raise ValueError(
+                f"sobol_samples = {self.sobol_samples}: Sobol estimation needs 0 (none) or >= "
+                f"{PAIR_SOBOL_MIN_SAMPLES} base samples"
+            )
+        return self
 
 
 class Case(CaseBase):
@@ -773,8 +786,13 @@ def analyse_pair(
         "first-order Sobol index). See docs/validation/jiang2024.md for how it relates to the "
         "3DCS contributions of the paper's Tables 3 and 7."
     ]
-    if analysis.sobol_samples:
-        sob = sobol_indices(stack, analysis.sobol_samples, seed=seed)
+    from gearte.studies import sample_cap
+
+    sobol_n = analysis.sobol_samples and sample_cap(
+        analysis, "sobol_samples", options, low=PAIR_SOBOL_MIN_SAMPLES
+    )
+    if sobol_n:
+        sob = sobol_indices(stack, sobol_n, seed=seed)
         cvals["sobol_first_order [%]"] = {k: 100 * v for k, v in sob.first_order.items()}
         cvals["sobol_total [%]"] = {k: 100 * v for k, v in sob.total.items()}
     out.append(

@@ -511,13 +511,15 @@ def run(case: Case, options) -> StudyResult:
             and "optimal_assembly_random_magnitudes" in case.analyses.monte_carlo.scenarios
         )
     ):
+        from gearte.studies import sample_cap
+
         ao = a_opts or AssemblyOptions()
         optimal = optimal_assembly(
             terms,
             mags,
             reference_value=angs.get(terms.reference_angle, 0.0) if terms.reference_angle else 0.0,
-            starts=ao.starts,
-            polish=ao.polish,
+            starts=sample_cap(ao, "starts", options),
+            polish=sample_cap(ao, "polish", options),
             seed=ao.seed,
             extra_starts=[paper.angles],
         )

@@ -225,7 +225,7 @@ def run(case: Case, options) -> StudyResult:
         cal_res, cal = _calibration(case, reducer, rcase, sources, traces, hyst, warnings)
         analyses.append(cal_res)
         if a.diagnosis is not None:
-            analyses.append(_diagnosis(cal, analyses, a.diagnosis, a.catalogue))
+            analyses.append(_diagnosis(cal, analyses, a.diagnosis, a.catalogue, options))
     return StudyResult(case=case, analyses=analyses, warnings=warnings)
 
 
@@ -435,7 +435,7 @@ def _calibration(case, reducer, rcase, sources, traces, hyst, warnings):
     return res, cal
 
 
-def _diagnosis(cal, analyses, sec: DiagnosisSection, cat_sec) -> AnalysisResult:
+def _diagnosis(cal, analyses, sec: DiagnosisSection, cat_sec, options) -> AnalysisResult:
     from gearte.runners.bench_diagnosis import diagnose
 
     spectrum = None
@@ -446,7 +446,10 @@ def _diagnosis(cal, analyses, sec: DiagnosisSection, cat_sec) -> AnalysisResult:
                 for x in a.values["te_orders"]
             ]
     lmf = (cat_sec or CatalogueSection()).lost_motion_fraction
-    dg = diagnose(cal, spectrum, lost_motion_fraction=lmf, draws=sec.draws, seed=sec.seed)
+    from gearte.studies import sample_cap
+
+    draws = sample_cap(sec, "draws", options)
+    dg = diagnose(cal, spectrum, lost_motion_fraction=lmf, draws=draws, seed=sec.seed)
 
     def conv(rows, key):
         return [

@@ -277,41 +277,28 @@ class RVDynamicModel:
                 return float(np.max(fourier_eval(mean, a, b, s)))
             return float(fourier_eval(mean, a, b, phase))
 
+        def bearing(name, rows, k, cl, err):
+            out.append(dict(name=name, kind="bearing", k=k, g=rows, cl=cl, e=err))
+
+        def line(name, k, g, err):
+            out.append(dict(name=name, kind="line", k=k, g=g, e=err))
+
         i_s, i_o = 0, self.n_bodies - 1
         k = p.sun_support_stiffness_N_per_m * N_PER_M_TO_N_PER_MM
         gx, gy = point_rows(i_s, (0, 0), None, None, (0, 0))
-        out.append(
-            dict(
-                name="sun support",
-                kind="bearing",
-                k=k,
-                g=(gx, gy),
-                cl=0.0,
-                e=-polar(*e.sun_assembly),
-            )
-        )
+        bearing("sun support", (gx, gy), k, 0.0, -polar(*e.sun_assembly))
         g = np.zeros(nd)
         g[2] = 1.0
-        out.append(
-            dict(
-                name="input shaft",
-                kind="line",
-                k=p.input_torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD,
-                g=g,
-                e=0.0,
-            )
+        line(
+            "input shaft",
+            p.input_torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD,
+            g,
+            0.0,
         )
         k = p.output_support_stiffness_N_per_m * N_PER_M_TO_N_PER_MM
         gx, gy = point_rows(i_o, (0, 0), None, None, (0, 0))
-        out.append(
-            dict(
-                name="output support",
-                kind="bearing",
-                k=k,
-                g=(gx, gy),
-                cl=e.output_bearing_clearance_mm,
-                e=-polar(*e.output_assembly),
-            )
+        bearing(
+            "output support", (gx, gy), k, e.output_bearing_clearance_mm, -polar(*e.output_assembly)
         )
         sun_off = polar(e.sun_eccentricity[0], th_s + e.sun_eccentricity[1])
         for i in range(m):
@@ -327,47 +314,35 @@ class RVDynamicModel:
             g = row([(0, (nvec[0], nvec[1], arm_a)), (ip, (-nvec[0], -nvec[1], -arm_b))])
             phase = p.sun_teeth * (th_s - th_o) + p.sun_teeth * 2 * np.pi * i / m
             pl_off = polar(e.planet_eccentricity[i, 0], th_h + e.planet_eccentricity[i, 1])
-            out.append(
-                dict(
-                    name=f"sun-planet{i + 1} mesh",
-                    kind="line",
-                    k=series(self.involute_fourier, phase),
-                    g=g,
-                    e=float(nvec @ (sun_off - pl_off)),
-                )
+            line(
+                f"sun-planet{i + 1} mesh",
+                series(self.involute_fourier, phase),
+                g,
+                float(nvec @ (sun_off - pl_off)),
             )
             gx, gy = point_rows(ip, ch, ih, ch, ch)
-            out.append(
-                dict(
-                    name=f"crank{i + 1} bending",
-                    kind="bearing",
-                    k=p.crank_bending_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
-                    g=(gx, gy),
-                    cl=0.0,
-                    e=np.zeros(2),
-                )
+            bearing(
+                f"crank{i + 1} bending",
+                (gx, gy),
+                p.crank_bending_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
+                0.0,
+                np.zeros(2),
             )
             g = np.zeros(nd)
             g[3 * ip + 2], g[3 * ih + 2] = 1.0, -1.0
-            out.append(
-                dict(
-                    name=f"crank{i + 1} torsion",
-                    kind="line",
-                    k=p.crank_torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD,
-                    g=g,
-                    e=0.0,
-                )
+            line(
+                f"crank{i + 1} torsion",
+                p.crank_torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD,
+                g,
+                0.0,
             )
             gx, gy = point_rows(ih, ch, i_o, (0, 0), ch)
-            out.append(
-                dict(
-                    name=f"crank{i + 1} support",
-                    kind="bearing",
-                    k=p.crank_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
-                    g=(gx, gy),
-                    cl=clear[i, n],
-                    e=-polar(e.carrier_hole[i, 0], psi + e.carrier_hole[i, 1]),
-                )
+            bearing(
+                f"crank{i + 1} support",
+                (gx, gy),
+                p.crank_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
+                clear[i, n],
+                -polar(e.carrier_hole[i, 0], psi + e.carrier_hole[i, 1]),
             )
         for j in range(n):
             ic = 1 + 2 * m + j
@@ -383,15 +358,12 @@ class RVDynamicModel:
                 gx, gy = point_rows(ih, ch, ic, cc, c)
                 cam = polar(e.cam[i, j, 0], chi + e.cam[i, j, 1])
                 hole = polar(e.disc_hole[i, j, 0], psi + e.disc_hole[i, j, 1])
-                out.append(
-                    dict(
-                        name=f"crank{i + 1}-disc{j + 1} bearing",
-                        kind="bearing",
-                        k=p.turning_arm_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
-                        g=(gx, gy),
-                        cl=clear[i, j],
-                        e=cam - hole,
-                    )
+                bearing(
+                    f"crank{i + 1}-disc{j + 1} bearing",
+                    (gx, gy),
+                    p.turning_arm_bearing_stiffness_N_per_m * N_PER_M_TO_N_PER_MM,
+                    clear[i, j],
+                    cam - hole,
                 )
             b = self.beta_cr
             dvec = self.sgn_radial * np.sin(b) * ehat + np.cos(b) * eperp
@@ -402,15 +374,11 @@ class RVDynamicModel:
             g = row([(ic, (nvec[0], nvec[1], g_t))])
             # pin and disc-profile errors: the disc must turn by Δθ_j(θ_o) more to load the pins
             d_rot = periodic_interp(e.disc_rotation[j], th_o)
-            out.append(
-                dict(
-                    name=f"disc{j + 1}-pins",
-                    kind="line",
-                    k=series(self.cycloid_fourier, p.pair.pin_count * chi),
-                    g=g,
-                    e=float(e.pin_composite[j, 0] * np.sin(th_o + e.pin_composite[j, 1]))
-                    - g_t * d_rot,
-                )
+            line(
+                f"disc{j + 1}-pins",
+                series(self.cycloid_fourier, p.pair.pin_count * chi),
+                g,
+                float(e.pin_composite[j, 0] * np.sin(th_o + e.pin_composite[j, 1])) - g_t * d_rot,
             )
         return out
 
