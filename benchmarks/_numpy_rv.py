@@ -218,9 +218,12 @@ def dense_rows(sparse, nd):
     return out
 
 
-def solve_batch_numpy(problem, h, en, gap, step_g, step_T, cold, record, exact=True, **_):
+def solve_batch_numpy(
+    problem, h, en, gap, step_g, step_T, cold, record, exact=True, start=None, **_
+):
     """Drop-in for :func:`gearte.solvers.rv_batch.solve_batch`: every step solved for all
-    samples at once (vectorised over samples), warm-started along each sequence like gearte."""
+    samples at once (vectorised over samples), warm-started along each sequence like gearte
+    (``start``: the earlier step whose solution starts each step, −1 cold, as gearte)."""
     from gearte.solvers.rv_batch import BatchSolution
 
     if problem.bearing_k.size:
@@ -235,11 +238,15 @@ def solve_batch_numpy(problem, h, en, gap, step_g, step_T, cold, record, exact=T
     forces = np.zeros((S, rec.size, nc))
     q = np.zeros((S, nd))
     F = np.zeros((S, nc))
+    if start is None:
+        start = np.where(np.asarray(cold, bool), -1, np.arange(K) - 1)
+    Q, FF = {}, {}
     for t in range(K):
         g = step_g[t]
-        if cold[t]:
-            q[:] = 0.0
-            F[:] = 0.0
+        if start[t] < 0:
+            q, F = np.zeros((S, nd)), np.zeros((S, nc))
+        else:
+            q, F = Q[start[t]].copy(), FF[start[t]].copy()
         s = Systems(
             problem.K0[g],
             Bd[g],
@@ -252,6 +259,7 @@ def solve_batch_numpy(problem, h, en, gap, step_g, step_T, cold, record, exact=T
             q, F, _ = newton(s, q, F=F, scheme="exact")
         else:
             q, F = solve(s, q, scheme="secant", kstart=problem.start_stiffness)
+        Q[t], FF[t] = q, F
         rot[:, t] = q[:, problem.output]
         if record[t]:
             forces[:, int(np.searchsorted(rec, t))] = F

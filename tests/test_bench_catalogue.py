@@ -12,6 +12,7 @@ from gearte.models.catalogue import (
     branch_directions,
     forward_backward_difference,
     hysteresis_values,
+    hysteresis_values_many,
     split_branches,
     te_peak_to_peak,
 )
@@ -43,6 +44,24 @@ def test_definitions_on_an_analytic_loop():
     assert hv.backlash == pytest.approx(play, rel=1e-9)
     hv5 = hysteresis_values(t, a, TR, lost_motion_fraction=0.05)
     assert hv5.lost_motion == pytest.approx(0.10 * TR / k + play, rel=1e-12)
+
+
+def test_many_curves_at_once_equal_one_curve_at_a_time():
+    """hysteresis_values_many (the batched yield read-out) gives each curve's
+    hysteresis_values: loops of different rigidity, play and friction on one torque grid, a
+    short sweep (read at its own peak) and a marked branch order."""
+    rng = np.random.default_rng(4)
+    ks, plays, fr = rng.uniform(0.8e6, 1.5e6, 5), rng.uniform(0, 3e-4, 5), rng.uniform(0, 8e-5, 5)
+    curves = [_loop(k, p, f, n=37) for k, p, f in zip(ks, plays, fr, strict=True)]
+    t, _, d = curves[0]
+    angles = np.array([c[1] for c in curves])
+    for torque, direction in ((t, None), (0.985 * t, d)):
+        many = hysteresis_values_many(torque, angles, TR, direction=direction,
+                                      lost_motion_fraction=0.05)  # fmt: skip
+        for i, a in enumerate(angles):
+            one = hysteresis_values(torque, a, TR, direction=direction, lost_motion_fraction=0.05)
+            for name in ("torsional_rigidity", "lost_motion", "backlash", "hysteresis_loss"):
+                assert many[name][i] == pytest.approx(getattr(one, name), rel=1e-12, abs=1e-18)
 
 
 def test_branch_inference_matches_marked_branches_with_noisy_torque():

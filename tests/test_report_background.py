@@ -4,77 +4,135 @@ in-process, and whatever goes wrong in it, the parent still writes the whole rep
 from __future__ import annotations
 
 import os
-import re
-from typing import Any
+import subprocess
+import sys
 
 import pytest
 
 from gearte.report.background import ReportWorker
-from gearte.report.outputs import write_outputs
-from gearte.studies import RunOptions, run_case
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="needs os.fork")
 
 
-def _page(html: str) -> str:
-    """The page without what differs between two renderings (the date, the figures' PNG)."""
+# The worker forks only where no other Python thread runs (a fork copies one thread), and a test
+# session may have threads left by other tests: the checks run in one fresh interpreter, each
+# printing "name: ok" or "name: <what failed>".
+_CHECKS = r"""
+import os, re, sys, tempfile
+from pathlib import Path
+from gearte.report.background import ReportWorker
+from gearte.report.outputs import write_outputs
+from gearte.studies import RunOptions, run_case
+
+def page(html):
     html = re.sub(r"\d{4}-\d\d-\d\d \d\d:\d\d UTC", "DATE", html)
     return re.sub(r"data:image/png;base64,[A-Za-z0-9+/=]+", "PNG", html)
 
-
-@pytest.fixture(scope="module")
-def result() -> Any:
-    return run_case("jiang2024_spur_pair", RunOptions(progress=False, samples=500))
-
-
-def _reaped(pid: int) -> bool:
+def reaped(pid):
     try:
         os.waitpid(pid, os.WNOHANG)
     except ChildProcessError:
         return True
     return False
 
+def check(name, fn):
+    try:
+        fn()
+        print(f"{name}: ok", flush=True)
+    except Exception as exc:
+        print(f"{name}: {type(exc).__name__}: {exc}", flush=True)
 
-def test_worker_renders_the_same_report_as_in_process(result: Any, tmp_path: Any) -> None:
-    worker = ReportWorker.start("jiang2024_spur_pair")
-    assert worker is not None
+result = run_case("jiang2024_spur_pair", RunOptions(progress=False, samples=500))
+tmp = Path(tempfile.mkdtemp())
+
+def same_report():
+    worker = ReportWorker.start()
+    assert worker is not None, "did not fork"
     pid = worker.pid
-    mine = write_outputs(result, tmp_path / "worker", worker=worker)
-    alone = write_outputs(result, tmp_path / "alone")
+    mine = write_outputs(result, tmp / "worker", worker=worker)
+    alone = write_outputs(result, tmp / "alone")
     a, b = mine["report"].read_text(), alone["report"].read_text()
-    assert _page(a) == _page(b)
+    assert page(a) == page(b), "pages differ"
     assert a.count("data:image/png;base64,") == b.count("data:image/png;base64,") > 0
-    assert {"figures", "render", "render: slowest figure", "html"} <= set(result.timings)
-    assert _reaped(pid)  # no zombie left behind
+    need = {"figures", "render", "render: slowest figure", "html"}
+    assert need <= set(result.timings), result.timings
+    assert reaped(pid), "zombie left"
 
-
-def test_worker_that_cannot_render_falls_back_in_process(result: Any, tmp_path: Any) -> None:
+def dead_worker():
     worker = ReportWorker.start()
-    assert worker is not None
+    assert worker is not None, "did not fork"
     os.kill(worker.pid, 9)  # the worker dies before the result is sent
-    paths = write_outputs(result, tmp_path / "out", worker=worker)
+    paths = write_outputs(result, tmp / "out", worker=worker)
     assert paths["report"].read_text().count("data:image/png;base64,") > 0
-    assert "report process failed: rendered in-process" in result.timings  # said, not hidden
-    del result.timings["report process failed: rendered in-process"]
+    key = "report process failed: rendered in-process"
+    assert key in result.timings, "fallback not said"
+    del result.timings[key]
 
-
-def test_unpicklable_result_is_rendered_in_process(result: Any, tmp_path: Any) -> None:
+def unpicklable():
     worker = ReportWorker.start()
-    assert worker is not None
+    assert worker is not None, "did not fork"
     pid = worker.pid
-    result.analyses[0].values["unpicklable"] = lambda: None  # noqa: E731 - cannot pickle
+    result.analyses[0].values["unpicklable"] = lambda: None
     try:
         assert worker.submit(result) is False
         assert worker.collect() is None
     finally:
         del result.analyses[0].values["unpicklable"]
-    assert _reaped(pid)
+    assert reaped(pid), "zombie left"
 
-
-def test_unused_worker_is_ended_and_reaped() -> None:
-    with ReportWorker.start() as worker:
+def unused():
+    worker = ReportWorker.start()
+    assert worker is not None, "did not fork"
+    with worker:
         pid = worker.pid
-    assert _reaped(pid)
+    assert reaped(pid), "zombie left"
+
+check("same_report", same_report)
+check("dead_worker", dead_worker)
+check("unpicklable", unpicklable)
+check("unused", unused)
+"""
+
+
+@pytest.fixture(scope="module")
+def checks() -> dict[str, str]:
+    p = subprocess.run(
+        [sys.executable, "-c", _CHECKS], capture_output=True, text=True, timeout=900, check=False
+    )
+    out = dict(
+        line.split(": ", 1) for line in p.stdout.splitlines() if ": " in line
+    )  # name -> "ok" or the failure
+    assert p.returncode == 0 and len(out) == 4, p.stdout + p.stderr[-3000:]
+    return out
+
+
+def test_worker_renders_the_same_report_as_in_process(checks: dict[str, str]) -> None:
+    assert checks["same_report"] == "ok", checks["same_report"]
+
+
+def test_worker_that_cannot_render_falls_back_in_process(checks: dict[str, str]) -> None:
+    assert checks["dead_worker"] == "ok", checks["dead_worker"]
+
+
+def test_unpicklable_result_is_rendered_in_process(checks: dict[str, str]) -> None:
+    assert checks["unpicklable"] == "ok", checks["unpicklable"]
+
+
+def test_unused_worker_is_ended_and_reaped(checks: dict[str, str]) -> None:
+    assert checks["unused"] == "ok", checks["unused"]
+
+
+def test_no_fork_while_other_threads_run() -> None:
+    import threading
+
+    stop = threading.Event()
+    t = threading.Thread(target=stop.wait)
+    t.start()
+    try:
+        assert ReportWorker.start() is None  # a fork would copy one thread of two
+    finally:
+        stop.set()
+        t.join()
 
 
 def test_fixed_grid_leaves_the_asked_room_around_each_panel() -> None:

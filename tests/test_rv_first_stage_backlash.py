@@ -213,3 +213,19 @@ def test_bundled_first_stage_example_adds_its_f24_js5_midpoint_to_the_catalogue(
         rad_to_arcmin(0.0555 / (R_SUN * RATIO))
     )
     assert v["lost_motion_min [arcmin]"] < v["lost_motion [arcmin]"] < v["lost_motion_max [arcmin]"]
+
+
+def test_rv_drive_of_a_chain_takes_the_first_stage_backlash_like_the_catalogue_analysis():
+    """A gear chain's RV stage (drive_from_case) has the rv_reducer catalogue's lost motion with
+    the first stage's free angle; first_stage_backlash = 'ignored' leaves it out."""
+    from gearte.studies._drives import drive_from_case
+    from gearte.units import rad_to_arcmin as arcmin
+
+    data = _catalogue_case(backlash_um=[60.0, 40.0, 50.0])
+    cat = _catalogue(data)
+    drive = drive_from_case(load_case_dict(data, name="fs"))
+    assert arcmin(drive.lost_motion()) == pytest.approx(cat["lost_motion [arcmin]"], rel=1e-12)
+    data["analyses"]["catalogue"]["first_stage_backlash"] = "ignored"
+    plain = drive_from_case(load_case_dict(data, name="fs"))
+    add = rad_to_arcmin(0.040 / (R_SUN * RATIO))
+    assert arcmin(plain.lost_motion()) == pytest.approx(cat["lost_motion [arcmin]"] - add)

@@ -58,6 +58,9 @@ class RVDrive:
         The unloaded TE is solved at this fraction of rated torque [-].
     law : ContactLaw, optional
         Pin-contact law; default: the load-sharing model's own.
+    first_stage_free_angle : float
+        Output free angle of the first stage's backlash [rad], added as a dead zone of the
+        catalogue test (:mod:`gearte.models.rv_first_stage`; 0: none).
     """
 
     reducer: RVReducer
@@ -68,6 +71,7 @@ class RVDrive:
     lost_motion_fraction: float = 0.03
     zero_load_fraction: float = 1e-3
     law: Any = None
+    first_stage_free_angle: float = 0.0
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     kind = "rv_reducer"
@@ -90,6 +94,12 @@ class RVDrive:
                 lost_motion_fraction=frac,
                 law=self.law,
             )
+            if self.first_stage_free_angle > 0.0:
+                from gearte.models.rv_first_stage import catalogue_with_free_angle
+
+                self._cache[frac] = catalogue_with_free_angle(
+                    self._cache[frac], self.first_stage_free_angle, self._rated(), frac
+                )
         return self._cache[frac]
 
     def lost_motion(self, torque: float | None = None) -> float:

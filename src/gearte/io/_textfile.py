@@ -58,17 +58,35 @@ def read_text_file(
     return src, text
 
 
-def header_delimiter(header: str) -> str:
-    """The column delimiter of a CSV header line: ``,``, else a tab, else ``;`` (``,`` if none).
+def read_header(
+    lines: list[str], i: int, src: str, error: type[BenchFileError]
+) -> tuple[int, str, str]:
+    """The header row ``lines[i]`` (the first line after the metadata) and its delimiter.
 
     Parameters
     ----------
-    header : str
-        The header line.
+    lines : list of str
+        The file's lines.
+    i : int
+        Index of the first line that is neither blank nor a ``#`` line [-].
+    src : str
+        The file, as errors name it.
+    error : type
+        The reader's error class, as in :func:`read_text_file`.
 
     Returns
     -------
-    str
-        The delimiter.
+    (int, str, str)
+        The header's 1-based line number, its text and its delimiter: ``,``, else a tab, else
+        ``;`` (``,`` if it has none).
+
+    Raises
+    ------
+    BenchFileError
+        (of the class ``error``) when the file ends before a header.
     """
-    return "," if "," in header else ("\t" if "\t" in header else (";" if ";" in header else ","))
+    if i >= len(lines):
+        raise error(src, len(lines), None, "has a header but no column names and no data")
+    header = lines[i]
+    delim = "," if "," in header else ("\t" if "\t" in header else (";" if ";" in header else ","))
+    return i + 1, header, delim

@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from gearte.errors import BenchFileError
-from gearte.io._textfile import header_delimiter, read_text_file
+from gearte.io._textfile import read_header, read_text_file
 from gearte.models.bench_data import HysteresisCurve, TETrace
 from gearte.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, Nm_to_Nmm, rad_to_deg
 
@@ -171,11 +171,7 @@ def _parse(path, allowed, aliases, text_columns=()) -> _Table:
                 meta[key] = value
             meta_lines[key] = i + 1
         i += 1
-    if i >= len(lines):
-        raise BenchFileError(src, len(lines), None, "has a header but no column names and no data")
-    header_line = i + 1
-    header = lines[i]
-    delim = header_delimiter(header)
+    header_line, header, delim = read_header(lines, i, src, BenchFileError)
     cells = header.split(delim)
     names: list[str] = []
     units: list[str | None] = []

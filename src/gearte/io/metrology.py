@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from gearte.errors import MeasurementFileError
-from gearte.io._textfile import header_delimiter, read_text_file
+from gearte.io._textfile import read_header, read_text_file
 from gearte.units import DEG_PER_RAD, mm_to_um, rad_to_deg
 
 __all__ = [
@@ -268,11 +268,7 @@ def _parse(path: str | os.PathLike, fmt: str) -> _Table:
                         f"temperature_C must be a number in [-60, 250], got {value!r}",
                     )
         i += 1
-    if i >= len(lines):
-        raise _err(src, len(lines), None, "has a header but no column names and no data")
-    header_line = i + 1
-    header = lines[i]
-    delim = header_delimiter(header)
+    header_line, header, delim = read_header(lines, i, src, MeasurementFileError)
     names: list[str] = []
     units: list[str | None] = []
     for j, cell in enumerate(header.split(delim)):

@@ -53,6 +53,7 @@ __all__ = [
     "hysteresis_loss",
     "HysteresisValues",
     "hysteresis_values",
+    "hysteresis_values_many",
     "te_peak_to_peak",
     "forward_backward_difference",
 ]
@@ -340,6 +341,73 @@ def hysteresis_values(
         hysteresis_loss=hysteresis_loss(br),
         lost_motion_fraction=lost_motion_fraction,
     )
+
+
+def _interp_weights(query: np.ndarray, xp: np.ndarray) -> np.ndarray:
+    """``W`` (len(query), len(xp)) with ``W @ fp == np.interp(query, xp, fp)`` for every ``fp``
+    (interpolation is linear in the ordinates)."""
+    return np.stack([np.interp(query, xp, e) for e in np.eye(xp.size)], axis=1)
+
+
+def hysteresis_values_many(
+    torque: ArrayLike,
+    angles: ArrayLike,
+    rated_torque: float,
+    *,
+    direction: ArrayLike | None = None,
+    lost_motion_fraction: float = 0.03,
+) -> dict[str, np.ndarray]:
+    """:func:`hysteresis_values` of many curves sampled at the same torques, at once.
+
+    The branches and the interpolation depend on the torque sequence only, so they are found
+    once (:func:`split_branches`) and every reading is a fixed linear combination of the
+    angles; the quantities then follow by the same formulas as for one curve.
+
+    Parameters
+    ----------
+    torque : array_like, shape (K,)
+        Output torque in recording order, shared by every curve [N·mm].
+    angles : array_like, shape (S, K)
+        Output torsion angle of each curve [rad].
+    rated_torque : float
+        Rated torque T_r [N·mm].
+    direction : array_like, optional
+        +1 rising / −1 falling torque per sample [-]; inferred when omitted.
+    lost_motion_fraction : float
+        f of :func:`lost_motion` [-].
+
+    Returns
+    -------
+    dict
+        ``"torsional_rigidity"`` [N·mm/rad], ``"lost_motion"``, ``"backlash"``,
+        ``"hysteresis_loss"`` [rad]: arrays of shape (S,).
+    """
+    t = np.asarray(torque, dtype=float)
+    a = np.atleast_2d(np.asarray(angles, dtype=float))
+    if a.ndim != 2 or a.shape[1] != t.size:
+        raise ParameterError("angles", a.shape, f"must be (curves, {t.size}) for {t.size} torques")
+    f = lost_motion_fraction
+    if not 0 < f < 0.5:
+        raise ParameterError("lost_motion_fraction", f, "must be in (0, 0.5)")
+    # the branches of the sample indices: which sample sits where on each branch
+    br = split_branches(t, np.arange(t.size, dtype=float), rated_torque, direction)
+    tr = rated_torque
+    hi = min(tr, br.asc_torque[-1], br.desc_torque[-1])
+    lo = max(-tr, br.asc_torque[0], br.desc_torque[0])
+    query = np.array([lo, -0.5 * tr, 0.5 * tr, hi, -f * tr, f * tr, 0.0])
+    asc = a[:, br.asc_angle.astype(np.int64)] @ _interp_weights(query, br.asc_torque).T
+    desc = a[:, br.desc_angle.astype(np.int64)] @ _interp_weights(query, br.desc_torque).T
+    mid = 0.5 * (asc + desc)
+    k_pos = (hi - 0.5 * tr) / (mid[:, 3] - mid[:, 2])
+    k_neg = (-0.5 * tr - lo) / (mid[:, 1] - mid[:, 0])
+    loss = desc[:, 6] - asc[:, 6]
+    w_f = 0.5 * ((desc[:, 1] - asc[:, 1]) + (desc[:, 2] - asc[:, 2]))
+    return {
+        "torsional_rigidity": 0.5 * (k_pos + k_neg),
+        "lost_motion": mid[:, 5] - mid[:, 4],
+        "backlash": loss - w_f,
+        "hysteresis_loss": loss,
+    }
 
 
 def te_peak_to_peak(te: ArrayLike) -> float:

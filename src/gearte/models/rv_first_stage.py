@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["mesh_backlash", "output_free_angle", "with_dead_zone"]
+__all__ = ["mesh_backlash", "output_free_angle", "with_dead_zone", "catalogue_with_free_angle"]
 
 
 def mesh_backlash(
@@ -120,3 +120,55 @@ def with_dead_zone(
     t = np.asarray(torque, dtype=float)
     side = np.where(t == 0.0, -np.sign(np.asarray(direction, dtype=float)), np.sign(t))
     return np.asarray(angle, dtype=float) + side * (0.5 * float(free_angle))
+
+
+def catalogue_with_free_angle(cat, free_angle: float, rated_torque: float, fraction: float):
+    """Catalogue values with a dead zone ``free_angle`` [rad] in the virtual loop and curve.
+
+    Parameters
+    ----------
+    cat : gearte.models.rv_catalogue.CatalogueValues
+        The virtual test without the first stage's free play.
+    free_angle : float
+        Output free angle [rad] (:func:`output_free_angle`).
+    rated_torque : float
+        Rated torque [N·mm].
+    fraction : float
+        Lost-motion torque, fraction of rated torque [-].
+
+    Returns
+    -------
+    CatalogueValues
+        The loop and curve with the dead zone (:func:`with_dead_zone`), read again by the shared
+        definitions (:func:`gearte.models.catalogue.hysteresis_values`): lost motion, backlash and
+        hysteresis loss grow by ``free_angle``, the rigidity is unchanged.
+    """
+    from dataclasses import replace
+
+    from gearte.models.catalogue import hysteresis_values
+    from gearte.models.rv_catalogue import TorsionTest
+
+    t = np.asarray(cat.curve.torque, dtype=float)
+    rising = np.sign(np.diff(t, prepend=t[0]))
+    rising[rising == 0] = -1.0  # the first point: approached from above (as torsion_test)
+    curve = TorsionTest(t, with_dead_zone(t, cat.curve.angle, rising, free_angle))
+    loop = TorsionTest(
+        cat.loop.torque,
+        with_dead_zone(cat.loop.torque, cat.loop.angle, cat.loop_direction, free_angle),
+    )
+    hv = hysteresis_values(
+        loop.torque,
+        loop.angle,
+        float(rated_torque),
+        direction=cat.loop_direction,
+        lost_motion_fraction=fraction,
+    )
+    return replace(
+        cat,
+        torsional_rigidity=hv.torsional_rigidity,
+        lost_motion=hv.lost_motion,
+        backlash=hv.backlash,
+        hysteresis_loss=hv.hysteresis_loss,
+        curve=curve,
+        loop=loop,
+    )

@@ -27,6 +27,11 @@ def first_stage_error_keys(planets: int) -> dict[str, list[str]]:
     ``first_stage.planet_thickness.c<i>`` and ``first_stage.centre_distance.c<i>`` (each
     planet's tooth-thickness deviation and its sun–planet centre-distance deviation; crank
     ``i`` 1-based as in the case file).
+
+    Parameters
+    ----------
+    planets : int
+        Number of planets (= cranks) [-].
     """
     cr = range(1, int(planets) + 1)
     return {

@@ -75,6 +75,7 @@ class RVBatchPlan:
     step_g: np.ndarray
     step_T: np.ndarray
     cold: np.ndarray
+    start: np.ndarray
     record: np.ndarray
     n_loop: int
 
@@ -170,6 +171,12 @@ def plan(model, keys: Sequence[str]) -> RVBatchPlan:
         np.full(P, model.zero_load_fraction * model.te_torque),
     ]
     cold = [np.eye(1, s.size, dtype=bool)[0] for s in step_g]
+    # starts: each sequence from its previous step; the rising branches (levels reversed)
+    # from the falling branches' solutions at the same torques (the same equilibria)
+    steps = np.arange(16 + 2 * P)
+    start = np.where(np.concatenate(cold), -1, steps - 1)
+    start[8:12] = [3, 2, 1, 0]
+    start[12:16] = [7, 6, 5, 4]
     record = [np.zeros(4, bool)] * 4 + [np.ones(P, bool), np.zeros(P, bool)]
     return RVBatchPlan(
         problem=problem,
@@ -187,6 +194,7 @@ def plan(model, keys: Sequence[str]) -> RVBatchPlan:
         step_g=np.concatenate(step_g),
         step_T=np.concatenate(step_T),
         cold=np.concatenate(cold),
+        start=start,
         record=np.concatenate(record),
         n_loop=16,
     )
@@ -289,8 +297,8 @@ def batch_quantities(
         A replacement for :func:`gearte.solvers.rv_batch.solve_batch` with its signature
         (benchmarks time a plain numpy solver through the same inputs and read-out).
     """
-    from gearte.models.catalogue import hysteresis_values
-    from gearte.models.contact_law import max_contact_pressure
+    from gearte.models.catalogue import hysteresis_values_many
+    from gearte.models.contact_law import max_contact_pressure, relative_radius
     from gearte.models.rv_load_sharing import cycloid_stage
     from gearte.solvers.rv_batch import solve_batch
     from gearte.units import Nmm_to_Nm, arcmin_to_rad, rad_to_arcmin
@@ -298,9 +306,13 @@ def batch_quantities(
     p = cached_plan(model, list(errors))
     h, en, gap = batch_inputs(model, p, errors, n)
     solve = solve_batch if solver is None else solver
-    sol = solve(
-        p.problem, h, en, gap, p.step_g, p.step_T, p.cold, p.record, compiled=compiled, exact=exact
-    )
+    # the per-case algorithm (exact=False) starts every branch cold, as the per-case solver
+    if exact:
+        sol = solve(p.problem, h, en, gap, p.step_g, p.step_T, p.cold, p.record,
+                    compiled=compiled, exact=exact, start=p.start)  # fmt: skip
+    else:
+        sol = solve(p.problem, h, en, gap, p.step_g, p.step_T, p.cold, p.record,
+                    compiled=compiled, exact=exact)  # fmt: skip
     red = model.reducer
     tr = float(red.rated_torque)
     angle = -sol.output[:, : p.n_loop]  # the four loop branches, 4 levels each
@@ -312,39 +324,31 @@ def batch_quantities(
     P = model.theta.size
     loaded = sol.output[:, p.n_loop : p.n_loop + P]
     unloaded = sol.output[:, p.n_loop + P :]
+    hv = hysteresis_values_many(
+        torque,
+        np.concatenate([up, up[:, -1:], ln, un, un[:, -1:], lp], axis=1),
+        tr,
+        direction=direction,
+        lost_motion_fraction=model.lost_motion_fraction,
+    )
     out = {
-        k: np.empty(n)
-        for k in (
-            "lost_motion [arcmin]",
-            "torsional_rigidity [Nm/arcmin]",
-            "backlash [arcmin]",
-            "hysteresis_loss [arcmin]",
-        )
+        "lost_motion [arcmin]": np.asarray(rad_to_arcmin(hv["lost_motion"]), dtype=float),
+        "torsional_rigidity [Nm/arcmin]": np.asarray(Nmm_to_Nm(hv["torsional_rigidity"]))
+        * float(arcmin_to_rad(1.0)),
+        "backlash [arcmin]": np.asarray(rad_to_arcmin(hv["backlash"]), dtype=float),
+        "hysteresis_loss [arcmin]": np.asarray(rad_to_arcmin(hv["hysteresis_loss"]), dtype=float),
     }
-    for s in range(n):
-        a_desc = np.concatenate([up[s], up[s, -1:], ln[s]])
-        a_asc = np.concatenate([un[s], un[s, -1:], lp[s]])
-        hv = hysteresis_values(
-            torque,
-            np.concatenate([a_desc, a_asc]),
-            tr,
-            direction=direction,
-            lost_motion_fraction=model.lost_motion_fraction,
-        )
-        out["lost_motion [arcmin]"][s] = rad_to_arcmin(hv.lost_motion)
-        out["torsional_rigidity [Nm/arcmin]"][s] = float(Nmm_to_Nm(hv.torsional_rigidity)) * float(
-            arcmin_to_rad(1.0)
-        )
-        out["backlash [arcmin]"][s] = rad_to_arcmin(hv.backlash)
-        out["hysteresis_loss [arcmin]"][s] = rad_to_arcmin(hv.hysteresis_loss)
     out["angular_te [arcmin]"] = np.asarray(rad_to_arcmin(np.ptp(unloaded, axis=1)), dtype=float)
     out["loaded_te [arcmin]"] = np.asarray(rad_to_arcmin(np.ptp(loaded, axis=1)), dtype=float)
-    N, zp = red.discs.count, red.pins.count
-    F = sol.forces.reshape(n, P, N, zp)
-    out["peak_pin_load [N]"] = F.reshape(n, -1).max(axis=1)
+    F = sol.forces.reshape(n, -1)
+    out["peak_pin_load [N]"] = F.max(axis=1)
+    # the largest Hertz pressure: p0 = (F E*/(π b R*))^½ grows with F at each contact, so it
+    # is the pressure of the contact with the largest F / R* (found once per sample)
     stage = cycloid_stage(red)
     d = red.discs
-    pr = max_contact_pressure(F, p.rho[None], stage.r, d.youngs_modulus, d.poisson_ratio,
-                              d.face_width)  # fmt: skip
-    out["max_contact_pressure [MPa]"] = np.asarray(pr, dtype=float).reshape(n, -1).max(axis=1)
+    rho = p.rho.reshape(-1)  # (P, N, zp): the order of the recorded forces
+    top = np.argmax(F / relative_radius(rho, stage.r)[None], axis=1)
+    pr = max_contact_pressure(F[np.arange(n), top], rho[top], stage.r, d.youngs_modulus,
+                              d.poisson_ratio, d.face_width)  # fmt: skip
+    out["max_contact_pressure [MPa]"] = np.asarray(pr, dtype=float)
     return out

@@ -180,27 +180,6 @@ def _env_update(env, b, o):
         env[b, 1] = o
 
 
-@njit(cache=True, nogil=True)
-def _new_stats():
-    stats = np.zeros(_STATS)
-    stats[1] = np.inf
-    stats[2] = -np.inf
-    return stats
-
-
-@njit(cache=True, nogil=True)
-def _record(trace, rec, rec_idx, nrec, o, y):
-    """Sample ``nrec`` (output ``o``, states ``y[rec_idx]``) into the ring buffers ``trace`` and
-    ``rec`` (each keeps its last rows; an empty one records nothing); returns ``nrec + 1``."""
-    if trace.shape[0] > 0:
-        trace[nrec % trace.shape[0]] = o
-    if rec.shape[0] > 0:
-        r = nrec % rec.shape[0]
-        for c in range(rec_idx.size):
-            rec[r, c] = y[rec_idx[c]]
-    return nrec + 1
-
-
 def _rk4_template(
     y0, t0, dt, n_steps, args, settle_steps, rec_every, rec_idx, trace, rec, work_size, env
 ):
@@ -212,8 +191,12 @@ def _rk4_template(
     k3 = np.empty(n)
     k4 = np.empty(n)
     tmp = np.empty(n)
-    stats = _new_stats()
+    stats = np.zeros(_STATS)
+    stats[1] = np.inf
+    stats[2] = -np.inf
     nrec = 0  # samples recorded in all; trace/rec keep their last rows (ring buffers)
+    cap_t = trace.shape[0]
+    cap = rec.shape[0]
     n_env = env.shape[0]
     n_out = n_steps - settle_steps + 1  # output samples after settling (envelope buckets)
     h2 = 0.5 * dt
@@ -224,7 +207,12 @@ def _rk4_template(
         if n_env > 0:
             _env_update(env, 0, o)
         if rec_every > 0:
-            nrec = _record(trace, rec, rec_idx, nrec, o, y)
+            if cap_t > 0:
+                trace[0] = o
+            if cap > 0:
+                for c in range(rec_idx.size):
+                    rec[0, c] = y[rec_idx[c]]
+            nrec = 1
     for s in range(n_steps):
         t = t0 + s * dt
         rhs(t, y, args, k1, work)
@@ -251,7 +239,13 @@ def _rk4_template(
             if n_env > 0:
                 _env_update(env, (j * n_env) // n_out, o)
             if rec_every > 0 and j % rec_every == 0:
-                nrec = _record(trace, rec, rec_idx, nrec, o, y)
+                if cap_t > 0:
+                    trace[nrec % cap_t] = o
+                if cap > 0:
+                    r = nrec % cap
+                    for c in range(rec_idx.size):
+                        rec[r, c] = y[rec_idx[c]]
+                nrec += 1
     return y, stats, nrec, -1
 
 
@@ -304,7 +298,9 @@ def _dopri5_template(
     k7 = np.empty(n)
     yn = np.empty(n)
     tmp = np.empty(n)
-    stats = _new_stats()
+    stats = np.zeros(_STATS)
+    stats[1] = np.inf
+    stats[2] = -np.inf
     counters = np.zeros(3)  # accepted, rejected, rhs evaluations
     t = t0
     h = h0
@@ -312,6 +308,8 @@ def _dopri5_template(
     counters[2] += 1
     next_rec = t_settle
     nrec = 0  # samples on the recording grid so far; trace/rec keep their last rows
+    cap_t = trace.shape[0]
+    cap = rec.shape[0]
     n_env = env.shape[0]
     while t < t_end:
         if counters[0] + counters[1] >= max_steps:
@@ -366,7 +364,13 @@ def _dopri5_template(
                 _stats_update(stats, o)
                 if n_env > 0:
                     _env_update(env, min((nrec * n_env) // n_out, n_env - 1), o)
-                nrec = _record(trace, rec, rec_idx, nrec, o, tmp)
+                if cap_t > 0:
+                    trace[nrec % cap_t] = o
+                if cap > 0:
+                    r = nrec % cap
+                    for c in range(rec_idx.size):
+                        rec[r, c] = tmp[rec_idx[c]]
+                nrec += 1
                 next_rec += rec_dt
             t = t_new
             acc = 0.0

@@ -29,12 +29,14 @@ to round-off (a test checks 1e-9 on sampled reducers).
 from __future__ import annotations
 
 import threading
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
 from gearte.errors import ConvergenceError, ParameterError
+from gearte.solvers.dense import solve_spd_into as _spd_solve
 from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
     LAW_LINEAR,
@@ -176,7 +178,7 @@ class BatchSolution:
     iterations: np.ndarray
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _rows_dot(idx, val, q, r):
     s = 0.0
     for w in range(idx.shape[1]):
@@ -184,145 +186,21 @@ def _rows_dot(idx, val, q, r):
     return s
 
 
-@njit(cache=True, nogil=True)
-def _energy_sp(K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, kc, q):
-    nd = q.size
-    e = 0.0
-    for a in range(nd):
-        t = 0.0
-        for b in range(nd):
-            t += K0[a, b] * q[b]
-        e += (0.5 * t - f0[a]) * q[a]
-    for c in range(gc.size):
-        d = _rows_dot(cidx, cval, q, c) - gc[c]
-        if d > 0.0:
-            e += 0.5 * kc[c] * d * d
-    for m in range(kn.size):
-        wx = _rows_dot(nidx, nval, q, 2 * m) + en[m, 0]
-        wy = _rows_dot(nidx, nval, q, 2 * m + 1) + en[m, 1]
-        rr = wx * wx + wy * wy
-        e += 0.5 * CLEARANCE_RESIDUAL * kn[m] * rr
-        r = np.sqrt(rr) - cn[m]
-        if r > 0.0:
-            e += 0.5 * (1.0 - CLEARANCE_RESIDUAL) * kn[m] * r * r
-    return e
-
-
-@njit(cache=True, nogil=True)
-def _spd_solve(H, b, L, x):
-    """Solve ``H x = b`` for symmetric positive definite ``H`` (Cholesky into the work array
-    ``L``, result in ``x``); LU where a pivot is not positive."""
-    n = b.size
-    for j in range(n):
-        s = H[j, j]
-        for k in range(j):
-            s -= L[j, k] * L[j, k]
-        if not s > 0.0:
-            x[:] = np.linalg.solve(H, b)
-            return
-        d = np.sqrt(s)
-        L[j, j] = d
-        for i in range(j + 1, n):
-            t = H[i, j]
-            for k in range(j):
-                t -= L[i, k] * L[j, k]
-            L[i, j] = t / d
-    for i in range(n):
-        t = b[i]
-        for k in range(i):
-            t -= L[i, k] * x[k]
-        x[i] = t / L[i, i]
-    for i in range(n - 1, -1, -1):
-        t = x[i]
-        for k in range(i + 1, n):
-            t -= L[k, i] * x[k]
-        x[i] = t / L[i, i]
-
-
-@njit(cache=True, nogil=True)
-def _newton_sp(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, kc, q, tol, maxit):
-    """:func:`gearte.solvers.rv_equilibrium._newton` on sparse rows (same steps and tests)."""
-    nd = q.size
-    nc = gc.size
-    nm = kn.size
-    Wc = cidx.shape[1]
-    Wn = nidx.shape[1]
-    active = np.zeros(nc, dtype=np.bool_)
-    d = np.empty(nc)
-    H = np.empty((nd, nd))
-    L = np.empty((nd, nd))
-    grad = np.empty(nd)
-    dq = np.empty(nd)
-    qn = np.empty(nd)
-    for c in range(nc):
-        d[c] = _rows_dot(cidx, cval, q, c) - gc[c]
-        active[c] = d[c] > 0.0
-    e0 = _energy_sp(K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, kc, q)
-    for it in range(maxit):
-        for a in range(nd):
-            t = -f0[a]
-            for b in range(nd):
-                H[a, b] = K0[a, b]
-                t += K0[a, b] * q[b]
-            grad[a] = t
-        for c in range(nc):
-            if active[c]:
-                w = kc[c] * d[c]
-                for a in range(Wc):
-                    ia = cidx[c, a]
-                    grad[ia] += w * cval[c, a]
-                    ba = kc[c] * cval[c, a]
-                    for b in range(Wc):
-                        H[ia, cidx[c, b]] += ba * cval[c, b]
-        for m in range(nm):
-            rx, ry = 2 * m, 2 * m + 1
-            wx = _rows_dot(nidx, nval, q, rx) + en[m, 0]
-            wy = _rows_dot(nidx, nval, q, ry) + en[m, 1]
-            gx, gy, hxx, hyy, hxy = _bearing_terms(wx, wy, kn[m], cn[m])
-            # x and y rows share one column pattern (both rows of the same bearing)
-            for a in range(Wn):
-                ia = nidx[rx, a]
-                bx, by = nval[rx, a], nval[ry, a]
-                grad[ia] += gx * bx + gy * by
-                ta = hxx * bx + hxy * by
-                tb = hxy * bx + hyy * by
-                for b in range(Wn):
-                    H[ia, nidx[rx, b]] += ta * nval[rx, b] + tb * nval[ry, b]
-        for a in range(nd):
-            H[a, a] += reg
-        _spd_solve(H, grad, L, dq)
-        for a in range(nd):
-            dq[a] = -dq[a]
-            qn[a] = q[a] + dq[a]
-        step = 1.0
-        decreased = False
-        e1 = e0
-        for _ in range(60):
-            e1 = _energy_sp(K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, kc, qn)
-            if e1 <= e0 + 1e-12 * abs(e0):
-                decreased = True
-                break
-            step *= 0.5
-            for a in range(nd):
-                qn[a] = q[a] + step * dq[a]
-        if not decreased:
-            return q, it + 1, True
-        stalled = e0 - e1 <= 1e-14 * abs(e0)
-        q = qn.copy()
-        e0 = e1
-        same = True
-        for c in range(nc):
-            d[c] = _rows_dot(cidx, cval, q, c) - gc[c]
-            a_new = d[c] > 0.0
-            if a_new != active[c]:
-                same = False
-            active[c] = a_new
-        big = 0.0
-        for a in range(nd):
-            big = max(big, abs(step * dq[a]))
-        if big < tol or (same and step == 1.0 and nm == 0) or (same and stalled and it > 2):
-            return q, it + 1, True
-    return q, maxit, False
+@njit(cache=True, nogil=True, inline="always")
+def _rows_times(idx, val, x, out):
+    """``out[r] = B[r]·x`` for every stored row (rows of three columns: the columns' values
+    read once per run of rows on the same columns)."""
+    if idx.shape[1] != 3:
+        for r in range(out.size):
+            out[r] = _rows_dot(idx, val, x, r)
+        return
+    i0 = i1 = i2 = -1
+    x0 = x1 = x2 = 0.0
+    for r in range(out.size):
+        if idx[r, 0] != i0 or idx[r, 1] != i1 or idx[r, 2] != i2:
+            i0, i1, i2 = idx[r, 0], idx[r, 1], idx[r, 2]
+            x0, x1, x2 = x[i0], x[i1], x[i2]
+        out[r] = val[r, 0] * x0 + val[r, 1] * x1 + val[r, 2] * x2
 
 
 def law_limit(a0: np.ndarray, a1: np.ndarray) -> np.ndarray:
@@ -331,7 +209,7 @@ def law_limit(a0: np.ndarray, a1: np.ndarray) -> np.ndarray:
     return np.exp(np.minimum((a0 - a1) / a1, 700.0))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _law_force(d, a0, a1, fstar, f_prev, d_prev):
     """Force ``F`` with ``δ(F) = F (a0 − a1 ln F) = d`` for an approach ``d > 0`` [N].
 
@@ -350,8 +228,7 @@ def _law_force(d, a0, a1, fstar, f_prev, d_prev):
         if slope > 0.0:
             F = f_prev + (d - d_prev) / slope
     if not (F > 0.0 and F < fstar):
-        den = a0 - a1 * np.log(max(d / max(a0, a1), 1e-300))
-        F = d / den if den > 0.0 else 0.5 * fstar
+        F = _law_force_start(d, a0, a1, fstar)
     for _ in range(100):
         lf = np.log(F)
         gp = a0 - a1 * lf - a1
@@ -368,13 +245,21 @@ def _law_force(d, a0, a1, fstar, f_prev, d_prev):
     return F
 
 
-@njit(cache=True, nogil=True)
-def _energy_law(K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, Fp, dp, F, d):
-    """Π with the exact pin law; fills the approaches ``d`` and forces ``F`` (from the known
-    pairs ``Fp``, ``dp``); +inf beyond the law's range.
+@njit(cache=True, nogil=True, inline="always")
+def _law_force_start(d, coef0, coef1, fstar):
+    """One-term estimate of the force at approach ``d > 0`` (``F ≈ d / (a0 − a1 ln(d/a))``)."""
+    den = coef0 - coef1 * np.log(max(d / max(coef0, coef1), 1e-300))
+    return d / den if den > 0.0 else 0.5 * fstar
 
-    ``φ(d) = ∫F dd = F² (a0/2 − a1 ln F/2 − a1/4) = F d/2 − a1 F²/4`` (with ``a1 ln F =
-    a0 − d/F`` on the law).
+
+@njit(cache=True, nogil=True)
+def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, Fp, dp, F, d, kt):
+    """Π at ``q``; fills the approaches ``d``, contact forces ``F`` and tangent stiffnesses
+    ``kt`` of every contact (0 where open).
+
+    ``exact``: the log law (forces from the known pairs ``Fp``, ``dp``;
+    ``φ(d) = ∫F dd = F d/2 − a1 F²/4``, tangent ``1/δ'(F)``; +inf beyond the law's range),
+    else the fixed stiffnesses ``kc`` (``φ = kc d²/2``).
     """
     nd = q.size
     e = 0.0
@@ -383,16 +268,25 @@ def _energy_law(K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, Fp, dp,
         for b in range(nd):
             t += K0[a, b] * q[b]
         e += (0.5 * t - f0[a]) * q[a]
+    _rows_times(cidx, cval, q, d)
     for c in range(gc.size):
-        d[c] = _rows_dot(cidx, cval, q, c) - gc[c]
-        if d[c] > 0.0:
-            f = _law_force(d[c], coef[c, 0], coef[c, 1], coef[c, 2], Fp[c], dp[c])
-            if f < 0.0:
-                return np.inf
-            F[c] = f
-            e += 0.5 * f * d[c] - 0.25 * coef[c, 1] * f * f
+        dc = d[c] - gc[c]
+        d[c] = dc
+        if dc > 0.0:
+            if exact:
+                f = _law_force(dc, coef[c, 0], coef[c, 1], coef[c, 2], Fp[c], dp[c])
+                if f < 0.0:
+                    return np.inf
+                F[c] = f
+                kt[c] = 1.0 / (dc / f - coef[c, 1])  # 1/δ'(F), δ' = a0 − a1 ln F − a1
+                e += 0.5 * f * dc - 0.25 * coef[c, 1] * f * f
+            else:
+                F[c] = kc[c] * dc
+                kt[c] = kc[c]
+                e += 0.5 * kc[c] * dc * dc
         else:
             F[c] = 0.0
+            kt[c] = 0.0
     for m in range(kn.size):
         wx = _rows_dot(nidx, nval, q, 2 * m) + en[m, 0]
         wy = _rows_dot(nidx, nval, q, 2 * m + 1) + en[m, 1]
@@ -404,64 +298,130 @@ def _energy_law(K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, Fp, dp,
     return e
 
 
-@njit(cache=True, nogil=True)
-def _newton_law(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, F, dprev, q, tol, maxit):
-    """Newton on Π with the exact load-dependent pin law (tangent stiffness ``1/δ'(F)``).
+@njit(cache=True, nogil=True, inline="always")
+def _assemble_rows3(cidx, cval, F, kt, H, grad):
+    """:func:`_assemble`'s contact rows where each row has three columns (a disc's x, y and
+    rotation): consecutive rows on the same columns are summed in registers and added to ``H``
+    and ``grad`` once per run (the contacts of one disc are consecutive)."""
+    i0 = i1 = i2 = -1
+    g0 = g1 = g2 = h00 = h01 = h02 = h11 = h12 = h22 = 0.0
+    for c in range(kt.size):
+        k = kt[c]
+        if not k > 0.0:
+            continue
+        if cidx[c, 0] != i0 or cidx[c, 1] != i1 or cidx[c, 2] != i2:
+            if i0 >= 0:
+                _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad)
+            i0, i1, i2 = cidx[c, 0], cidx[c, 1], cidx[c, 2]
+            g0 = g1 = g2 = h00 = h01 = h02 = h11 = h12 = h22 = 0.0
+        f = F[c]
+        v0, v1, v2 = cval[c, 0], cval[c, 1], cval[c, 2]
+        g0 += f * v0
+        g1 += f * v1
+        g2 += f * v2
+        k0, k1, k2 = k * v0, k * v1, k * v2
+        h00 += k0 * v0
+        h01 += k0 * v1
+        h02 += k0 * v2
+        h11 += k1 * v1
+        h12 += k1 * v2
+        h22 += k2 * v2
+    if i0 >= 0:
+        _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad)
 
-    The fixed point of the per-contact secant iteration of
-    :func:`gearte.solvers.rv_equilibrium._solve_position` is the root of this Π's gradient;
-    Newton reaches it quadratically instead of linearly. ``F`` (nc,) holds warm force guesses
-    and returns the contact forces, ``dprev`` the approaches those guesses belong to (the
-    previous step's). Returns (q, iterations, ok).
+
+@njit(cache=True, nogil=True, inline="always")
+def _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad):
+    """Add a symmetric 3 × 3 block and its gradient on columns (i0, i1, i2) (repeated columns,
+    the padding of :func:`sparse_rows`, carry zero entries and add nothing)."""
+    grad[i0] += g0
+    grad[i1] += g1
+    grad[i2] += g2
+    H[i0, i0] += h00
+    H[i1, i1] += h11
+    H[i2, i2] += h22
+    H[i0, i1] += h01
+    H[i1, i0] += h01
+    H[i0, i2] += h02
+    H[i2, i0] += h02
+    H[i1, i2] += h12
+    H[i2, i1] += h12
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, F, kt, q, H, grad):
+    """Gradient ``K0 q − f0 + Σ F_c B_c + bearings`` and Hessian ``K0 + Σ kt_c B_c B_cᵀ +
+    bearings + reg I`` at ``q`` — the one contact-row assembly of every Newton variant here
+    (a contact enters where ``kt_c > 0``)."""
+    nd = q.size
+    Wc = cidx.shape[1]
+    Wn = nidx.shape[1]
+    for a in range(nd):
+        t = -f0[a]
+        for b in range(nd):
+            H[a, b] = K0[a, b]
+            t += K0[a, b] * q[b]
+        grad[a] = t
+    if Wc == 3:
+        _assemble_rows3(cidx, cval, F, kt, H, grad)
+    else:
+        for c in range(kt.size):
+            if kt[c] > 0.0:
+                f = F[c]
+                k = kt[c]
+                for a in range(Wc):
+                    ia = cidx[c, a]
+                    grad[ia] += f * cval[c, a]
+                    ba = k * cval[c, a]
+                    for b in range(Wc):
+                        H[ia, cidx[c, b]] += ba * cval[c, b]
+    for m in range(kn.size):
+        rx, ry = 2 * m, 2 * m + 1
+        wx = _rows_dot(nidx, nval, q, rx) + en[m, 0]
+        wy = _rows_dot(nidx, nval, q, ry) + en[m, 1]
+        gx, gy, hxx, hyy, hxy = _bearing_terms(wx, wy, kn[m], cn[m])
+        # x and y rows share one column pattern (both rows of the same bearing)
+        for a in range(Wn):
+            ia = nidx[rx, a]
+            bx, by = nval[rx, a], nval[ry, a]
+            grad[ia] += gx * bx + gy * by
+            ta = hxx * bx + hxy * by
+            tb = hxy * bx + hyy * by
+            for b in range(Wn):
+                H[ia, nidx[rx, b]] += ta * nval[rx, b] + tb * nval[ry, b]
+    for a in range(nd):
+        H[a, a] += reg
+
+
+@njit(cache=True, nogil=True)
+def _newton(
+    exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, F, d, kt, w, tol,
+    maxit,
+):  # fmt: skip
+    """Active-set Newton with a backtracking line search on Π (:func:`_energy`), in place.
+
+    ``exact=False``: fixed contact stiffnesses ``kc`` — :func:`gearte.solvers.rv_equilibrium.
+    _newton` on sparse rows (same steps and tests). ``exact=True``: the exact load-dependent
+    pin law (tangent ``1/δ'(F)``): the fixed point of the per-contact secant iteration of
+    :func:`gearte.solvers.rv_equilibrium._solve_position` is the root of this Π's gradient, and
+    Newton reaches it quadratically. On entry ``F``, ``d`` hold warm (force, approach) pairs of
+    the law (exact only); on return ``q`` the minimiser and ``F``, ``d``, ``kt`` its forces,
+    approaches and tangents. ``w``: the work arrays (:func:`_work`). Returns (iterations, ok).
     """
     nd = q.size
     nc = gc.size
     nm = kn.size
-    Wc = cidx.shape[1]
-    Wn = nidx.shape[1]
-    d = np.empty(nc)
-    dn = np.empty(nc)
-    Fn = F.copy()
-    H = np.empty((nd, nd))
-    L = np.empty((nd, nd))
-    grad = np.empty(nd)
-    dq = np.empty(nd)
-    qn = np.empty(nd)
-    e0 = _energy_law(K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, Fn, dprev, F, d)
+    H, L, grad, dq, qn = w.H, w.L, w.grad, w.dq, w.qn
+    Fn, dn, ktn = w.Fn, w.dn, w.ktn
+    e0 = _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, F, d, Fn,
+                 dn, ktn)  # fmt: skip
     if not np.isfinite(e0):
-        return q, 0, False
+        return 0, False
+    F[:] = Fn
+    d[:] = dn
+    kt[:] = ktn
     for it in range(maxit):
-        for a in range(nd):
-            t = -f0[a]
-            for b in range(nd):
-                H[a, b] = K0[a, b]
-                t += K0[a, b] * q[b]
-            grad[a] = t
-        for c in range(nc):
-            if d[c] > 0.0:
-                f = F[c]
-                kt = 1.0 / (d[c] / f - coef[c, 1])  # 1/δ'(F), δ' = a0 − a1 ln F − a1
-                for a in range(Wc):
-                    ia = cidx[c, a]
-                    grad[ia] += f * cval[c, a]
-                    ba = kt * cval[c, a]
-                    for b in range(Wc):
-                        H[ia, cidx[c, b]] += ba * cval[c, b]
-        for m in range(nm):
-            rx, ry = 2 * m, 2 * m + 1
-            wx = _rows_dot(nidx, nval, q, rx) + en[m, 0]
-            wy = _rows_dot(nidx, nval, q, ry) + en[m, 1]
-            gx, gy, hxx, hyy, hxy = _bearing_terms(wx, wy, kn[m], cn[m])
-            for a in range(Wn):
-                ia = nidx[rx, a]
-                bx, by = nval[rx, a], nval[ry, a]
-                grad[ia] += gx * bx + gy * by
-                ta = hxx * bx + hxy * by
-                tb = hxy * bx + hyy * by
-                for b in range(Wn):
-                    H[ia, nidx[rx, b]] += ta * nval[rx, b] + tb * nval[ry, b]
-        for a in range(nd):
-            H[a, a] += reg
+        _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, F, kt, q, H, grad)
         _spd_solve(H, grad, L, dq)
         for a in range(nd):
             dq[a] = -dq[a]
@@ -470,7 +430,8 @@ def _newton_law(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, F, dp
         decreased = False
         e1 = e0
         for _ in range(60):
-            e1 = _energy_law(K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, qn, F, d, Fn, dn)
+            e1 = _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, qn, F,
+                         d, Fn, dn, ktn)  # fmt: skip
             if e1 <= e0 + 1e-12 * abs(e0):
                 decreased = True
                 break
@@ -478,65 +439,177 @@ def _newton_law(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, F, dp
             for a in range(nd):
                 qn[a] = q[a] + step * dq[a]
         if not decreased:
-            return q, it + 1, True
+            # no descent left at round-off level: q is the minimiser to machine precision
+            return it + 1, True
+        stalled = e0 - e1 <= 1e-14 * abs(e0)
         same = True
         for c in range(nc):
             if (dn[c] > 0.0) != (d[c] > 0.0):
                 same = False
-        q = qn.copy()
+        q[:] = qn
         F[:] = Fn
         d[:] = dn
+        kt[:] = ktn
         e0 = e1
         big = 0.0
         for a in range(nd):
             big = max(big, abs(step * dq[a]))
-        # quadratic convergence: after a full step of size s the error is O(s²)
-        if big < tol or (same and step == 1.0 and big < 1e-9):
-            return q, it + 1, True
-    return q, maxit, False
+        if big < tol:
+            return it + 1, True
+        if exact:
+            # quadratic convergence: after a full step of size s the error is O(s²)
+            if same and step == 1.0 and big < 1e-9:
+                return it + 1, True
+        elif (same and step == 1.0 and nm == 0) or (same and stalled and it > 2):
+            return it + 1, True
+    return maxit, False
 
 
 @njit(cache=True, nogil=True)
-def _position_sp(
-    K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, group, ngroups, law, coef, k, kc, q0,
-    tol, maxit, force, approach, exact,
-):  # fmt: skip
-    """:func:`gearte.solvers.rv_equilibrium._solve_position` on sparse rows; updates ``k``,
-    ``kc`` and ``force`` in place, returns (q, iterations, ok).
+def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, F, d, kt, w,
+                  maxit):  # fmt: skip
+    """Newton on the equilibrium *and* the pin law together, in place: no inner law solves.
 
-    ``exact``: with the per-contact law, Newton on the exact law (:func:`_newton_law`, warm
-    forces ``force`` at approaches ``approach``, both updated) first; the secant fixed point only
-    where it fails."""
+    Unknowns ``q`` and the force ``F_c`` of every closed contact; equations
+    ``K0 q − f0 + Σ F_c B_c (+ bearings) = 0`` and ``δ(F_c) = d_c(q)``. Linearising the law,
+    ``ΔF_c = (B_c·Δq − (δ(F_c) − d_c)) / δ'(F_c)``, and eliminating ``ΔF`` leaves the Hessian of
+    :func:`_newton` with the force replaced by its tangent prediction
+    ``F̃_c = F_c + (d_c − δ(F_c))/δ'(F_c)``: one logarithm per closed contact and iteration.
+    A contact opens where its updated force is not positive; an open one closes where its
+    approach is positive (start force :func:`_law_force_start`). Converged when the step in
+    ``q`` is below 1e-9 and every force moved by less than 1e-7 of the largest, with no contact
+    opening or closing (quadratic convergence: the errors left are of the order of the squares
+    of those steps, ~1e-14 of the largest force). On entry ``F``
+    holds the start forces (> 0: closed); on return ``q``, ``F`` (forces), ``d`` (approaches)
+    and ``kt`` (tangents). Returns (iterations, ok); not ok (no convergence within ``maxit``,
+    or a force beyond the law's range) leaves the state undefined.
+    """
+    nd = q.size
     nc = gc.size
-    if law == LAW_SECANT_PER_CONTACT and exact:
-        guess = force.copy()
-        q, its, ok = _newton_law(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef,
-                                 guess, approach, q0.copy(), 1e-13 * max(1.0, np.max(np.abs(q0))),
-                                 maxit)  # fmt: skip
-        if ok:
+    H, L, grad, dq, Ft, Bdq = w.H, w.L, w.grad, w.dq, w.Fn, w.dn
+    for it in range(maxit):
+        changed = False
+        _rows_times(cidx, cval, q, d)
+        for c in range(nc):
+            dc = d[c] - gc[c]
+            d[c] = dc
+            f = F[c]
+            if not f > 0.0:
+                if dc > 0.0:
+                    f = _law_force_start(dc, coef[c, 0], coef[c, 1], coef[c, 2])
+                    changed = True
+                else:
+                    kt[c] = 0.0
+                    Ft[c] = 0.0
+                    F[c] = 0.0
+                    continue
+            a1 = coef[c, 1]
+            rest = coef[c, 0] - a1 * np.log(f)  # δ/F = a0 − a1 ln F
+            slope = rest - a1  # δ'(F)
+            if not slope > 0.0:
+                return it, False  # beyond the law's range
+            k = 1.0 / slope
+            kt[c] = k
+            F[c] = f
+            Ft[c] = f + (dc - f * rest) * k
+        _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, Ft, kt, q, H, grad)
+        _spd_solve(H, grad, L, dq)
+        big = 0.0
+        for a in range(nd):
+            q[a] -= dq[a]
+            big = max(big, abs(dq[a]))
+        fbig = 0.0
+        fmax = 0.0
+        _rows_times(cidx, cval, dq, Bdq)
+        for c in range(nc):
+            if kt[c] > 0.0:
+                fn = Ft[c] - kt[c] * Bdq[c]
+                if fn > 0.0:
+                    fbig = max(fbig, abs(fn - F[c]))
+                    fmax = max(fmax, fn)
+                    F[c] = fn
+                else:
+                    F[c] = 0.0
+                    changed = True
+        if not changed and big < 1e-9 and fbig <= 1e-7 * fmax:
+            _rows_times(cidx, cval, q, d)
             for c in range(nc):
-                force[c] = guess[c]
-                approach[c] = _rows_dot(cidx, cval, q, c) - gc[c]
-                if force[c] > 0.0 and approach[c] > 0.0:
-                    kc[c] = force[c] / approach[c]
-            return q, its, True
-    q = q0.copy()
+                d[c] -= gc[c]
+                if not F[c] > 0.0:
+                    F[c] = 0.0
+                    kt[c] = 0.0
+            return it + 1, True
+    return maxit, False
+
+
+_Work = namedtuple("_Work", "H L grad dq qn Fn dn ktn kt q0 F0 d0 f0 force approach k kc")
+
+
+@njit(cache=True, nogil=True)
+def _work(nd, nc, ngroups):
+    """The work arrays of one thread: nothing is allocated inside the solver loops."""
+    return _Work(
+        np.empty((nd, nd)), np.empty((nd, nd)), np.empty(nd), np.empty(nd), np.empty(nd),
+        np.empty(nc), np.empty(nc), np.empty(nc), np.zeros(nc), np.empty(nd), np.empty(nc),
+        np.empty(nc), np.empty(nd), np.zeros(nc), np.zeros(nc), np.empty(ngroups), np.empty(nc),
+    )  # fmt: skip
+
+
+@njit(cache=True, nogil=True)
+def _position(
+    K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, group, ngroups, law, coef, q, w, tol,
+    maxit, exact,
+):  # fmt: skip
+    """:func:`gearte.solvers.rv_equilibrium._solve_position` on sparse rows, in place.
+
+    State in ``q`` (displacements) and the work arrays ``w``: ``w.k`` (per disc) and ``w.kc``
+    (per contact) stiffnesses, ``w.force`` and ``w.approach`` (the last solution's contact
+    forces and approaches: warm pairs of the law). Returns (iterations, ok).
+
+    ``exact`` (per-contact law only): :func:`_newton_mixed` from the warm forces first; where it
+    fails, Newton on Π with the exact law (:func:`_newton`); the secant fixed point only where
+    both fail.
+    """
+    nc = gc.size
+    k, kc, force, approach, kt = w.k, w.kc, w.force, w.approach, w.kt
+    qmax = 1.0
+    for a in range(q.size):
+        qmax = max(qmax, abs(q[a]))
+    qtol = 1e-13 * qmax
+    if law == LAW_SECANT_PER_CONTACT and exact:
+        w.q0[:] = q
+        w.F0[:] = force
+        w.d0[:] = approach
+        its, ok = _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q,
+                                force, approach, kt, w, 30)  # fmt: skip
+        if not ok:
+            q[:] = w.q0
+            force[:] = w.F0
+            approach[:] = w.d0
+            more, ok = _newton(True, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef,
+                               kc, q, force, approach, kt, w, qtol, maxit)  # fmt: skip
+            its += more
+        if ok:
+            return its, True
+        q[:] = w.q0
+        force[:] = w.F0
+        approach[:] = w.d0
+        for c in range(nc):  # the secant stiffness of the start as the fixed point's start
+            if force[c] > 0.0 and approach[c] > 0.0:
+                kc[c] = force[c] / approach[c]
     if law != LAW_SECANT_PER_CONTACT:
         for c in range(nc):
             kc[c] = k[group[c]]
     total = 0
-    qtol = 1e-13 * max(1.0, np.max(np.abs(q0)))
     for _outer in range(200):
-        q, its, ok = _newton_sp(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, kc, q,
-                                qtol, maxit)  # fmt: skip
+        its, ok = _newton(False, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc,
+                          q, force, approach, kt, w, qtol, maxit)  # fmt: skip
         total += its
         if not ok:
-            return q, total, False
-        for c in range(nc):
-            d = _rows_dot(cidx, cval, q, c) - gc[c]
-            force[c] = kc[c] * d if d > 0.0 else 0.0
+            return total, False
+        # force = kc d on the closed contacts (from the last energy evaluation)
         if law == LAW_LINEAR:
-            return q, total, True
+            return total, True
         change = 0.0
         if law == LAW_SECANT_PER_DISC:
             for g in range(ngroups):
@@ -548,7 +621,7 @@ def _position_sp(
                         cm = c
                 if fmax > 0.0:
                     if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
-                        return q, total, False
+                        return total, False
                     knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
                     change = max(change, abs(knew / k[g] - 1.0))
                     k[g] = knew
@@ -558,7 +631,7 @@ def _position_sp(
             for c in range(nc):
                 if force[c] > 0.0:
                     if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
-                        return q, total, False
+                        return total, False
                     knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
                     change = max(change, abs(knew / kc[c] - 1.0))
                     kc[c] = knew
@@ -571,20 +644,21 @@ def _position_sp(
                     k[g] = kg
         if change < tol:
             for c in range(nc):
-                d = _rows_dot(cidx, cval, q, c) - gc[c]
-                force[c] = kc[c] * d if d > 0.0 else 0.0
-            return q, total, True
-    return q, total, False
+                dc = approach[c]
+                force[c] = kc[c] * dc if dc > 0.0 else 0.0
+            return total, True
+    return total, False
 
 
 @njit(cache=True, nogil=True)
 def _solve_batch(
     K0s, us, regs, cidx, cvals, nidx, nvals, kn, cn, group, ngroups, law, coefs, kstart, Hs, ENs,
-    GAPs, step_g, step_T, cold, rec, nrec, out_u, out_h, out_q, tol, maxit, exact,
+    GAPs, step_g, step_T, start, rec, nrec, out_u, out_h, out_q, tol, maxit, exact,
 ):  # fmt: skip
     """All samples × steps. The system is the condensed one (:func:`condense`): stiffness
     ``K0s[g]``, load ``T us[g] − Hs[s, g]``; the output rotation is recovered as
-    ``T out_u[g] − out_h[s, g] + out_q[g] · q``."""
+    ``T out_u[g] − out_h[s, g] + out_q[g] · q``. ``start[t]``: the step whose solution (of the
+    same sample) starts step ``t`` (−1: zero displacements and the law's start stiffness)."""
     S = Hs.shape[0]
     K = step_g.size
     nd = us.shape[1]
@@ -592,40 +666,53 @@ def _solve_batch(
     rot = np.zeros((S, K))
     forces = np.zeros((S, nrec, nc))
     iters = np.zeros((S, K), dtype=np.int64)
-    k = np.empty(ngroups)
-    kc = np.empty(nc)
-    force = np.zeros(nc)
-    approach = np.zeros(nc)
-    f0 = np.empty(nd)
+    w = _work(nd, nc, ngroups)
+    f0 = w.f0
     q = np.zeros(nd)
+    # the solution of every step of the current sample (starts of later steps)
+    Q = np.zeros((K, nd))
+    FF = np.zeros((K, nc))
+    DD = np.zeros((K, nc))
+    KG = np.zeros((K, ngroups))
+    KC = np.zeros((K, nc))
     for s in range(S):
         for t in range(K):
             g = step_g[t]
             T = step_T[t]
-            if cold[t]:
+            u = start[t]
+            if u < 0:
                 q[:] = 0.0
-                force[:] = 0.0
-                approach[:] = 0.0
-                k[:] = kstart
-                for c in range(nc):
-                    kc[c] = k[group[c]]
+                w.force[:] = 0.0
+                w.approach[:] = 0.0
+                w.k[:] = kstart
+                w.kc[:] = kstart
+            else:
+                q[:] = Q[u]
+                w.force[:] = FF[u]
+                w.approach[:] = DD[u]
+                w.k[:] = KG[u]
+                w.kc[:] = KC[u]
             for a in range(nd):
                 f0[a] = T * us[g, a] - Hs[s, g, a]
-            q, its, ok = _position_sp(
+            its, ok = _position(
                 K0s[g], regs[g], f0, nidx, nvals[g], ENs[s, g], kn, cn, cidx, cvals[g],
-                GAPs[s, g], group, ngroups, law, coefs[g], k, kc, q, tol, maxit, force, approach,
-                exact,
+                GAPs[s, g], group, ngroups, law, coefs[g], q, w, tol, maxit, exact,
             )  # fmt: skip
             if not ok:
                 iters[s, t] = -1
                 break
             iters[s, t] = its
+            Q[t] = q
+            FF[t] = w.force
+            DD[t] = w.approach
+            KG[t] = w.k
+            KC[t] = w.kc
             r = T * out_u[g] - out_h[s, g]
             for a in range(nd):
                 r += out_q[g, a] * q[a]
             rot[s, t] = r
             if rec[t] >= 0:
-                forces[s, rec[t]] = force
+                forces[s, rec[t]] = w.force
     return rot, forces, iters
 
 
@@ -721,6 +808,7 @@ def solve_batch(
     cold: np.ndarray,
     record: np.ndarray | None = None,
     *,
+    start: np.ndarray | None = None,
     tol: float = 1e-9,
     maxit: int = 100,
     exact: bool = True,
@@ -742,9 +830,14 @@ def solve_batch(
     step_torque : numpy.ndarray
         (K,) output torque of each step [N·mm].
     cold : numpy.ndarray
-        (K,) bool [-]: start a new sequence at this step (zero displacements, start stiffness).
+        (K,) bool [-]: start a new sequence at this step (zero displacements, start stiffness);
+        otherwise a step starts from the previous step's solution.
     record : numpy.ndarray, optional
         (K,) bool [-]: keep the contact forces at this step (default none).
+    start : numpy.ndarray, optional
+        (K,) int [-]: instead of ``cold``, the earlier step whose solution starts each step
+        (−1: cold). A step that repeats an earlier one (same geometry and torque, e.g. the
+        rising branch of a hysteresis loop) starting from it is verified in one iteration.
     tol : float
         Relative tolerance of the secant fixed point [-] (as
         :func:`gearte.solvers.rv_equilibrium.solve_positions`).
@@ -752,8 +845,9 @@ def solve_batch(
         Newton iterations per solve.
     exact : bool
         Per-contact law: Newton on the exact law (quadratic convergence to the secant fixed
-        point's limit) instead of the secant fixed point (linear convergence, stopped at ``tol``);
-        ``False`` runs the fixed point exactly as the per-case solver does.
+        point's limit; :func:`_newton_mixed`, falling back to a line-searched Newton) instead
+        of the secant fixed point (linear convergence, stopped at ``tol``); ``False`` runs the
+        fixed point exactly as the per-case solver does.
     compiled : bool
         ``False`` runs the plain-Python twin.
 
@@ -766,8 +860,13 @@ def solve_batch(
     K = np.asarray(step_geometry).size
     if np.asarray(step_torque).shape != (K,) or np.asarray(cold).shape != (K,):
         raise ParameterError("steps", K, "step_geometry, step_torque and cold need one entry each")
-    if K and not bool(np.asarray(cold)[0]):
-        raise ParameterError("cold", cold, "the first step must start a sequence (cold)")
+    if start is None:
+        if K and not bool(np.asarray(cold)[0]):
+            raise ParameterError("cold", cold, "the first step must start a sequence (cold)")
+        start = np.where(np.asarray(cold, dtype=bool), -1, np.arange(K) - 1)
+    start = np.asarray(start, dtype=np.int64)
+    if start.shape != (K,) or np.any(start >= np.arange(K)) or np.any(start < -1):
+        raise ParameterError("start", start, "one entry per step: an earlier step or -1")
     rec = np.full(K, -1, dtype=np.int64)
     if record is not None:
         r = np.flatnonzero(np.asarray(record, dtype=bool))
@@ -786,34 +885,24 @@ def solve_batch(
     h = np.asarray(h, dtype=float)
     hc = np.einsum("gcn,sgn->sgc", cd.M, h)  # condensed loads, (S, G, m)
     out_h = np.einsum("gn,sgn->sg", cd.out_hrow, h)
+    en = np.asarray(bearing_offset, dtype=float)
+    gap = np.asarray(gap, dtype=float)
     args = (
         cd.K, cd.u, cd.reg, cd.contacts.index, np.ascontiguousarray(cd.contacts.value),
         cd.bearings.index, np.ascontiguousarray(cd.bearings.value),
         np.ascontiguousarray(p.bearing_k, dtype=float),
         np.ascontiguousarray(p.bearing_c, dtype=float), p.group.astype(np.int64), p.ngroups,
         int(p.law), coef3, float(p.start_stiffness),
-        np.ascontiguousarray(hc), np.ascontiguousarray(bearing_offset, dtype=float),
-        np.ascontiguousarray(gap, dtype=float), np.asarray(step_geometry, dtype=np.int64),
-        np.asarray(step_torque, dtype=float), np.asarray(cold, dtype=np.bool_), rec, nrec,
-        np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
+        np.ascontiguousarray(hc), np.ascontiguousarray(en), np.ascontiguousarray(gap),
+        np.asarray(step_geometry, dtype=np.int64), np.asarray(step_torque, dtype=float), start,
+        rec, nrec, np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
         np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact),
     )  # fmt: skip
     if compiled:
         rot, forces, iters = _solve_batch(*args)
     else:
-        g = _solve_batch.py_func.__globals__
-        names = ("_position_sp", "_newton_sp", "_energy_sp", "_spd_solve", "_rows_dot",
-                 "_newton_law", "_energy_law", "_law_force")  # fmt: skip
         with _TWIN_LOCK:
-            saved = {n: g[n] for n in names}
-            for n in names:
-                g[n] = saved[n].py_func
-            try:
-                rot, forces, iters = _solve_batch.py_func(*args)
-            finally:
-                g.update(saved)
-        # _law_delta is imported compiled; its py_func is called through the compiled object,
-        # which is fine: it is a pure scalar expression.
+            rot, forces, iters = _twin(_solve_batch)(*args)
     if np.any(iters < 0):
         s, t = (int(v[0]) for v in np.nonzero(iters < 0))
         raise ConvergenceError(
@@ -823,3 +912,27 @@ def solve_batch(
             "(or a pin force beyond the range of the contact law)"
         )
     return BatchSolution(rot, forces, iters)
+
+
+_KERNELS = ("_solve_batch", "_position", "_newton", "_newton_mixed", "_energy", "_assemble",
+            "_assemble_rows3", "_add_block3", "_rows_times",
+            "_spd_solve", "_rows_dot", "_law_force", "_law_force_start", "_work", "_bearing_terms",
+            "_law_delta")  # fmt: skip
+
+
+def _twin(kernel):
+    """The plain-Python twin of ``kernel``: its ``py_func``, calling the plain-Python versions
+    of the other kernels (swapped into this module's globals while it runs; the caller holds
+    ``_TWIN_LOCK``)."""
+    g = kernel.py_func.__globals__
+
+    def run(*args):
+        saved = {n: g[n] for n in _KERNELS}
+        for n in _KERNELS:
+            g[n] = getattr(saved[n], "py_func", saved[n])
+        try:
+            return kernel.py_func(*args)
+        finally:
+            g.update(saved)
+
+    return run

@@ -177,7 +177,7 @@ def drive_from_case(case: Any, *, name: str | None = None) -> Drive:
         )
     if kind == "rv_reducer":
         from gearte.drives.rv_reducer import RVDrive
-        from gearte.studies.rv_reducer import build_reducer
+        from gearte.studies.rv_reducer import build_reducer, first_stage_terms
         from gearte.units import deg_to_rad
 
         red = build_reducer(case.reducer)
@@ -195,8 +195,18 @@ def drive_from_case(case: Any, *, name: str | None = None) -> Drive:
 
             law = contact_law(red, law_name)
         cat = getattr(case.analyses, "catalogue", None)
+        free = 0.0  # the first stage's backlash at the output (first_stage_backlash = additive)
+        fs_terms = first_stage_terms(case.reducer.first_stage)
+        if fs_terms is not None and getattr(cat, "first_stage_backlash", "additive") == "additive":
+            import numpy as np
+
+            from gearte.models.rv_first_stage import output_free_angle
+            from gearte.units import um_to_mm
+
+            mid = um_to_mm(np.asarray(fs_terms["backlash_um"]["mid"], dtype=float))
+            free = float(output_free_angle(mid, fs_terms["r_sun"], float(red.ratio)))
         if cat is None:
-            return RVDrive(red, name=label, law=law)
+            return RVDrive(red, name=label, law=law, first_stage_free_angle=free)
         return RVDrive(
             red,
             name=label,
@@ -205,6 +215,7 @@ def drive_from_case(case: Any, *, name: str | None = None) -> Drive:
             steps_per_segment=cat.steps_per_segment,
             lost_motion_fraction=cat.lost_motion_fraction,
             law=law,
+            first_stage_free_angle=free,
         )
     raise ValueError(
         f"case kind {kind!r} does not describe one drive; drive kinds: {list(DRIVE_CASE_KINDS)}"

@@ -1225,44 +1225,9 @@ def _te_csv(te) -> str:
     return "\n".join(rows) + "\n"
 
 
-def _with_first_stage(cat, free_angle: float, rated: float, fraction: float):
-    """Catalogue values with the first stage's dead zone ``free_angle`` [rad] in the loop and
-    the curve, re-read by the shared definitions (:mod:`gearte.models.rv_first_stage`)."""
-    from dataclasses import replace
-
-    from gearte.models.catalogue import hysteresis_values
-    from gearte.models.rv_catalogue import TorsionTest
-    from gearte.models.rv_first_stage import with_dead_zone
-
-    t = cat.curve.torque
-    rising = np.sign(np.diff(t, prepend=t[0]))
-    rising[rising == 0] = -1.0  # the first point: approached from above (torsion_test)
-    curve = TorsionTest(t, with_dead_zone(t, cat.curve.angle, rising, free_angle))
-    loop = TorsionTest(
-        cat.loop.torque,
-        with_dead_zone(cat.loop.torque, cat.loop.angle, cat.loop_direction, free_angle),
-    )
-    hv = hysteresis_values(
-        loop.torque,
-        loop.angle,
-        rated,
-        direction=cat.loop_direction,
-        lost_motion_fraction=fraction,
-    )
-    return replace(
-        cat,
-        torsional_rigidity=hv.torsional_rigidity,
-        lost_motion=hv.lost_motion,
-        backlash=hv.backlash,
-        hysteresis_loss=hv.hysteresis_loss,
-        curve=curve,
-        loop=loop,
-    )
-
-
 def _catalogue(red, sec: CatalogueSection, law, fs_terms=None) -> AnalysisResult:
     from gearte.models.rv_catalogue import catalogue_values
-    from gearte.models.rv_first_stage import output_free_angle
+    from gearte.models.rv_first_stage import catalogue_with_free_angle, output_free_angle
 
     cat = catalogue_values(
         red,
@@ -1281,13 +1246,13 @@ def _catalogue(red, sec: CatalogueSection, law, fs_terms=None) -> AnalysisResult
             for k, v in fs_terms["backlash_um"].items()
         }
         base = cat
-        cat = _with_first_stage(
+        cat = catalogue_with_free_angle(
             base, free["mid"], float(red.rated_torque), sec.lost_motion_fraction
         )
         fs_values["first_stage_backlash_at_output [arcmin]"] = rad_to_arcmin(free["mid"])
         if free["min"] != free["max"]:
             for tag in ("min", "max"):
-                c = _with_first_stage(
+                c = catalogue_with_free_angle(
                     base, free[tag], float(red.rated_torque), sec.lost_motion_fraction
                 )
                 fs_values[f"first_stage_backlash_at_output_{tag} [arcmin]"] = rad_to_arcmin(
