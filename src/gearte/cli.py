@@ -487,10 +487,11 @@ def export(
 @click.argument("cases", nargs=-1, required=True)
 def validate(cases: tuple[str, ...]) -> None:
     """Check case files without running them; print every problem, one per line."""
-    from gearte.errors import CaseFileError
+    from gearte.errors import CaseFileError, ParameterError
 
     def _validate() -> None:
         from gearte.io.case_file import load_case
+        from gearte.studies import preflight
 
         bad = 0
         for c in cases:
@@ -505,6 +506,12 @@ def validate(cases: tuple[str, ...]) -> None:
                 click.echo(
                     f"{c}: 1 error(s)\n  (file): {str(exc).strip(chr(39) + chr(34))}", err=True
                 )
+                continue
+            try:  # the checks `run` makes on the built drive before any analysis
+                preflight(case)
+            except ParameterError as exc:
+                bad += 1
+                click.echo(f"{c}: 1 error(s)\n  {exc}", err=True)
                 continue
             click.echo(f"{c}: ok ({case.case.kind})")
         if bad:

@@ -155,6 +155,25 @@ def paper_rule_assembly(
     (the smaller of the two solutions in [0, 2 pi)).
     """
     mags = dict(magnitudes)
+    ang, rule = paper_rule_angles(terms, mags, given_angles)
+    return _plan(terms, mags, ang, tuple(rule))
+
+
+def paper_rule_angles(
+    terms: TermSet,
+    magnitudes: Mapping[str, float],
+    given_angles: Mapping[str, float] | None = None,
+) -> tuple[dict[str, float], list[str]]:
+    """The angles [rad] of :func:`paper_rule_assembly` and the angles the rule set, without
+    evaluating the TE (the study's pre-flight runs it to check the term keys and that no angle
+    enters a frequency group with both signs).
+
+    Raises
+    ------
+    ParameterError
+        ``terms``: an angle enters one frequency group with both signs; a missing magnitude.
+    """
+    mags = dict(magnitudes)
     keyed_vector(terms.magnitudes, mags, "magnitudes", required=True)
     ang = {a: float((given_angles or {}).get(a, 0.0)) for a in terms.angles}
     _, harm, group = frequency_basis(terms)
@@ -214,7 +233,7 @@ def paper_rule_assembly(
             target = np.angle(F) + (0.0 if lam > 0 else np.pi)
             ang[v] = float(np.mod((target - np.angle(Gv)) / s, 2 * np.pi))
             rule.append(v)
-    return _plan(terms, mags, ang, tuple(rule))
+    return ang, rule
 
 
 def halton_starts(n: int, d: int, seed: int) -> np.ndarray:

@@ -487,6 +487,31 @@ def _new_envelope(n_env: int) -> np.ndarray:
     return env
 
 
+def check_rk4_steps(dt: float, span_s: float) -> None:
+    """Refuse an RK4 integration of ``span_s`` [s] in steps of ``dt`` [s] whose step count
+    (at :data:`_RK4_STEP_S` a step, a lower estimate) is over the time budget
+    (``GEARTE_MAX_SECONDS``, :func:`gearte.limits.check_time`). Called by :func:`integrate`
+    before any step and by the studies' pre-flight (``gearte validate``) before any analysis.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``dt``, the step count and ``GEARTE_MAX_SECONDS``.
+    """
+    from gearte.limits import check_time
+
+    # found by fuzzing: a stiff model's tiny step made ~1e150 steps, an integer the compiled
+    # kernel cannot take, or a run of hours
+    steps = span_s / dt
+    check_time(
+        "dt",
+        dt,
+        steps * _RK4_STEP_S,
+        f"an RK4 integration of {steps:.3g} steps of {dt:.3g} s over {span_s:g} s (a stiff "
+        "model: check its masses, inertias and stiffnesses)",
+    )
+
+
 def integrate(
     system: ODESystem,
     y0: np.ndarray,
@@ -603,17 +628,7 @@ def integrate(
                 )
         # end exactly at t1: the step is shortened (never lengthened) to fit the span
         steps = (t1 - t0) / dt
-        from gearte.limits import check_time
-
-        # before any step (found by fuzzing: a stiff model's tiny step made ~1e150 steps, an
-        # integer the compiled kernel cannot take, or a run of hours)
-        check_time(
-            "dt",
-            dt,
-            steps * _RK4_STEP_S,
-            f"an RK4 integration of {steps:.3g} steps of {dt:.3g} s over {t1 - t0:g} s (a stiff "
-            "model: check its masses, inertias and stiffnesses)",
-        )
+        check_rk4_steps(dt, t1 - t0)
         n_steps = max(1, int(np.ceil(steps - 1e-9)))
         dt = (t1 - t0) / n_steps
         settle_steps = int(round(t_settle / dt))

@@ -25,6 +25,7 @@ __all__ = [
     "available_kinds",
     "get_kind",
     "register_kind",
+    "preflight",
     "run_case",
     "check_samples_override",
     "sample_cap",
@@ -121,6 +122,23 @@ def sample_cap(section: Any, name: str, options: Any, low: int | None = None) ->
     return max(low, min(int(value), int(n)))
 
 
+def preflight(case: Any) -> None:
+    """Every check a run of ``case`` (a validated ``Case``) makes on the built drive, made before
+    any analysis: the kind module's ``preflight(case)`` where it has one (it builds the drive and
+    model objects and calls the same check functions the analyses call). ``gearte validate`` and
+    :func:`run_case` call it, so a run refuses such an input before doing any work and validate
+    gives the same message (docs/errors.md, "Limits").
+
+    Raises
+    ------
+    gearte.errors.ParameterError
+        Naming the key of the first failing check.
+    """
+    fn = getattr(get_kind(case.case.kind), "preflight", None)
+    if fn is not None:
+        fn(case)
+
+
 def run_case(case: Any, options: RunOptions | None = None) -> Any:
     """Run a case: a validated ``Case``, a path to a TOML file, a bundled name or a dict.
 
@@ -149,6 +167,7 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
     t_imp = time.perf_counter()
     module = get_kind(case.case.kind)
     check_samples_override(case, (options or RunOptions()).samples)
+    preflight(case)
     t0 = time.perf_counter()
     from gearte.execution.stop import keep_finished_chunks
 

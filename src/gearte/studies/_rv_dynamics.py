@@ -577,6 +577,34 @@ def _batch(case, red, model, options) -> AnalysisResult:
     )
 
 
+def preflight_dynamics(case, red: RVReducer) -> None:
+    """The checks of :func:`run_dynamics` that need the built model, without running an analysis
+    (``gearte validate`` and ``gearte run`` before any analysis): the masses and inertias
+    derived from geometry and density (:func:`build_dynamic_model`: a derived body needs
+    ``reducer.density_kg_per_m3``), a finite elastic mode, and the RK4 step count of each
+    fixed-step integration against the time budget (:func:`gearte.solvers.ode.check_rk4_steps`,
+    at the default step of the base model; a speed of the sweep is checked again when it runs).
+
+    Raises
+    ------
+    ParameterError
+        The first failing check, naming its key.
+    """
+    from gearte.runners.rv_dynamics_sim import default_step
+    from gearte.solvers.ode import check_rk4_steps
+
+    model, _ = build_dynamic_model(case, red)
+    a = case.analyses
+    spans = []
+    if a.dte is not None and a.dte.method == "rk4":
+        spans.append((a.dte.step_fraction, a.dte.duration_s + a.dte.settle_s))
+    for o in (a.speed_sweep, a.batch):
+        if o is not None:
+            spans.append((0.85, o.duration_s + o.settle_s))
+    for fraction, span in spans:
+        check_rk4_steps(default_step(model, fraction), span)
+
+
 def run_dynamics(case, red: RVReducer, options) -> tuple[list[AnalysisResult], list[str]]:
     """Run the dynamic analyses an ``rv_reducer`` case asks for.
 

@@ -414,6 +414,47 @@ def to_toml(data: Mapping[str, Any], _prefix: str = "") -> str:
     return out
 
 
+def yield_inputs(
+    section: YieldSection,
+    units: Mapping[str, str],
+    nominal: Mapping[str, float],
+    defaults: Mapping[str, ToleranceEntry] | None = None,
+    families: Mapping[str, list[str]] | None = None,
+    grade_um: Callable[[str, int], float | None] | None = None,
+) -> tuple[Any, dict[str, Any]]:
+    """The tolerance set and allocation cost models of a yield section, checked against the
+    drive's error keys (arguments as :func:`yield_analysis`). :func:`yield_analysis` calls it
+    before any sample and the kinds' pre-flight (``gearte validate``) calls it without running.
+
+    Returns
+    -------
+    (ToleranceSet, dict)
+        The tolerances and ``{error key: CostModel or PriceTable}``.
+
+    Raises
+    ------
+    ParameterError
+        A tolerance or cost naming a key the drive does not have
+        (``analyses.yield.tolerances.<key>``, ``analyses.yield.allocation.costs.<key>``), a
+        tolerance in the wrong unit, a grade on an error that is not a gear's eccentricity.
+    """
+    from gearte.errors import ParameterError
+    from gearte.tolerance.allocation import CostModel, PriceTable
+
+    ts = _tolerances(section, units, nominal, dict(defaults or {}), dict(families or {}), grade_um)
+    costs: dict[str, CostModel | PriceTable] = {}
+    for key, c in (section.allocation.costs if section.allocation else {}).items():
+        if key not in ts.families:
+            raise ParameterError(
+                f"analyses.yield.allocation.costs.{key}", key, "has no tolerance to allocate"
+            )
+        if c.b is not None:
+            costs[key] = CostModel(c.a, c.b, c.k)
+        else:
+            costs[key] = PriceTable(tuple(c.widths or ()), tuple(c.prices or ()))
+    return ts, costs
+
+
 def yield_analysis(
     section: YieldSection,
     model: Callable,
@@ -455,9 +496,8 @@ def yield_analysis(
         ``(key, grade) -> tolerance [µm]`` for errors that are a gear's eccentricity (``None``
         for the others): how ``grade = N`` reads for this drive.
     """
-    from gearte.errors import ParameterError
     from gearte.studies import sample_cap
-    from gearte.tolerance.allocation import CostModel, PriceTable, allocate
+    from gearte.tolerance.allocation import allocate
     from gearte.tolerance.yield_contributions import (
         linear_prediction,
         pareto_rows,
@@ -467,19 +507,8 @@ def yield_analysis(
 
     seed = section.seed if getattr(options, "seed", None) is None else int(options.seed)
     n = section.samples if getattr(options, "samples", None) is None else int(options.samples)
-    defaults = dict(defaults or {})
-    ts = _tolerances(section, units, nominal, defaults, dict(families or {}), grade_um)
+    ts, costs = yield_inputs(section, units, nominal, defaults, families, grade_um)
     spec = [SpecLimit(q, s.lower, s.upper) for q, s in section.spec.items()]
-    costs: dict[str, CostModel | PriceTable] = {}  # checked before any work
-    for key, c in (section.allocation.costs if section.allocation else {}).items():
-        if key not in ts.families:
-            raise ParameterError(
-                f"analyses.yield.allocation.costs.{key}", key, "has no tolerance to allocate"
-            )
-        if c.b is not None:
-            costs[key] = CostModel(c.a, c.b, c.k)
-        else:
-            costs[key] = PriceTable(tuple(c.widths or ()), tuple(c.prices or ()))
     progress = getattr(options, "progress", False)
     res = run_yield(
         model,

@@ -525,20 +525,46 @@ def run(case: Case, options) -> StudyResult:
     return StudyResult(case=case, analyses=analyses, warnings=warnings)
 
 
-def _yield(st, case: Case, options) -> AnalysisResult:
-    """``[analyses.yield]``: the nine component errors [µm] drawn from their laws → the
-    distribution of the geometric TE (not only eq 17's RSS band) and its yield."""
+def _yield_keys(case: Case) -> tuple[dict, dict, dict]:
+    """The yield's error keys (all in µm), their means [µm] and the tolerances the ``[errors]``
+    bands imply (mean ± T/2 as normal laws with σ = T/6, unless the section says else)."""
     from gearte.models.cycloid_te import ERROR_FACTORS
-    from gearte.runners.yield_models import CycloidGeometricTE
-    from gearte.studies._yield import ToleranceEntry, yield_analysis
+    from gearte.studies._yield import ToleranceEntry
 
     means = {k: getattr(case.errors, k).mean_um for k in ERROR_FACTORS}
-    # the [errors] bands (mean ± T/2) as normal laws with σ = T/6, unless the section says else
     bands = {
         k: ToleranceEntry(tolerance_um=0.5 * getattr(case.errors, k).tolerance_um)
         for k in ERROR_FACTORS
         if getattr(case.errors, k).tolerance_um > 0
     }
+    return {k: "um" for k in ERROR_FACTORS}, means, bands
+
+
+def preflight(case: Case) -> None:
+    """The checks :func:`run` makes before any analysis that the schema cannot make alone
+    (``gearte validate``, :func:`gearte.studies.run_case`): the yield's tolerance and cost keys
+    against the stage's error keys (:func:`~gearte.studies._yield.yield_inputs`).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``analyses.yield.tolerances.<key>`` or ``analyses.yield.allocation.costs.<key>``.
+    """
+    if case.analyses.yield_ is not None:
+        from gearte.studies._yield import yield_inputs
+
+        units, means, bands = _yield_keys(case)
+        yield_inputs(case.analyses.yield_, units, means, defaults=bands)
+
+
+def _yield(st, case: Case, options) -> AnalysisResult:
+    """``[analyses.yield]``: the nine component errors [µm] drawn from their laws → the
+    distribution of the geometric TE (not only eq 17's RSS band) and its yield."""
+    from gearte.models.cycloid_te import ERROR_FACTORS
+    from gearte.runners.yield_models import CycloidGeometricTE
+    from gearte.studies._yield import yield_analysis
+
+    units, means, bands = _yield_keys(case)
 
     def worst_case(errors):
         d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
@@ -549,7 +575,7 @@ def _yield(st, case: Case, options) -> AnalysisResult:
     return yield_analysis(
         case.analyses.yield_,  # type: ignore[arg-type]
         CycloidGeometricTE(st, means),
-        {k: "um" for k in ERROR_FACTORS},
+        units,
         means,
         options=options,
         worst_case=worst_case,

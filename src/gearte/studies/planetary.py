@@ -431,6 +431,28 @@ def _meaning(key: str) -> str:
 
 
 # --------------------------------------------------------------------------- run
+def preflight(case: Case) -> None:
+    """The checks :func:`run` makes on the built terms before any analysis (``gearte validate``,
+    :func:`gearte.studies.run_case`): the paper-rule phase allocation every run makes
+    (:func:`~gearte.runners.planetary_assembly.paper_rule_angles`; an angle that enters one
+    frequency group with both signs is refused) and the yield's tolerance and cost keys
+    (:func:`~gearte.studies._yield.yield_inputs`), without evaluating any TE.
+
+    Raises
+    ------
+    ParameterError
+        Naming the key (``terms`` and the angle, ``analyses.yield...``).
+    """
+    from gearte.runners.planetary_assembly import paper_rule_angles
+
+    terms, mags, angs = build_terms(case)
+    paper_rule_angles(terms, mags, angs)
+    if case.analyses.yield_ is not None:
+        from gearte.studies._yield import yield_inputs
+
+        yield_inputs(case.analyses.yield_, *_yield_keys(terms, mags, angs))
+
+
 def run(case: Case, options) -> StudyResult:
     """Derive (or read) the terms, then coupled TE, assembly phases and Monte-Carlo."""
     from gearte.runners.planetary_assembly import (
@@ -667,13 +689,8 @@ def run(case: Case, options) -> StudyResult:
     return StudyResult(case=case, analyses=analyses, warnings=warnings)
 
 
-def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> AnalysisResult:
-    """``[analyses.yield]``: magnitudes [µm] and directions [deg] as tolerances (e.g. Wang's
-    random assembly: each direction ``uniform``, ``nominal_deg = 180``, ``tolerance_deg =
-    180``) → yield of the coupled TE."""
-    from gearte.runners.yield_models import PlanetaryCoupledTE
-    from gearte.studies._yield import yield_analysis
-
+def _yield_keys(terms: TermSet, mags: dict, angs: dict) -> tuple[dict, dict]:
+    """The error keys of the yield (magnitudes in µm, angles in deg) and their nominal values."""
     mag_um = {k: float(mm_to_um(v)) for k, v in mags.items()}
     ang_deg = {k: float(rad_to_deg(v)) for k, v in angs.items()}
     units = {k: "um" for k in terms.magnitudes} | {k: "deg" for k in terms.angles}
@@ -681,6 +698,19 @@ def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> Analy
         **{k: mag_um.get(k, 0.0) for k in terms.magnitudes},
         **{k: ang_deg.get(k, 0.0) for k in terms.angles},
     }
+    return units, nominal
+
+
+def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> AnalysisResult:
+    """``[analyses.yield]``: magnitudes [µm] and directions [deg] as tolerances (e.g. Wang's
+    random assembly: each direction ``uniform``, ``nominal_deg = 180``, ``tolerance_deg =
+    180``) → yield of the coupled TE."""
+    from gearte.runners.yield_models import PlanetaryCoupledTE
+    from gearte.studies._yield import yield_analysis
+
+    units, nominal = _yield_keys(terms, mags, angs)
+    mag_um = {k: float(mm_to_um(v)) for k, v in mags.items()}
+    ang_deg = {k: float(rad_to_deg(v)) for k, v in angs.items()}
 
     def worst_case(errors):
         d = case.model_dump(mode="json", by_alias=True, exclude_none=True)

@@ -1379,6 +1379,30 @@ def _cycloid_analyses(case: Case, options) -> tuple[list[AnalysisResult], list[s
     return out, list(res.warnings)
 
 
+def preflight(case: Case) -> None:
+    """The checks :func:`run` makes on the built reducer, before any analysis (called by
+    ``gearte validate`` and by :func:`gearte.studies.run_case`): the dynamic model's derived
+    masses (density), its elastic modes and RK4 step budgets
+    (:func:`_rv_dynamics.preflight_dynamics`); the yield's tolerance and cost keys against the
+    reducer's error keys (:func:`~gearte.studies._yield.yield_inputs`).
+
+    Raises
+    ------
+    ParameterError
+        Naming the key of the first failing check.
+    """
+    a = case.analyses
+    if a.yield_ is not None:
+        from gearte.studies._yield import yield_inputs
+
+        # the reducer the yield reads: the design without the case's errors
+        red0 = build_reducer(case.reducer, with_errors=not case.reducer.errors)
+        families, defaults, units = _yield_keys(case, red0, a.yield_)
+        yield_inputs(a.yield_, units, {}, defaults, families, _grade_um(case))
+    if any(getattr(a, k) is not None for k in dyn.ANALYSES):
+        dyn.preflight_dynamics(case, build_reducer(case.reducer))
+
+
 def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyResult:
     """Run the analyses a case asks for; every one reads the same :class:`RVReducer`.
 
@@ -1444,6 +1468,45 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
     return StudyResult(case=case, analyses=out, warnings=warnings)
 
 
+def _yield_keys(case: Case, red, sec: RVYieldSection) -> tuple[dict, dict, dict]:
+    """``(families, defaults, units)`` of the reducer's yield: the error keys of ``red`` (and of
+    the first stage's backlash when it is additive), the tolerances its classes imply, µm each."""
+    from gearte.runners.yield_models import rv_error_keys
+
+    families = rv_error_keys(red)
+    fs_terms = first_stage_terms(case.reducer.first_stage)
+    defaults: dict[str, Any] = {}
+    if fs_terms is not None and sec.first_stage_backlash == "additive":
+        from gearte.runners.rv_first_stage_yield import first_stage_error_keys
+        from gearte.studies._yield import ToleranceEntry
+
+        fs_keys = first_stage_error_keys(case.reducer.first_stage.planets)
+        families = {**families, **fs_keys}
+        for key, (lo, hi) in fs_terms["limits_um"].items():
+            # a class is a drawing limit: truncated normal, 3σ = half its width, cut there
+            defaults[key] = ToleranceEntry(
+                kind="truncated_normal", tolerance_um=0.5 * (hi - lo), nominal_um=0.5 * (lo + hi)
+            )
+    units = {k: "um" for k in families} | {k: "um" for v in families.values() for k in v}
+    return families, defaults, units
+
+
+def _grade_um(case: Case):
+    """The ``grade_um(key, grade)`` argument of the reducer's yield
+    (:func:`~gearte.studies._yield.yield_analysis`)."""
+
+    def grade_um(key: str, grade: int) -> float | None:
+        """planet_base_circle: eccentricity tolerance F_rT/2 of the planet (ISO 1328-1:2013)."""
+        from gearte.tolerance.iso1328 import runout_tolerance
+
+        fs = case.reducer.first_stage
+        if key.split(".")[0] != "planet_base_circle":
+            return None
+        return 0.5 * runout_tolerance(grade, fs.module_mm, fs.module_mm * fs.planet_teeth)
+
+    return grade_um
+
+
 def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
     """``[analyses.yield]``: each sample one assembled reducer (errors drawn from the
     tolerances; errors without a tolerance keep the case's values) → catalogue test, angular TE
@@ -1453,7 +1516,6 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         RV_PIN_FAMILIES,
         RV_VECTOR_PARTS,
         RVReducerYield,
-        rv_error_keys,
     )
     from gearte.studies._yield import yield_analysis
 
@@ -1462,16 +1524,11 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         positions=sec.positions,
         te_torque=None if sec.te_torque_Nm is None else float(Nm_to_Nmm(sec.te_torque_Nm)),
     )
-    families = rv_error_keys(red)
+    families, defaults, units = _yield_keys(case, red, sec)
     fs_terms = first_stage_terms(case.reducer.first_stage)
-    defaults: dict[str, Any] = {}
     fs_model = None
     if fs_terms is not None and sec.first_stage_backlash == "additive":
-        from gearte.runners.rv_first_stage_yield import (
-            FirstStageBacklashYield,
-            first_stage_error_keys,
-        )
-        from gearte.studies._yield import ToleranceEntry
+        from gearte.runners.rv_first_stage_yield import FirstStageBacklashYield
 
         model = fs_model = FirstStageBacklashYield(  # type: ignore[assignment]
             model,
@@ -1481,14 +1538,6 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
             fs_terms["alpha"],
             nominal_um=fs_terms["nominal_um"],
         )
-        fs_keys = first_stage_error_keys(case.reducer.first_stage.planets)
-        families = {**families, **fs_keys}
-        for key, (lo, hi) in fs_terms["limits_um"].items():
-            # a class is a drawing limit: truncated normal, 3σ = half its width, cut there
-            defaults[key] = ToleranceEntry(
-                kind="truncated_normal", tolerance_um=0.5 * (hi - lo), nominal_um=0.5 * (lo + hi)
-            )
-    units = {k: "um" for k in families} | {k: "um" for v in families.values() for k in v}
 
     def worst_case(errors):
         d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
@@ -1538,15 +1587,6 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         }
         return d
 
-    def grade_um(key: str, grade: int) -> float | None:
-        """planet_base_circle: eccentricity tolerance F_rT/2 of the planet (ISO 1328-1:2013)."""
-        from gearte.tolerance.iso1328 import runout_tolerance
-
-        fs = case.reducer.first_stage
-        if key.split(".")[0] != "planet_base_circle":
-            return None
-        return 0.5 * runout_tolerance(grade, fs.module_mm, fs.module_mm * fs.planet_teeth)
-
     res = yield_analysis(
         sec,
         model,
@@ -1557,7 +1597,7 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         references=["han2023", "hu2020"],
         defaults=defaults,
         families=families,
-        grade_um=grade_um,
+        grade_um=_grade_um(case),
     )
     res.values["first_stage_backlash"] = sec.first_stage_backlash
     if fs_terms is not None and sec.first_stage_backlash == "additive":
