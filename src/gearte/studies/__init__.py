@@ -167,6 +167,7 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
     t_imp = time.perf_counter()
     module = get_kind(case.case.kind)
     check_samples_override(case, (options or RunOptions()).samples)
+    t_pre = time.perf_counter()
     preflight(case)
     t0 = time.perf_counter()
     from gearte.execution.stop import keep_finished_chunks
@@ -182,7 +183,8 @@ def run_case(case: Any, options: RunOptions | None = None) -> Any:
             raise _stopped(stop, None) from None
     t_end = time.perf_counter()
     result.elapsed_s = t_end - t0
-    result.timings["imports: study kind"] = t0 - t_imp
+    result.timings["imports: study kind"] = t_pre - t_imp
+    result.timings["preflight"] = t0 - t_pre
     result.timings.update(numba)
     result.timings.update(analysis_timings(result.analyses, t0, t_end))
     if stop.stopped:
