@@ -46,6 +46,7 @@ import argparse
 import contextlib
 import json
 import math
+import os
 import random
 import re
 import sys
@@ -298,6 +299,27 @@ def check_text(text: str, tmp: Path) -> Outcome:
         return Outcome("rejected", exc.errors[0][0])
     except Exception as exc:  # noqa: BLE001 - what the harness looks for
         return Outcome("crash", f"{type(exc).__name__}: {str(exc)[:200]}")
+    # the pre-flight `gearte validate` makes after the schema (checks on the built drive), under
+    # the budgets the fuzzed runs get, so an accepted mutant is one `run` should not refuse
+    from gearte.errors import ParameterError
+    from gearte.studies import preflight
+
+    saved = {k: os.environ.get(k) for k in RUN_BUDGETS}
+    os.environ.update(RUN_BUDGETS)
+    try:
+        preflight(case)
+    except ParameterError as exc:
+        if "\n" in str(exc) or not exc.field.strip():
+            return Outcome("bad_message", repr(str(exc)))
+        return Outcome("rejected", exc.field)
+    except Exception as exc:  # noqa: BLE001 - what the harness looks for
+        return Outcome("crash", f"preflight {type(exc).__name__}: {str(exc)[:200]}")
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
     try:
         given = tomllib.loads(text)
     except Exception:  # noqa: BLE001
