@@ -100,14 +100,14 @@ def ziggurat_tables() -> ZigguratTables:
 def stream_states(seed: int | np.random.SeedSequence, streams: int = STREAMS) -> np.ndarray:
     """The xoshiro256++ states of one chunk: ``(streams, 4)`` uint64 from a seed sequence.
 
+    A state of all zeros (probability 2⁻²⁵⁶) would stay zero; its first word is set to 1.
+
     Parameters
     ----------
     seed : int or SeedSequence
         The chunk's seed (a child of the study's ``SeedSequence``).
     streams : int
         Number of independent streams [-].
-
-    A state of all zeros (probability 2⁻²⁵⁶) would stay zero; its first word is set to 1.
     """
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     st = ss.generate_state(4 * streams, np.uint64).reshape(streams, 4)
@@ -196,15 +196,15 @@ def _standard_normals(st, n, k, w, f):  # pragma: no cover - compiled
 def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
     """``n`` standard normal numbers [-] from the chunk streams of ``seed`` (compiled).
 
+    The same numbers as the Gaussian group of :mod:`gearte.tolerance.montecarlo`'s kernel for
+    a stack of one standard normal contributor.
+
     Parameters
     ----------
     seed : int or SeedSequence
         Seed of the streams (:func:`stream_states`).
     n : int
         How many numbers [-].
-
-    The same numbers as the Gaussian group of :mod:`gearte.tolerance.montecarlo`'s kernel for
-    a stack of one standard normal contributor.
     """
     t = ziggurat_tables()
     return _standard_normals(stream_states(seed), int(n), t.k, t.w, t.f)
