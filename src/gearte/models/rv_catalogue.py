@@ -43,6 +43,7 @@ __all__ = [
     "backlash",
     "CatalogueValues",
     "catalogue_values",
+    "read_catalogue",
     "virtual_loop",
 ]
 
@@ -308,10 +309,41 @@ def catalogue_values(
     loop, direction = virtual_loop(
         reducer, theta=theta, lost_motion_fraction=lost_motion_fraction, law=law
     )
+    return read_catalogue(curve, loop, direction, _rated(reducer), lost_motion_fraction)
+
+
+def read_catalogue(
+    curve: TorsionTest,
+    loop: TorsionTest,
+    direction: np.ndarray,
+    rated_torque: float,
+    lost_motion_fraction: float,
+) -> CatalogueValues:
+    """Catalogue values read from a virtual loop by the shared definitions.
+
+    Parameters
+    ----------
+    curve : TorsionTest
+        The dense torsion sweep kept for plots [N·mm, rad].
+    loop : TorsionTest
+        The virtual hysteresis loop the values are read from [N·mm, rad].
+    direction : ndarray
+        Loading direction of each loop point (+1 rising, −1 falling) [-].
+    rated_torque : float
+        Rated torque [N·mm].
+    lost_motion_fraction : float
+        f of the lost-motion definition [-].
+
+    Returns
+    -------
+    CatalogueValues
+        Rigidity [N·mm/rad], lost motion, backlash and hysteresis loss [rad]
+        (:func:`gearte.models.catalogue.hysteresis_values`), with the curve and loop.
+    """
     hv = hysteresis_values(
         loop.torque,
         loop.angle,
-        _rated(reducer),
+        float(rated_torque),
         direction=direction,
         lost_motion_fraction=lost_motion_fraction,
     )

@@ -143,10 +143,7 @@ def catalogue_with_free_angle(cat, free_angle: float, rated_torque: float, fract
         definitions (:func:`gearte.models.catalogue.hysteresis_values`): lost motion, backlash and
         hysteresis loss grow by ``free_angle``, the rigidity is unchanged.
     """
-    from dataclasses import replace
-
-    from gearte.models.catalogue import hysteresis_values
-    from gearte.models.rv_catalogue import TorsionTest
+    from gearte.models.rv_catalogue import TorsionTest, read_catalogue
 
     t = np.asarray(cat.curve.torque, dtype=float)
     rising = np.sign(np.diff(t, prepend=t[0]))
@@ -156,19 +153,4 @@ def catalogue_with_free_angle(cat, free_angle: float, rated_torque: float, fract
         cat.loop.torque,
         with_dead_zone(cat.loop.torque, cat.loop.angle, cat.loop_direction, free_angle),
     )
-    hv = hysteresis_values(
-        loop.torque,
-        loop.angle,
-        float(rated_torque),
-        direction=cat.loop_direction,
-        lost_motion_fraction=fraction,
-    )
-    return replace(
-        cat,
-        torsional_rigidity=hv.torsional_rigidity,
-        lost_motion=hv.lost_motion,
-        backlash=hv.backlash,
-        hysteresis_loss=hv.hysteresis_loss,
-        curve=curve,
-        loop=loop,
-    )
+    return read_catalogue(curve, loop, cat.loop_direction, rated_torque, fraction)
