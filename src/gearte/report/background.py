@@ -4,9 +4,10 @@ Most of a warm ``gearte run`` of a fast case is not the analyses: importing matp
 building the figures and drawing them. :class:`ReportWorker` forks, at the command's start
 (before the case is loaded), a process that imports the plotting stack, draws one throw-away
 figure (fonts, text layout caches) and imports the case's study kind while the parent loads the
-case, imports numba, loads its kernels and runs the analyses on the other core. The parent then sends it the result (pickled); the worker builds the figures, renders
-them (itself forking one helper per further core, :func:`gearte.report.html.render_figures`) and
-the HTML, and sends back the page and the stage timings, while the parent writes the CSV tables.
+case, imports numba, loads its kernels and runs the analyses on the other core. The parent then
+sends it the result (pickled); the worker builds the figures, renders them (itself forking one
+helper per further core, :func:`gearte.report.html.render_figures`) and the HTML, and sends back
+the page and the stage timings, while the parent writes the CSV tables.
 
 Nothing depends on it: where ``os.fork`` is missing, the worker died, the result does not
 pickle, or anything in the worker fails, the parent renders in-process as before (an error of a
@@ -235,7 +236,8 @@ class ReportWorker:
         Returns
         -------
         (html, timings) or None
-            The page and the stage times [s] (``"report process: warm-up"``, ``"report process: waited for the result"``, ``"figures"``, ``"render"``, ``"render: slowest
+            The page and the stage times [s] (``"report process: warm-up"``, ``"report
+            process: waited for the result"``, ``"figures"``, ``"render"``, ``"render: slowest
             figure"``, ``"html"``), or ``None`` when the worker could not render it (the caller
             then renders in-process).
         """
