@@ -425,13 +425,19 @@ class DaskExecutor(ChunkExecutor):
                 nw = default_workers() if workers is None else int(workers)
                 if nw < 1:
                     raise ParameterError("workers", workers, "must be ≥ 1")
-                cluster = distributed.LocalCluster(
-                    n_workers=nw,
-                    threads_per_worker=1,
-                    processes=True,
-                    dashboard_address=None,
-                    silence_logs=logging.ERROR,
-                )
+                # No dashboard, so no use for the workers' statistical profiler: it samples
+                # the running chunk's stack every 10 ms of wall time and keeps an hour of
+                # profiles (CPU and memory that grow with the run's length; docs/cluster.md).
+                import dask
+
+                with dask.config.set({"distributed.worker.profile.enabled": False}):
+                    cluster = distributed.LocalCluster(
+                        n_workers=nw,
+                        threads_per_worker=1,
+                        processes=True,
+                        dashboard_address=None,
+                        silence_logs=logging.ERROR,
+                    )
                 self._owned.append(cluster)
                 self.client = distributed.Client(cluster, set_as_default=False)
                 self._owned.insert(0, self.client)
