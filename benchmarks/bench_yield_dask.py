@@ -164,6 +164,14 @@ def main() -> None:
             "cpk": r.cpk,
             "mean": st.mean,
             "sd": st.sd,
+            "passed": r.passed,
+            # every statistic, bit for bit (JSON floats round-trip): compare runs made apart
+            "stats": {
+                k: [*v.stats.as_tuple(), v.fail_fraction, v.cpk]
+                for k, v in r.quantities.items()
+                if k != CPU_KEY
+            },
+            "worst_samples": [w["sample"] for w in r.worst],
             **extra,
         }
         results[label] = r
