@@ -316,6 +316,8 @@ def check_text(text: str, tmp: Path) -> Outcome:
         if "\n" in str(exc) or not exc.file.strip():
             return Outcome("bad_message", repr(str(exc)))
         return Outcome("rejected", exc.file)
+    except CaseFileError as exc:  # a case file the pre-flight loads (a chain's drive case)
+        return Outcome("rejected", exc.errors[0][0])
     except Exception as exc:  # noqa: BLE001 - what the harness looks for
         return Outcome("crash", f"preflight {type(exc).__name__}: {str(exc)[:200]}")
     finally:

@@ -517,6 +517,10 @@ def validate(cases: tuple[str, ...]) -> None:
                 bad += 1
                 click.echo(f"{c}: 1 error(s)\n  {exc}", err=True)
                 continue
+            except CaseFileError as exc:  # a case file the pre-flight loads (a drive's case)
+                bad += 1
+                click.echo(str(exc), err=True)
+                continue
             click.echo(f"{c}: ok ({case.case.kind})")
         if bad:
             sys.exit(EXIT_BAD_INPUT)
