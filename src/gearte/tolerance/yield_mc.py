@@ -603,6 +603,13 @@ def run_yield(
     # normalise margins by each quantity's scale so one worst list ranks several quantities
     scale: dict[str, float] = {}
     nominal = evaluate_checked(model, tolerances.nominal_values(1), 1)
+    declared = getattr(model, "quantities", None)
+    if declared is not None and sorted(declared) != sorted(nominal):
+        # the pre-flight checks a spec against the declared names: they must be the outputs
+        raise RuntimeError(
+            f"{type(model).__name__}.quantities {sorted(declared)} differ from its outputs "
+            f"{sorted(nominal)}"
+        )
     for s in spec:
         if s.quantity not in nominal:
             raise ParameterError(
