@@ -8,8 +8,9 @@ The CLI reports the time of each stage (``results.json`` records the same, but f
 write); this script adds the process's wall and CPU time (the report worker and its helpers
 included) and prints, per case:
 
-* imports (gearte and what loading the case imports), numba (cache load or compile, inside the
-  analyses' intervals), analyses (without numba: the work the user asked for), figures (build),
+* imports (gearte, what loading the case imports, the preflight), numba (its import where a
+  study imports it, cache load or compile, in the preflight or the analyses), analyses (without
+  numba: the work the user asked for), figures (build),
   render (PNG, forked workers), the slowest figure, html, csv, write, and *startup/exit* (the
   wall time outside gearte's own timing: interpreter start, exit);
 * *other* = wall − analyses: everything the user did not ask for, and its ratio to the analyses.
@@ -62,18 +63,23 @@ def run_once(case: str, cache_dir: str, out_dir: str) -> dict[str, float]:
     line = next(ln for ln in p.stderr.splitlines() if ln.startswith("timings [s]: "))
     t: dict[str, float] = json.loads(line.removeprefix("timings [s]: "))
     out = {s: 0.0 for s in STAGES}
+    in_analyses = 0.0  # numba's import and cache load inside the analyses' intervals
     for k, v in t.items():
-        if k.startswith("imports") or k == "load case":
+        if k.startswith(("numba", "imports: numba")):  # its import and cache load / compile
+            out["numba"] += v
+            if not k.endswith(": preflight"):
+                in_analyses += v
+            else:  # inside the preflight's interval
+                out["imports"] -= v
+        elif k.startswith("imports") or k in ("load case", "preflight"):
             out["imports"] += v
         elif k.startswith("analysis: "):
             out["analyses"] += v
-        elif k.startswith("numba"):
-            out["numba"] += v
         elif k == "render: slowest figure":
             out["fig max"] = v
         elif k in out:
             out[k] += v
-    out["analyses"] = max(0.0, out["analyses"] - out["numba"])  # numba is inside the analyses
+    out["analyses"] = max(0.0, out["analyses"] - in_analyses)
     out["startup"] = wall - t["total in gearte"]
     out["wall"] = wall
     out["cpu"] = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)

@@ -57,6 +57,7 @@ def _error(title: str, message: str) -> None:
 def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     """Run ``fn`` turning gearte's errors into clean messages and exit codes."""
     from gearte.errors import (
+        BenchFileError,
         CaseFileError,
         ClusterLostError,
         ConvergenceError,
@@ -100,6 +101,9 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
         sys.exit(EXIT_BAD_INPUT)
     except ParameterError as exc:
         _error("invalid parameter", str(exc))
+        sys.exit(EXIT_BAD_INPUT)
+    except BenchFileError as exc:  # a malformed bench or metrology file: bad input
+        _error("invalid data file", str(exc))
         sys.exit(EXIT_BAD_INPUT)
     except FileNotFoundError as exc:
         _error("not found", str(exc).strip("'\""))
@@ -487,7 +491,7 @@ def export(
 @click.argument("cases", nargs=-1, required=True)
 def validate(cases: tuple[str, ...]) -> None:
     """Check case files without running them; print every problem, one per line."""
-    from gearte.errors import CaseFileError, ParameterError
+    from gearte.errors import BenchFileError, CaseFileError, ParameterError
 
     def _validate() -> None:
         from gearte.io.case_file import load_case
@@ -509,9 +513,13 @@ def validate(cases: tuple[str, ...]) -> None:
                 continue
             try:  # the checks `run` makes on the built drive before any analysis
                 preflight(case)
-            except ParameterError as exc:
+            except (ParameterError, BenchFileError) as exc:
                 bad += 1
                 click.echo(f"{c}: 1 error(s)\n  {exc}", err=True)
+                continue
+            except CaseFileError as exc:  # a case file the pre-flight loads (a drive's case)
+                bad += 1
+                click.echo(str(exc), err=True)
                 continue
             click.echo(f"{c}: ok ({case.case.kind})")
         if bad:

@@ -153,7 +153,9 @@ class Errors(StrictModel):
     )
     magnitudes_um: dict[str, float] = Field(description="error magnitude per key [µm]")
     angles_deg: dict[str, float] = Field(
-        default_factory=dict, description="error angle per key [deg] (missing: 0)"
+        default_factory=dict,
+        description="error angle per key [deg] (missing: 0); |angle| <= 5729577.95 deg (1e5 rad, "
+        "the range of the compiled sine and cosine of the TE kernels)",
     )
     terms: list[TermRow] | None = Field(default=None, description="source='terms': the list")
     reference_angle: str | None = Field(
@@ -171,6 +173,20 @@ class Errors(StrictModel):
                 raise ValueError(f"magnitude {k!r} = {x!r}: must be a finite number >= 0 [µm]")
             if x > 10_000:
                 raise ValueError(f"magnitude {k!r} = {x!r}: must be <= 10000 µm")
+        return v
+
+    @field_validator("angles_deg")
+    @classmethod
+    def _bounded_angles(cls, v: dict[str, float]) -> dict[str, float]:
+        from gearte.solvers.trig_extremes import SINCOS_MAX_ARG
+
+        limit = float(rad_to_deg(SINCOS_MAX_ARG))
+        for k, x in v.items():
+            if not np.isfinite(x) or abs(x) > limit:
+                raise ValueError(
+                    f"angle {k!r} = {x!r}: must be a finite number with |angle| <= {limit:.9g} "
+                    f"deg ({SINCOS_MAX_ARG:g} rad, the range of the TE kernels' sine and cosine)"
+                )
         return v
 
     @model_validator(mode="after")
@@ -448,9 +464,11 @@ def preflight(case: Case) -> None:
     terms, mags, angs = build_terms(case)
     paper_rule_angles(terms, mags, angs)
     if case.analyses.yield_ is not None:
+        from gearte.runners.yield_models import PlanetaryCoupledTE
         from gearte.studies._yield import yield_inputs
 
-        yield_inputs(case.analyses.yield_, *_yield_keys(terms, mags, angs))
+        units, nominal = _yield_keys(terms, mags, angs)
+        yield_inputs(case.analyses.yield_, units, nominal, quantities=PlanetaryCoupledTE.quantities)
 
 
 def run(case: Case, options) -> StudyResult:
