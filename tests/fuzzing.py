@@ -301,7 +301,7 @@ def check_text(text: str, tmp: Path) -> Outcome:
         return Outcome("crash", f"{type(exc).__name__}: {str(exc)[:200]}")
     # the pre-flight `gearte validate` makes after the schema (checks on the built drive), under
     # the budgets the fuzzed runs get, so an accepted mutant is one `run` should not refuse
-    from gearte.errors import ParameterError
+    from gearte.errors import BenchFileError, ParameterError
     from gearte.studies import preflight
 
     saved = {k: os.environ.get(k) for k in RUN_BUDGETS}
@@ -312,6 +312,12 @@ def check_text(text: str, tmp: Path) -> Outcome:
         if "\n" in str(exc) or not exc.field.strip():
             return Outcome("bad_message", repr(str(exc)))
         return Outcome("rejected", exc.field)
+    except BenchFileError as exc:  # rv_bench's pre-flight reads its bench files
+        if "\n" in str(exc) or not exc.file.strip():
+            return Outcome("bad_message", repr(str(exc)))
+        return Outcome("rejected", exc.file)
+    except CaseFileError as exc:  # a case file the pre-flight loads (a chain's drive case)
+        return Outcome("rejected", exc.errors[0][0])
     except Exception as exc:  # noqa: BLE001 - what the harness looks for
         return Outcome("crash", f"preflight {type(exc).__name__}: {str(exc)[:200]}")
     finally:
@@ -374,7 +380,7 @@ def run_args(path: Path, out: Path, report: bool = False) -> list[str]:
     return args if report else [*args, "--no-report"]
 
 
-_KEYED = re.compile(r"^error \((invalid parameter|invalid case|not found)\): \S")
+_KEYED = re.compile(r"^error \((invalid parameter|invalid case|invalid data file|not found)\): \S")
 
 
 def classify_run(code: int, stderr: str, text: str, out: Path) -> Outcome:

@@ -23,6 +23,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gearte"
 LAYERS: list[tuple[str, ...]] = [
     (
         "gearte._version",
+        "gearte._blas",
         "gearte.errors",
         "gearte.limits",
         "gearte.units",

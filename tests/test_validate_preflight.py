@@ -116,3 +116,175 @@ def test_rk4_step_count_over_the_time_budget_is_refused_by_validate(tmp_path, mo
 def test_validate_still_accepts_every_bundled_case(name):
     r = CliRunner().invoke(main, ["validate", name])
     assert r.exit_code == 0, r.output
+
+
+# --- the refusals the 10 000-file fuzzing job (seed 13) still found in `run` after `validate`
+def _validate_and_run_schema(path: Path, tmp_path: Path) -> str:
+    """A schema refusal: validate and run both exit 2 with the same error line."""
+    runner = CliRunner()
+    v = runner.invoke(main, ["validate", str(path)])
+    assert v.exit_code == EXIT_BAD_INPUT, v.output
+    line = v.output.strip().splitlines()[1].strip()
+    out = tmp_path / "out"
+    r = runner.invoke(main, ["run", str(path), "--out", str(out), "--no-report", "--no-progress"])
+    assert r.exit_code == EXIT_BAD_INPUT, r.output
+    assert not (out / "results.json").exists()
+    assert line in r.output
+    return line
+
+
+def test_yield_spec_on_a_quantity_the_stage_model_does_not_give_is_refused_by_validate(tmp_path):
+    """A typo in a spec quantity (fuzzing: `geometric_te [rcmin]`): the names come from the
+    yield model's `quantities`, the same list its outputs are checked against."""
+    p = _mutant(
+        tmp_path,
+        "hu2020_rv80e_yield",
+        '[analyses.yield.spec."geometric_te [arcmin]"]',
+        '[analyses.yield.spec."geometric_te [rcmin]"]',
+    )
+    v, r = _validate_and_run(p, tmp_path)
+    assert v == r
+    assert v.startswith("analyses.yield.spec.geometric_te [rcmin] = ")
+    assert "is not a quantity of the model ['geometric_te [arcmin]']" in v
+
+
+def test_rv_yield_spec_on_a_quantity_the_reducer_model_does_not_give_is_refused(tmp_path):
+    p = _mutant(
+        tmp_path, "han2023_rv110e_yield", '"angular_te [arcmin]" = {', '"angular_te [rcmin]" = {'
+    )
+    v, r = _validate_and_run(p, tmp_path)
+    assert v == r
+    assert v.startswith("analyses.yield.spec.angular_te [rcmin] = ")
+    assert "'loaded_te [arcmin]'" in v
+
+
+def test_gear_chain_yield_tolerance_on_a_key_the_pair_stack_does_not_have_is_refused(tmp_path):
+    """A pair stage's keys come from its backlash stack: the gear_chain pre-flight builds the
+    pair (and the RV stage's drive) without computing a lost motion."""
+    p = _mutant(
+        tmp_path,
+        "robot_joint_spur_rv_yield",
+        '[analyses.yield.tolerances."spur_pair.driven_gear_eccentricity"]',
+        '[analyses.yield.tolerances."spur_pair.driven_ear_eccentricity"]',
+    )
+    v, r = _validate_and_run(p, tmp_path)
+    assert v == r
+    assert v.startswith("analyses.yield.tolerances.spur_pair.driven_ear_eccentricity = ")
+    assert "'spur_pair.driven_gear_eccentricity'" in v  # the known keys are listed
+
+
+def test_gear_chain_yield_spec_on_a_quantity_of_no_stage_is_refused(tmp_path):
+    p = _mutant(
+        tmp_path,
+        "robot_joint_spur_rv_yield",
+        '[analyses.yield.spec."joint_lost_motion [arcmin]"]',
+        '[analyses.yield.spec."joint_lost_motion [arcsec]"]',
+    )
+    v, r = _validate_and_run(p, tmp_path)
+    assert v == r
+    assert v.startswith("analyses.yield.spec.joint_lost_motion [arcsec] = ")
+    assert "'spur_pair.lost_motion [arcmin]'" in v
+
+
+def test_planetary_angle_beyond_the_kernels_sincos_range_is_a_schema_error(tmp_path):
+    """errors.angles_deg is bounded by the TE kernels' sine/cosine range (1e5 rad)."""
+    p = _mutant(tmp_path, "wang2013_2kh_eq9", "beta_l = 0.0", "beta_l = -1e30")
+    line = _validate_and_run_schema(p, tmp_path)
+    assert line.startswith("errors.angles_deg: angle 'beta_l' = -1e+30: must be a finite number")
+    assert "5729577.95 deg" in line
+
+
+def test_planetary_angle_at_the_bound_is_accepted(tmp_path):
+    p = _mutant(tmp_path, "wang2013_2kh_eq9", "beta_l = 0.0", "beta_l = -5729577.9")
+    r = CliRunner().invoke(main, ["validate", str(p)])
+    assert r.exit_code == 0, r.output
+
+
+def test_speed_sweep_duration_lost_beside_the_settling_time_is_refused_by_validate(tmp_path):
+    """duration_s = 1e-300: settle_s + duration_s == settle_s, the integrator's t_settle check
+    (solvers.ode.check_span) refuses it; the pre-flight names the case key."""
+    text = case_path("li2023_rv_modified_fourier").read_text(encoding="utf-8")
+    head, tail = text.split("[analyses.speed_sweep]", 1)
+    tail = tail.replace("duration_s = 0.1", "duration_s = 1e-300", 1)
+    p = tmp_path / "sweep_mutant.toml"
+    p.write_text(head + "[analyses.speed_sweep]" + tail, encoding="utf-8")
+    v, r = _validate_and_run(p, tmp_path)
+    assert v == r
+    assert v.startswith("analyses.speed_sweep.duration_s = 1e-300: leaves no simulated time")
+
+
+def test_tooth_contact_deformation_beyond_the_elastic_range_is_refused_by_validate(tmp_path):
+    """E = 0.12 MPa: the solve at the paper's mesh position (the pre-flight) deforms a pin far
+    beyond 0.1 x pin radius; exit 2 naming the torque key, before any analysis."""
+    p = _mutant(
+        tmp_path,
+        "hu2020_rv80e_modified",
+        "youngs_modulus_MPa = 2.06e5",
+        "youngs_modulus_MPa = 0.12",
+    )
+    v, r = _validate_and_run(p, tmp_path)
+    assert v == r
+    assert v.startswith("analyses.tooth_contact.torque_Nm = ")
+    assert "beyond the elastic contact model's range" in v and "youngs_modulus_MPa = 0.12" in v
+
+
+def test_malformed_bench_file_is_refused_by_validate_as_by_run(tmp_path):
+    """rv_bench's pre-flight reads the bench files with the run's readers: a malformed file is
+    exit 2 ('invalid data file') in both, one line naming file, line and column."""
+    import shutil
+
+    src = case_path("synthetic_rv_bench")
+    shutil.copytree(src.parent / "synthetic_rv_bench", tmp_path / "synthetic_rv_bench")
+    shutil.copy(src, tmp_path / "bench.toml")
+    hyst = tmp_path / "synthetic_rv_bench" / "hysteresis.csv"
+    lines = hyst.read_text(encoding="utf-8").splitlines()
+    lines[4] = "1.95,abc,ascending"
+    hyst.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    p = tmp_path / "bench.toml"
+    runner = CliRunner()
+    v = runner.invoke(main, ["validate", str(p)])
+    assert v.exit_code == EXIT_BAD_INPUT, v.output
+    line = v.output.strip().splitlines()[1].strip()
+    assert "hysteresis.csv, line 5" in line
+    r = runner.invoke(main, ["run", str(p), "--out", str(tmp_path / "o"), "--no-report"])
+    assert r.exit_code == EXIT_BAD_INPUT, r.output
+    assert f"error (invalid data file): {line}" in r.output
+
+
+def test_every_kind_has_a_preflight():
+    from gearte.io.kinds import available_kinds, get_kind
+
+    ours = [k for k in available_kinds() if get_kind(k).__name__.startswith("gearte.studies.")]
+    assert {"gear_pair", "gear_chain", "rv_bench", "rv_lot", "rv_serial"} <= set(ours)
+    missing = [k for k in ours if not callable(getattr(get_kind(k), "preflight", None))]
+    assert missing == []
+
+
+def test_yield_model_whose_quantities_differ_from_its_outputs_is_a_bug():
+    """The pre-flight checks a spec against a model's `quantities`; run_yield holds the model to
+    them (a mismatch is an internal error, never a silently unchecked spec)."""
+    from gearte.tolerance.yield_mc import Tolerance, ToleranceSet, run_yield
+
+    class Wrong:
+        quantities = ("a [mm]",)
+
+        def __call__(self, errors):
+            return {"b [mm]": errors["x"] * 1.0}
+
+    ts = ToleranceSet((Tolerance("x", "normal", 1.0),), ())
+    with pytest.raises(RuntimeError, match="quantities"):
+        run_yield(Wrong(), ts, [], 4, seed=1)
+
+
+def test_rv_tooth_contact_deformation_beyond_the_elastic_range_is_refused_by_validate(tmp_path):
+    """The reducer's cycloid analyses run as a cycloid_stage case: its pre-flight too."""
+    p = _mutant(
+        tmp_path,
+        "hu2020_rv80e_initial_reducer",
+        "youngs_modulus_MPa = 2.06e5",
+        "youngs_modulus_MPa = 0.12",
+    )
+    v, r = _validate_and_run(p, tmp_path)
+    assert v == r
+    assert v.startswith("analyses.tooth_contact.torque_Nm = ")
+    assert "beyond the elastic contact model's range" in v

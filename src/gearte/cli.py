@@ -57,6 +57,7 @@ def _error(title: str, message: str) -> None:
 def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     """Run ``fn`` turning gearte's errors into clean messages and exit codes."""
     from gearte.errors import (
+        BenchFileError,
         CaseFileError,
         ClusterLostError,
         ConvergenceError,
@@ -100,6 +101,9 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
         sys.exit(EXIT_BAD_INPUT)
     except ParameterError as exc:
         _error("invalid parameter", str(exc))
+        sys.exit(EXIT_BAD_INPUT)
+    except BenchFileError as exc:  # a malformed bench or metrology file: bad input
+        _error("invalid data file", str(exc))
         sys.exit(EXIT_BAD_INPUT)
     except FileNotFoundError as exc:
         _error("not found", str(exc).strip("'\""))
@@ -269,18 +273,18 @@ def run(
         from gearte.studies import RunOptions, run_case
 
         t1 = time.perf_counter()
-        c = load_case(case)
-        t2 = time.perf_counter()
-        default = os.path.join("out", safe_label(c.case.name or c.case.kind))
-        target = check_output_dir(out_dir if out_dir is not None else default)
-        # the report's process (forked with the case's kind imported: its result unpickles
-        # there) imports matplotlib while this one runs the analyses
+        # the report's process, forked first, imports matplotlib and the case's study kind (its
+        # result unpickles there) while this one loads the case and runs the analyses
         renderer = None
         if not no_report:
             from gearte.report.background import ReportWorker
 
-            renderer = ReportWorker.start()
+            renderer = ReportWorker.start(case)
         try:
+            c = load_case(case)
+            t2 = time.perf_counter()
+            default = os.path.join("out", safe_label(c.case.name or c.case.kind))
+            target = check_output_dir(out_dir if out_dir is not None else default)
             with _executor(scheduler, workers) as executor:
                 opts = RunOptions(
                     progress=not no_progress,
@@ -487,7 +491,7 @@ def export(
 @click.argument("cases", nargs=-1, required=True)
 def validate(cases: tuple[str, ...]) -> None:
     """Check case files without running them; print every problem, one per line."""
-    from gearte.errors import CaseFileError, ParameterError
+    from gearte.errors import BenchFileError, CaseFileError, ParameterError
 
     def _validate() -> None:
         from gearte.io.case_file import load_case
@@ -509,9 +513,13 @@ def validate(cases: tuple[str, ...]) -> None:
                 continue
             try:  # the checks `run` makes on the built drive before any analysis
                 preflight(case)
-            except ParameterError as exc:
+            except (ParameterError, BenchFileError) as exc:
                 bad += 1
                 click.echo(f"{c}: 1 error(s)\n  {exc}", err=True)
+                continue
+            except CaseFileError as exc:  # a case file the pre-flight loads (a drive's case)
+                bad += 1
+                click.echo(str(exc), err=True)
                 continue
             click.echo(f"{c}: ok ({case.case.kind})")
         if bad:

@@ -43,6 +43,7 @@ from numba import njit
 
 from gearte.errors import ParameterError
 from gearte.geometry.planetary import PlanetarySet, SunPlanetErrors
+from gearte.solvers.nelder_mead import nm_best, nm_start, nm_tell
 from gearte.solvers.trig_extremes import (
     SINCOS_MAX_ARG,
     exact_extremes,
@@ -69,6 +70,7 @@ __all__ = [
     "exact_extremes_numpy",
     "grid_extremes_numpy",
     "sample_extremes",
+    "minimize_amplitude",
 ]
 
 
@@ -428,10 +430,10 @@ def group_phasors(
 
 
 # --------------------------------------------------------------------------- sample kernel
-@njit(cache=True, nogil=True)
-def _row_phasors(mags, i, sa, ca, o, gain, mag_idx, ang_idx, coeff, c0, s0, fsign, group, zr, zi):
+@njit(cache=True, nogil=True, inline="always")
+def _row_phasors(mags, i, sa, ca, gain, mag_idx, ang_idx, coeff, c0, s0, fsign, group, zr, zi):
     """Constant part c (returned) and group phasors (zr, zi, filled) of sample i, from the
-    sines/cosines ``sa[o + v], ca[o + v]`` of its angles and the terms' phase tables c0, s0."""
+    sines/cosines ``sa[v], ca[v]`` of its angles and the terms' phase tables c0, s0."""
     c = 0.0
     for g in range(zr.shape[0]):
         zr[g] = 0.0
@@ -440,8 +442,8 @@ def _row_phasors(mags, i, sa, ca, o, gain, mag_idx, ang_idx, coeff, c0, s0, fsig
         a = gain[k] * mags[i, mag_idx[k]]
         v = ang_idx[k]
         if v >= 0:  # phase + coeff * theta, coeff = ±1
-            cp = c0[k] * ca[o + v] - coeff[k] * s0[k] * sa[o + v]
-            sp = s0[k] * ca[o + v] + coeff[k] * c0[k] * sa[o + v]
+            cp = c0[k] * ca[v] - coeff[k] * s0[k] * sa[v]
+            sp = s0[k] * ca[v] + coeff[k] * c0[k] * sa[v]
         else:
             cp = c0[k]
             sp = s0[k]
@@ -457,48 +459,183 @@ def _row_phasors(mags, i, sa, ca, o, gain, mag_idx, ang_idx, coeff, c0, s0, fsig
     return c
 
 
-@njit(cache=True, nogil=True)
-def _phase_tables(phase):
-    """cos and sin of the terms' constant phases."""
-    K = phase.shape[0]
-    c0 = np.empty(K)
-    s0 = np.empty(K)
-    for k in range(K):
-        c0[k] = math.cos(phase[k])
-        s0[k] = math.sin(phase[k])
-    return c0, s0
+MODE_SAMPLES = 0
+""":func:`_te_kernel` mode: extremes per row of magnitudes and angles."""
+MODE_MINIMIZE = 1
+""":func:`_te_kernel` mode: Nelder–Mead on the amplitude over the free angles."""
+MODE_PHASORS = 2
+""":func:`_te_kernel` mode: extremes per row of given constant parts and phasors."""
 
 
 @njit(cache=True, nogil=True)
-def _sample_kernel(mags, angs, gain, mag_idx, ang_idx, coeff, phase, fsign, group, nh, M):
-    """Phasor sums and exact extremes for each sample (row) of magnitudes and angles."""
-    n = mags.shape[0]
+def _te_kernel(mode, mags, angs, cz, pos, tf, ti, nh, M, fx, fn, sim, fsim, vec, ist, tol):
+    """The planetary's one compiled entry point: exact extremes of Σe for many assemblies, or
+    the assembly that minimises the amplitude max|Σe| (compiled Nelder–Mead).
+
+    ``mode`` :data:`MODE_SAMPLES`: row i of ``mags`` [mm] (n, n_mag) and ``angs`` [rad] (n, V)
+    → ``fx[i]``, ``fn[i]`` = max, min of Σe [mm]. :data:`MODE_PHASORS`: row i of ``cz`` (n,
+    1 + 2 G) = constant part, Re Z_g, Im Z_g [mm] → ``fx[i]``, ``fn[i]``. :data:`MODE_MINIMIZE`:
+    ``angs[0]`` all angles [rad], of which ``pos`` are free; Nelder–Mead (state ``sim, fsim,
+    vec, ist`` of :mod:`gearte.solvers.nelder_mead`, started by the caller; tolerances ``tol`` =
+    xatol [rad], fatol [mm]) on the amplitude [mm] (inf where an angle leaves the exact range of
+    sincos) with ``mags[0]``; the best vertex stays in ``sim[0]``.
+
+    Per term, ``tf`` rows gain, coeff, cos phase, sin phase, sign of the frequency, phase [rad]
+    (in :data:`MODE_SAMPLES` the cosines and sines are computed here from the phases) and ``ti``
+    rows magnitude index, angle index, group; ``nh`` the harmonics, ``M`` the grid's nodes.
+
+    One kernel with a single call site of :func:`~gearte.solvers.trig_extremes.extremes_kernel`
+    and of :func:`_row_phasors`: numba compiles a copy of what a kernel calls into every kernel
+    that calls it, and the three uses compiled three copies (issue 12: first-run compile).
+    """
     G = nh.shape[0]
     V = angs.shape[1]
+    N = pos.shape[0]
+    n = fx.shape[0] if mode != MODE_MINIMIZE else 1
+    if n == 0:
+        return
+    if mode == MODE_SAMPLES:
+        for k in range(tf.shape[1]):
+            tf[2, k] = math.cos(tf[5, k])
+            tf[3, k] = math.sin(tf[5, k])
     tab = node_tables(nh, M)
     buf = np.empty(M)
     zr = np.empty(G)
     zi = np.empty(G)
     wr = np.empty(G)
     wi = np.empty(G)
-    # one sine/cosine per angle, shared by its terms: a vectorised pass over the whole chunk
-    flat = angs.ravel()
-    sa = np.empty(n * V)
-    ca = np.empty(n * V)
-    sincos_into(flat, sa, ca)
-    c0, s0 = _phase_tables(phase)
-    fmax = np.empty(n)
-    fmin = np.empty(n)
-    for i in range(n):
-        c = _row_phasors(
-            mags, i, sa, ca, i * V, gain, mag_idx, ang_idx, coeff, c0, s0, fsign, group, zr, zi
-        )
-        if G == 0:
-            fmax[i] = c
-            fmin[i] = c
+    th = np.empty(V)
+    sa = np.empty(V)
+    ca = np.empty(V)
+    xt = vec[2]
+    i = 0
+    while True:
+        ok = True
+        c = 0.0
+        if mode == MODE_PHASORS:
+            c = cz[i, 0]
+            for g in range(G):
+                zr[g] = cz[i, 1 + g]
+                zi[g] = cz[i, 1 + G + g]
         else:
-            fmax[i], fmin[i] = extremes_kernel(c, zr, zi, nh, tab, buf, wr, wi)
-    return fmax, fmin
+            # row i of the samples, or the one row of the optimisation (i stays 0 there: a literal
+            # 0 in the call would compile _row_phasors a second time, for Literal[int](0))
+            for v in range(V):
+                th[v] = angs[i, v]
+            if mode == MODE_MINIMIZE:
+                for j in range(N):
+                    th[pos[j]] = xt[j]
+                for v in range(V):
+                    if not abs(th[v]) <= SINCOS_MAX_ARG:
+                        ok = False
+            if ok:
+                sincos_into(th, sa, ca)
+                c = _row_phasors(
+                    mags, i, sa, ca, tf[0], ti[0], ti[1], tf[1], tf[2], tf[3], tf[4], ti[2], zr, zi
+                )
+        fmax = np.inf
+        fmin = -np.inf
+        if ok:
+            if G == 0:
+                fmax = c
+                fmin = c
+            else:
+                fmax, fmin = extremes_kernel(c, zr, zi, nh, tab, buf, wr, wi)
+        if mode != MODE_MINIMIZE:
+            fx[i] = fmax
+            fn[i] = fmin
+            i += 1
+            if i >= n:
+                return
+        else:
+            f = (abs(c) if G == 0 else max(fmax, -fmin)) if ok else np.inf
+            if nm_tell(f, tol[0], tol[1], sim, fsim, vec, ist):
+                return
+
+
+def _term_tables(terms: TermSet) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """``tf`` (cos and sin of the phases from numpy), ``ti``, harmonics and nodes ``M`` of
+    :func:`_te_kernel` for ``terms`` (16 nodes when there is no group)."""
+    arr = _term_arrays(terms)
+    ph = arr["phase"]
+    tf = np.array([arr["gain"], arr["coeff"], np.cos(ph), np.sin(ph), arr["fsign"], ph])
+    ti = np.array([arr["mag_idx"], arr["ang_idx"], arr["group"]], dtype=np.int64)
+    nh = arr["harmonics"]
+    return tf, ti, nh, grid_points(nh) if nh.size else 16
+
+
+_NO_F2 = np.zeros((0, 0))
+_NO_F1 = np.zeros(0)
+_NO_I1 = np.zeros(0, dtype=np.int64)
+
+
+def _phasor_extremes(
+    c: np.ndarray, Z: np.ndarray, harmonics: Sequence[int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`~gearte.solvers.trig_extremes.exact_extremes` through :func:`_te_kernel` (the same
+    kernel, the same values): max, min [mm] per row of ``c`` (n,) and ``Z`` (n, G) [mm]."""
+    nh = np.ascontiguousarray(np.asarray(harmonics, dtype=np.int64))
+    c = np.atleast_1d(np.asarray(c, dtype=float))
+    Z = np.atleast_2d(np.asarray(Z, dtype=complex))
+    if nh.size == 0:
+        return c.copy(), c.copy()
+    if np.any(nh < 1):
+        raise ParameterError("harmonics", harmonics, "must be integers >= 1")
+    cz = np.ascontiguousarray(np.concatenate([c[:, None], Z.real, Z.imag], axis=1))
+    n = c.shape[0]
+    fx = np.empty(n)
+    fn = np.empty(n)
+    _te_kernel(
+        MODE_PHASORS, _NO_F2, np.zeros((0, 1)), cz, _NO_I1, _NO_F2, np.zeros((0, 0), np.int64),
+        nh, grid_points(nh), fx, fn, _NO_F2, _NO_F1, _NO_F2, _NO_I1, _NO_F1,
+    )  # fmt: skip
+    return fx, fn
+
+
+def minimize_amplitude(
+    terms: TermSet,
+    magnitudes: np.ndarray,
+    base: np.ndarray,
+    pos: Sequence[int],
+    starts: Sequence[np.ndarray],
+    xatol: float,
+    fatol: float,
+    maxiter: int,
+    restarts: int = 1,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Compiled Nelder–Mead (SciPy's adaptive method, :mod:`gearte.solvers.nelder_mead`) on the
+    exact amplitude max|Σe| [mm] over the free angles ``pos`` (indices into ``terms.angles``),
+    from each of ``starts`` [rad], restarted ``restarts`` times from its own result (a minimax
+    can stall a simplex on a kink).
+
+    ``magnitudes`` [mm] per key of ``terms.magnitudes``; ``base`` [rad] every angle (the free
+    ones are overwritten); ``xatol`` [rad], ``fatol`` [mm] and ``maxiter`` [-] as SciPy's.
+    Returns (x [rad] per start, amplitude [mm] per start). The amplitude is inf where an angle
+    leaves ±:data:`~gearte.solvers.trig_extremes.SINCOS_MAX_ARG`.
+    """
+    tf, ti, nh, M = _term_tables(terms)
+    mags = np.ascontiguousarray(np.asarray(magnitudes, dtype=float).reshape(1, -1))
+    angs = np.ascontiguousarray(np.asarray(base, dtype=float).reshape(1, -1))
+    p = np.asarray(pos, dtype=np.int64)
+    N = p.size
+    sim = np.empty((N + 1, N))
+    fsim = np.empty(N + 2)
+    vec = np.empty((4, N))
+    ist = np.zeros(4, dtype=np.int64)
+    tol = np.array([xatol, fatol], dtype=float)
+    xs, fs = [], []
+    for x0 in starts:
+        x = np.ascontiguousarray(x0, dtype=float)
+        for _ in range(1 + restarts):
+            nm_start(x, maxiter, sim, fsim, vec, ist)
+            _te_kernel(
+                MODE_MINIMIZE, mags, angs, _NO_F2, p, tf, ti, nh, M, _NO_F1, _NO_F1, sim, fsim,
+                vec, ist, tol,
+            )  # fmt: skip
+            x = sim[0].copy()
+        xs.append(x)
+        fs.append(nm_best(fsim, N))
+    return np.array(xs), np.array(fs)
 
 
 def sample_extremes(
@@ -511,30 +648,24 @@ def sample_extremes(
     angles' sines and cosines from its vectorised :func:`~gearte.solvers.trig_extremes.sincos`
     (|angle| <= 1e5 rad).
     """
-    arr = _term_arrays(terms)
-    m = np.ascontiguousarray(np.atleast_2d(np.asarray(magnitudes, dtype=float)))
-    th = np.ascontiguousarray(np.atleast_2d(np.asarray(angles, dtype=float)))
+    # C-contiguous and writeable: a read-only view (np.broadcast_to) is another compile
+    m = np.require(np.atleast_2d(np.asarray(magnitudes, dtype=float)), requirements=["C", "W"])
+    th = np.require(np.atleast_2d(np.asarray(angles, dtype=float)), requirements=["C", "W"])
     if th.shape[1] == 0:
         th = np.zeros((m.shape[0], 1))
     if th.size and not np.all(np.abs(th) <= SINCOS_MAX_ARG):
         raise ParameterError(
             "angles", float(np.max(np.abs(th))), f"|angle| must be <= {SINCOS_MAX_ARG} rad"
         )
-    nh = arr["harmonics"]
-    M = grid_points(nh) if nh.size else 16
-    return _sample_kernel(
-        m,
-        th,
-        arr["gain"],
-        arr["mag_idx"],
-        arr["ang_idx"],
-        arr["coeff"],
-        arr["phase"],
-        arr["fsign"],
-        arr["group"],
-        nh,
-        M,
-    )
+    tf, ti, nh, M = _term_tables(terms)  # cos and sin of the phases computed in the kernel
+    n = m.shape[0]
+    fx = np.empty(n)
+    fn = np.empty(n)
+    _te_kernel(
+        MODE_SAMPLES, m, th, _NO_F2, _NO_I1, tf, ti, nh, M, fx, fn, _NO_F2, _NO_F1, _NO_F2,
+        _NO_I1, _NO_F1,
+    )  # fmt: skip
+    return fx, fn
 
 
 # --------------------------------------------------------------------------- coupled TE
@@ -614,7 +745,7 @@ def coupled_te(
     angs = keyed_vector(terms.angles, angles, "angles", required=False)
     q0, harm, _ = frequency_basis(terms)
     c, Z = group_phasors(terms, mags, angs)
-    fmax, fmin = exact_extremes(np.array([c]), Z[None, :], harm)
+    fmax, fmin = _phasor_extremes(np.array([c]), Z[None, :], harm)
     return CoupledTE(
         constant=float(c),
         harmonics=harm,

@@ -156,6 +156,12 @@ class GearChainYield:
         if not lever_length > 0:
             raise ParameterError("lever_length", lever_length, "must be > 0 mm")
         self.lever_length = float(lever_length)
+        #: The names of the outputs (a spec may bound them; checked before any sample).
+        self.quantities: tuple[str, ...] = (
+            *(f"{st.slug}.lost_motion [arcmin]" for st in self.stages),
+            "joint_lost_motion [arcmin]",
+            "end_effector_error [mm]",
+        )
 
     def _get(self, errors: Mapping[str, np.ndarray], key: str, n: int) -> np.ndarray:
         if key in errors:

@@ -10,8 +10,9 @@ Two solvers on a :class:`gearte.models.planetary_errors.TermSet`:
 * :func:`optimal_assembly` — the global minimum of the *exact* coupled amplitude
   ``max_t |Σe(t)|`` over every free angle: a batch of quasi-random (Halton) starts evaluated with
   the compiled exact kernel, then Nelder–Mead from the best starts. The Nelder–Mead runs compiled
-  (:func:`_nelder_mead`, a line-by-line port of SciPy 1.17's ``_minimize_neldermead`` with
-  ``adaptive=True`` and no bounds, calling the compiled amplitude directly); its plain twin is
+  (:func:`gearte.models.planetary_errors.minimize_amplitude`: :mod:`gearte.solvers.nelder_mead`,
+  a line-by-line port of SciPy 1.17's ``_minimize_neldermead`` with ``adaptive=True`` and no
+  bounds, in the same kernel as the compiled amplitude); its plain twin is
   SciPy's ``minimize(method="Nelder-Mead")`` on the same objective
   (:func:`_polish_scipy`, used by the tests and ``benchmarks/bench_planetary_assembly.py``).
 
@@ -25,24 +26,15 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from gearte.errors import ParameterError
 from gearte.models.planetary_errors import (
     TermSet,
-    _row_phasors,
-    _term_arrays,
     coupled_te,
     frequency_basis,
     keyed_vector,
+    minimize_amplitude,
     sample_extremes,
-)
-from gearte.solvers.trig_extremes import (
-    SINCOS_MAX_ARG,
-    extremes_kernel,
-    grid_points,
-    node_tables,
-    sincos_into,
 )
 
 __all__ = [
@@ -265,238 +257,15 @@ def halton_starts(n: int, d: int, seed: int) -> np.ndarray:
     return np.mod(out + np.random.default_rng(seed).random(d), 1.0)
 
 
-# --------------------------------------------------------------------------- compiled polish
-@njit(cache=True, nogil=True)
-def _amplitude(x, base, pos, mags, tf, ti, nh, tab, work):
-    """max |Σe| [mm] with the free angles ``x`` [rad] (the objective of the polish); inf if an
-    angle leaves the exact range of sincos.
-
-    ``base`` all angles [rad] (the free ones overwritten), ``pos`` the free angles' indices,
-    ``mags`` (1, n_mag) [mm]; per term ``tf`` rows gain, coeff, cos phase, sin phase, sign of q
-    and ``ti`` rows magnitude index, angle index, group; ``nh``/``tab`` harmonics and node
-    tables; ``work`` scratch (3 V + M + 4 G). Few, plain arguments: a tuple of 20 arrays
-    costs seconds of compile in every function it passes through."""
-    V = base.shape[0]
-    G = nh.shape[0]
-    th = work[:V]
-    sa = work[V : 2 * V]
-    ca = work[2 * V : 3 * V]
-    o = 3 * V
-    M = tab.shape[1]
-    buf = work[o : o + M]
-    zr = work[o + M : o + M + G]
-    zi = work[o + M + G : o + M + 2 * G]
-    wr = work[o + M + 2 * G : o + M + 3 * G]
-    wi = work[o + M + 3 * G : o + M + 4 * G]
-    for v in range(V):
-        th[v] = base[v]
-    for j in range(pos.shape[0]):
-        th[pos[j]] = x[j]
-    for v in range(V):
-        if not abs(th[v]) <= SINCOS_MAX_ARG:
-            return np.inf
-    sincos_into(th, sa, ca)
-    i0 = pos.shape[0] - pos.shape[0]  # a variable 0: a literal 0 compiles _row_phasors again
-    c = _row_phasors(
-        mags, i0, sa, ca, i0, tf[0], ti[0], ti[1], tf[1], tf[2], tf[3], tf[4], ti[2], zr, zi
-    )
-    if G == 0:
-        return abs(c)
-    fx, fn = extremes_kernel(c, zr, zi, nh, tab, buf, wr, wi)
-    return max(fx, -fn)
-
-
-@njit(cache=True, nogil=True)
-def _sort_simplex(sim, fsim, row):
-    """Order the vertices by value (stable insertion sort, as numpy's argsort on < 16 items);
-    ``row`` scratch of one vertex. Written with scalar loops only: array expressions and slice
-    assignments would triple the compile time."""
-    n, N = sim.shape
-    for i in range(1, n):
-        f = fsim[i]
-        for q in range(N):
-            row[q] = sim[i, q]
-        j = i - 1
-        while j >= 0 and fsim[j] > f:
-            fsim[j + 1] = fsim[j]
-            for q in range(N):
-                sim[j + 1, q] = sim[j, q]
-            j -= 1
-        fsim[j + 1] = f
-        for q in range(N):
-            sim[j + 1, q] = row[q]
-
-
-@njit(cache=True, nogil=True)
-def _affine(out, a, x, b, y):
-    """out = a x + b y (the Nelder-Mead trial points, SciPy's operation order)."""
-    for q in range(out.shape[0]):
-        out[q] = a * x[q] + b * y[q]
-
-
-@njit(cache=True, nogil=True)
-def _put(sim, fsim, k, x, f):
-    """Vertex k of the simplex = x with value f."""
-    for q in range(x.shape[0]):
-        sim[k, q] = x[q]
-    fsim[k] = f
-
-
-@njit(cache=True, nogil=True)
-def _reflect_or_stop(sim, fsim, xbar, xt, xatol, fatol, rho):
-    """SciPy's convergence test; if not converged, the centroid of the best N vertices in
-    ``xbar`` and the reflected point in ``xt``. Returns True when converged."""
-    n1, N = sim.shape
-    dx = 0.0
-    df = 0.0
-    for k in range(1, n1):
-        df = max(df, abs(fsim[0] - fsim[k]))
-        for q in range(N):
-            dx = max(dx, abs(sim[k, q] - sim[0, q]))
-    if dx <= xatol and df <= fatol:
-        return True
-    for q in range(N):
-        acc = sim[0, q]
-        for k in range(1, N):
-            acc += sim[k, q]
-        xbar[q] = acc / N
-    _affine(xt, 1.0 + rho, xbar, -rho, sim[N])
-    return False
-
-
-@njit(cache=True, nogil=True)
-def _nelder_mead(x0, xatol, fatol, maxiter, base, pos, mags, tf, ti, nh, tab, work):
-    """SciPy 1.17 ``_minimize_neldermead`` (adaptive, no bounds, maxfev unlimited) on
-    :func:`_amplitude`, the same operations in the same order: returns (x, f).
-
-    Written as a state machine with a single call of the objective (each call site would get
-    its own inlined copy of the extremes kernel: several seconds of compile each)."""
-    N = x0.shape[0]
-    dim = float(N)
-    rho = 1.0
-    chi = 1.0 + 2.0 / dim
-    psi = 0.75 - 1.0 / (2.0 * dim)
-    sigma = 1.0 - 1.0 / dim
-    sim = np.empty((N + 1, N))
-    fsim = np.empty(N + 1)
-    for k in range(N + 1):
-        for q in range(N):
-            sim[k, q] = x0[q]
-        if k > 0:
-            y = x0[k - 1]
-            sim[k, k - 1] = (1.0 + 0.05) * y if y != 0 else 0.00025
-    row = np.empty(N)
-    xbar = np.empty(N)
-    xr = np.empty(N)
-    xt = np.empty(N)
-    fxr = 0.0
-    iterations = 1
-    # states: 0 initial vertex k, 1 reflection, 2 expansion, 3 outside / 4 inside contraction,
-    # 5 shrunk vertex k; xt holds the point to evaluate
-    state = 0
-    k = 0
-    for q in range(N):
-        xt[q] = sim[0, q]
-    while True:
-        f = _amplitude(xt, base, pos, mags, tf, ti, nh, tab, work)  # the only call
-        end = False  # end of an iteration: count, sort, test, reflect
-        if state == 0 or state == 5:
-            fsim[k] = f
-            k += 1
-            if k <= N:
-                for q in range(N):
-                    if state == 5:
-                        sim[k, q] = sim[0, q] + sigma * (sim[k, q] - sim[0, q])
-                    xt[q] = sim[k, q]
-                continue
-            if state == 0:
-                _sort_simplex(sim, fsim, row)
-                if iterations >= maxiter or _reflect_or_stop(
-                    sim, fsim, xbar, xt, xatol, fatol, rho
-                ):
-                    break
-                state = 1
-                continue
-            end = True
-        elif state == 1:
-            fxr = f
-            for q in range(N):
-                xr[q] = xt[q]
-            if fxr < fsim[0]:
-                _affine(xt, 1.0 + rho * chi, xbar, -(rho * chi), sim[N])
-                state = 2
-            elif fxr < fsim[N - 1]:
-                _put(sim, fsim, N, xr, fxr)
-                end = True
-            elif fxr < fsim[N]:
-                _affine(xt, 1.0 + psi * rho, xbar, -(psi * rho), sim[N])
-                state = 3
-            else:
-                _affine(xt, 1.0 - psi, xbar, psi, sim[N])
-                state = 4
-        elif state == 2:
-            if f < fxr:
-                _put(sim, fsim, N, xt, f)
-            else:
-                _put(sim, fsim, N, xr, fxr)
-            end = True
-        elif (state == 3 and f <= fxr) or (state == 4 and f < fsim[N]):
-            _put(sim, fsim, N, xt, f)
-            end = True
-        else:  # contraction failed: shrink towards the best vertex
-            state = 5
-            k = 1
-            for q in range(N):
-                sim[1, q] = sim[0, q] + sigma * (sim[1, q] - sim[0, q])
-                xt[q] = sim[1, q]
-        if end:
-            iterations += 1
-            _sort_simplex(sim, fsim, row)
-            if iterations >= maxiter or _reflect_or_stop(sim, fsim, xbar, xt, xatol, fatol, rho):
-                break
-            state = 1
-    best = fsim[0]
-    for k in range(1, N + 1):
-        best = min(best, fsim[k])
-    x = np.empty(N)
-    for q in range(N):
-        x[q] = sim[0, q]
-    return x, best
-
-
 def _polish_compiled(
     cand: list[np.ndarray], base: np.ndarray, pos: list[int], mvec: np.ndarray, terms: TermSet
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Compiled Nelder–Mead (:func:`_nelder_mead`) from each start in ``cand`` [rad], restarted
-    once from its result (a minimax can stall a simplex on a kink): (x per start, amplitude [mm]
-    per start). The loop over starts stays in Python (a dozen calls): one compiled level fewer
-    saves seconds of first-run compile."""
-    arr = _term_arrays(terms)
-    nh = arr["harmonics"]
-    M = grid_points(nh) if nh.size else 16
-    V, G = base.size, nh.size
-    tf = np.array(
-        [arr["gain"], arr["coeff"], np.cos(arr["phase"]), np.sin(arr["phase"]), arr["fsign"]]
+    """Compiled Nelder–Mead (:func:`gearte.models.planetary_errors.minimize_amplitude`) from
+    each start in ``cand`` [rad], restarted once from its result (a minimax can stall a simplex
+    on a kink): (x per start, amplitude [mm] per start)."""
+    return minimize_amplitude(
+        terms, mvec, base, pos, cand, xatol=1e-10, fatol=1e-14, maxiter=4000 * len(pos)
     )
-    ti = np.array([arr["mag_idx"], arr["ang_idx"], arr["group"]], dtype=np.int64)
-    args = (
-        base.astype(float),
-        np.asarray(pos, dtype=np.int64),
-        np.ascontiguousarray(mvec.reshape(1, -1), dtype=float),
-        tf,
-        ti,
-        nh,
-        node_tables(nh, M),
-        np.empty(3 * V + M + 4 * G),
-    )
-    d = len(pos)
-    xs, fs = [], []
-    for x0 in cand:
-        x, _ = _nelder_mead(np.ascontiguousarray(x0, dtype=float), 1e-10, 1e-14, 4000 * d, *args)
-        x, f = _nelder_mead(x, 1e-10, 1e-14, 4000 * d, *args)
-        xs.append(x)
-        fs.append(f)
-    return np.array(xs), np.array(fs)
 
 
 def _polish_scipy(amp, cand: list[np.ndarray], d: int) -> tuple[np.ndarray, np.ndarray]:

@@ -82,6 +82,11 @@ class FirstStageBacklashYield:
         self.alpha = float(working_pressure_angle)
         self.keys = first_stage_error_keys(self.given.size)
         self.nominal = dict(nominal_um or {})
+        #: The names of the outputs: the inner model's and the first stage's backlash.
+        self.quantities: tuple[str, ...] = (
+            *getattr(inner, "quantities", ()),
+            "first_stage_backlash_at_output [arcmin]",
+        )
 
     def _backlash(self, errors: Mapping[str, np.ndarray], n: int) -> np.ndarray:
         """``(n, N)`` backlash of each mesh [mm]."""

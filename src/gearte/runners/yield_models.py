@@ -78,6 +78,9 @@ class CycloidGeometricTE:
     Hu Y. et al. (2020) Applied Sciences 10(2), 481. doi:10.3390/app10020481
     """
 
+    #: The names of the outputs (a spec may bound them; checked before any sample).
+    quantities: tuple[str, ...] = ("geometric_te [arcmin]",)
+
     def __init__(self, stage, nominal_um: Mapping[str, float] | None = None) -> None:
         from gearte.models.cycloid_te import ERROR_FACTORS, factor_contributions, te_gradients
 
@@ -108,7 +111,7 @@ class CycloidGeometricTE:
                     te[nz] += eccentricity_te(self.stage, e[nz])
             else:
                 te += self.gradients[k] * e
-        return {"geometric_te [arcmin]": np.asarray(rad_to_arcmin(te), dtype=float)}
+        return {self.quantities[0]: np.asarray(rad_to_arcmin(te), dtype=float)}
 
 
 class PlanetaryCoupledTE:
@@ -133,6 +136,12 @@ class PlanetaryCoupledTE:
     ----------
     Wang C. et al. (2013) Trans. CSAM 44(8), 287–292. doi:10.6041/j.issn.1000-1298.2013.08.049
     """
+
+    #: The names of the outputs (a spec may bound them; checked before any sample).
+    quantities: tuple[str, ...] = (
+        "coupled_te_amplitude [arcsec]",
+        "coupled_te_peak_to_peak [arcsec]",
+    )
 
     def __init__(
         self,
@@ -169,13 +178,10 @@ class PlanetaryCoupledTE:
             angs = np.zeros((n, 0))
         fmax, fmin = sample_extremes(self.terms, mags, angs)
         s = abs(self.terms.scale)
+        amplitude, peak_to_peak = self.quantities
         return {
-            "coupled_te_amplitude [arcsec]": np.asarray(
-                rad_to_arcsec(np.maximum(fmax, -fmin) * s), dtype=float
-            ),
-            "coupled_te_peak_to_peak [arcsec]": np.asarray(
-                rad_to_arcsec((fmax - fmin) * s), dtype=float
-            ),
+            amplitude: np.asarray(rad_to_arcsec(np.maximum(fmax, -fmin) * s), dtype=float),
+            peak_to_peak: np.asarray(rad_to_arcsec((fmax - fmin) * s), dtype=float),
         }
 
 
@@ -272,6 +278,19 @@ class RVReducerYield:
     Han et al. (2023), Hu et al. (2020); see :mod:`gearte.models.rv_load_sharing` and
     :mod:`gearte.models.rv_catalogue`.
     """
+
+    #: The names of the outputs, those of :meth:`one` and of the batched solver (a spec may bound
+    #: them; checked before any sample, and against the outputs when a yield runs).
+    quantities: tuple[str, ...] = (
+        "lost_motion [arcmin]",
+        "torsional_rigidity [Nm/arcmin]",
+        "backlash [arcmin]",
+        "hysteresis_loss [arcmin]",
+        "angular_te [arcmin]",
+        "loaded_te [arcmin]",
+        "peak_pin_load [N]",
+        "max_contact_pressure [MPa]",
+    )
 
     def __init__(
         self,
@@ -427,6 +446,9 @@ class GearChainLostMotion:
     Jiang et al. (2024), see :mod:`gearte.models.lost_motion`.
     """
 
+    #: The names of the outputs (a spec may bound them; checked before any sample).
+    quantities: tuple[str, ...] = ("joint_lost_motion [arcmin]",)
+
     def __init__(self, names, ratios) -> None:
         from gearte.models.lost_motion import stage_transfer_factors
 
@@ -442,7 +464,7 @@ class GearChainLostMotion:
         e = np.column_stack(
             [np.maximum(np.asarray(errors[k], dtype=float), 0.0) for k in self.names]
         )
-        return {"joint_lost_motion [arcmin]": (e @ self.factors).reshape(n)}
+        return {self.quantities[0]: (e @ self.factors).reshape(n)}
 
 
 def chain_tolerances(drives, confidence: float = 0.9973):

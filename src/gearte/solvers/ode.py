@@ -512,6 +512,24 @@ def check_rk4_steps(dt: float, span_s: float) -> None:
     )
 
 
+def check_span(t_span: tuple[float, float], t_settle: float) -> None:
+    """Refuse a time span [s] that :func:`integrate` cannot summarise: its end not after its
+    start, or a settling time ``t_settle`` [s] outside ``[0, t1 - t0)`` (no output after
+    settling; also a span whose length is lost beside ``t_settle`` in double precision). Called
+    by :func:`integrate` and by the studies' pre-flight (``gearte validate``).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``t_span`` or ``t_settle``.
+    """
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    if not t1 > t0:
+        raise ParameterError("t_span", t_span, "end must be after start")
+    if not 0.0 <= t_settle < t1 - t0:
+        raise ParameterError("t_settle", t_settle, f"must be in [0, {t1 - t0:g}) s")
+
+
 def integrate(
     system: ODESystem,
     y0: np.ndarray,
@@ -580,10 +598,7 @@ def integrate(
     buckets. Only the recorded rows are bounded by ``record_window``.
     """
     t0, t1 = float(t_span[0]), float(t_span[1])
-    if not t1 > t0:
-        raise ParameterError("t_span", t_span, "end must be after start")
-    if not 0.0 <= t_settle < t1 - t0:
-        raise ParameterError("t_settle", t_settle, f"must be in [0, {t1 - t0:g}) s")
+    check_span((t0, t1), t_settle)
     if record_window is not None and record_window < 1:
         raise ParameterError("record_window", record_window, "must be ≥ 1 row (or None: all)")
     if output_window is not None and output_window < 1:

@@ -137,7 +137,7 @@ def grid_points(harmonics: Sequence[int] | np.ndarray) -> int:
     return max(16, 8 * int(max(harmonics)) if len(harmonics) else 16)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def node_tables(nh, M):
     """tab[2g, j] = sin(n_g u_j), tab[2g + 1, j] = cos(n_g u_j), u_j = 2 pi j / M (the product
     n_g j reduced modulo M in integers first)."""
@@ -214,36 +214,14 @@ def _eval_at(d, c, wr, wi, nh):
 
 
 @njit(cache=True, nogil=True)
-def _golden(h, sgn, c, wr, wi, nh):
-    """Golden-section search for the largest sgn*f on [-h, h] around a node (fallback)."""
-    gr = 0.6180339887498949
-    a = -h
-    b = h
-    x1 = b - gr * (b - a)
-    x2 = a + gr * (b - a)
-    f1 = sgn * _eval_at(x1, c, wr, wi, nh)[0]
-    f2 = sgn * _eval_at(x2, c, wr, wi, nh)[0]
-    for _ in range(200):
-        if b - a <= 1e-12:
-            break
-        if f1 < f2:
-            a = x1
-            x1 = x2
-            f1 = f2
-            x2 = a + gr * (b - a)
-            f2 = sgn * _eval_at(x2, c, wr, wi, nh)[0]
-        else:
-            b = x2
-            x2 = x1
-            f2 = f1
-            x1 = b - gr * (b - a)
-            f1 = sgn * _eval_at(x1, c, wr, wi, nh)[0]
-    return max(f1, f2, sgn * _eval_at(0.0, c, wr, wi, nh)[0])
-
-
-@njit(cache=True, nogil=True)
 def _refine(j, sgn, buf, tab, c, zr, zi, nh, h, stol, wr, wi):
-    """Largest sgn*f on [u_j - h, u_j + h]: Halley on f' from the parabolic vertex."""
+    """Largest sgn*f on [u_j - h, u_j + h]: Halley on f' from the parabolic vertex; if an
+    iterate leaves the interval, meets f'' >= 0 or 30 steps do not converge, golden-section
+    search on [-h, h] (200 steps at most, down to 1e-12 rad) and the best of its two last
+    points and the node.
+
+    Written as a state machine with a single evaluation of f (:func:`_eval_at`, inlined): each
+    call site would compile its own copy (issue 12: first-run compile)."""
     M = buf.shape[0]
     for g in range(nh.shape[0]):
         s = tab[2 * g, j]
@@ -254,48 +232,80 @@ def _refine(j, sgn, buf, tab, c, zr, zi, nh, h, stol, wr, wi):
     v = sgn * buf[j]
     vn = sgn * buf[j + 1 if j < M - 1 else 0]
     den = vp - 2.0 * v + vn
-    d = 0.5 * h * (vp - vn) / den if den < 0.0 else 0.0
-    for _ in range(30):
-        f, d1, d2, d3 = _eval_at(d, c, wr, wi, nh)
-        d1 *= sgn
-        d2 *= sgn
-        d3 *= sgn
-        if d2 >= 0.0:
-            break
-        q = 2.0 * d2 * d2 - d1 * d3
-        step = -2.0 * d1 * d2 / q if q > 0.0 else -d1 / d2  # Halley, else Newton
-        if abs(step) <= stol:
-            return sgn * f + step * (d1 + step * (0.5 * d2 + step * d3 / 6.0))
-        d = d + step
-        if d < -h or d > h:
-            break
-    return _golden(h, sgn, c, wr, wi, nh)
+    x = 0.5 * h * (vp - vn) / den if den < 0.0 else 0.0
+    gr = 0.6180339887498949
+    a = -h
+    b = h
+    x1 = 0.0
+    x2 = 0.0
+    f1 = 0.0
+    f2 = 0.0
+    # phase 0: Halley (it = steps taken); golden section: 1 first point x1, 2 first point x2,
+    # 3 new x2, 5 new x1 (it = its steps), 4 the node itself, then done
+    phase = 0
+    it = 0
+    while True:
+        f, d1, d2, d3 = _eval_at(x, c, wr, wi, nh)  # the only evaluation
+        if phase == 0:
+            d1 *= sgn
+            d2 *= sgn
+            d3 *= sgn
+            if d2 < 0.0:
+                q = 2.0 * d2 * d2 - d1 * d3
+                step = -2.0 * d1 * d2 / q if q > 0.0 else -d1 / d2  # Halley, else Newton
+                if abs(step) <= stol:
+                    return sgn * f + step * (d1 + step * (0.5 * d2 + step * d3 / 6.0))
+                x = x + step
+                it += 1
+                if not (x < -h or x > h) and it < 30:
+                    continue
+            # golden-section fallback on [-h, h]
+            x1 = b - gr * (b - a)
+            x2 = a + gr * (b - a)
+            x = x1
+            phase = 1
+            continue
+        if phase == 4:
+            return max(f1, f2, sgn * f)
+        if phase == 1:
+            f1 = sgn * f
+            x = x2
+            phase = 2
+            it = 0
+            continue
+        if phase == 5:
+            f1 = sgn * f
+        else:  # phases 2 and 3
+            f2 = sgn * f
+        if it >= 200 or b - a <= 1e-12:
+            x = 0.0
+            phase = 4
+            continue
+        it += 1
+        if f1 < f2:
+            a = x1
+            x1 = x2
+            f1 = f2
+            x2 = a + gr * (b - a)
+            x = x2
+            phase = 3
+        else:
+            b = x2
+            x2 = x1
+            f2 = f1
+            x1 = b - gr * (b - a)
+            x = x1
+            phase = 5
 
 
-@njit(cache=True, nogil=True)
-def _best_of(sgn, thr, buf, tab, c, zr, zi, nh, h, stol, wr, wi):
-    """Slow path: refine every discrete local maximum of sgn*f whose node is above thr."""
-    M = buf.shape[0]
-    best = -np.inf
-    for j in range(M):
-        v = sgn * buf[j]
-        if v > thr:
-            vp = sgn * buf[j - 1 if j > 0 else M - 1]
-            vn = sgn * buf[j + 1 if j < M - 1 else 0]
-            if v >= vp and v >= vn:
-                r = _refine(j, sgn, buf, tab, c, zr, zi, nh, h, stol, wr, wi)
-                if r > best:
-                    best = r
-    return best
-
-
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def extremes_kernel(c, zr, zi, nh, tab, buf, wr, wi):
     """(max f, min f) over one period for one sample (compiled; see the module docstring).
 
     ``tab`` from :func:`node_tables` with ``M = len(buf)`` >= 8 n_max nodes; ``wr, wi`` scratch of
-    length G. Called per sample by the Monte-Carlo kernel of
-    :mod:`gearte.models.planetary_errors`.
+    length G. Inlined into the kernels that call it (one call site each: the Monte-Carlo /
+    optimisation kernel of :mod:`gearte.models.planetary_errors` and :func:`exact_extremes`), with
+    a single call site of the refinement: every call site of a kernel compiles its own copy.
     """
     M = buf.shape[0]
     h = 2.0 * math.pi / M
@@ -314,14 +324,33 @@ def extremes_kernel(c, zr, zi, nh, tab, buf, wr, wi):
     # Taylor-stop step: Σ|Z| n⁴ stol⁴ / 24 <= 1e-13 Σ|Z|, and never above 1e-3 rad
     stol = min(1e-3, math.sqrt(math.sqrt(2.4e-12 * s1 / s4))) if s4 > 0.0 else 1e-3
     nx, sx, nn, sn = _count_beyond(buf, mx - bound, mn + bound)
-    if nx == 1:  # the best node alone is within the margin
-        fmax = _refine(sx, 1.0, buf, tab, c, zr, zi, nh, h, stol, wr, wi)
-    else:
-        fmax = _best_of(1.0, mx - bound, buf, tab, c, zr, zi, nh, h, stol, wr, wi)
-    if nn == 1:
-        fmin = -_refine(sn, -1.0, buf, tab, c, zr, zi, nh, h, stol, wr, wi)
-    else:
-        fmin = -_best_of(-1.0, -(mn + bound), buf, tab, c, zr, zi, nh, h, stol, wr, wi)
+    fmax = 0.0
+    fmin = 0.0
+    for side in range(2):  # the maximum, then the minimum as the maximum of -f
+        sgn = 1.0 if side == 0 else -1.0
+        cnt = nx if side == 0 else nn
+        thr = mx - bound if side == 0 else -(mn + bound)
+        # the best node alone within the margin: refine it; else every discrete local maximum
+        # of sgn*f above the margin
+        j0 = (sx if side == 0 else sn) if cnt == 1 else 0
+        j1 = j0 + 1 if cnt == 1 else M
+        best = -np.inf
+        for j in range(j0, j1):
+            if cnt != 1:
+                v = sgn * buf[j]
+                if not v > thr:
+                    continue
+                vp = sgn * buf[j - 1 if j > 0 else M - 1]
+                vn = sgn * buf[j + 1 if j < M - 1 else 0]
+                if not (v >= vp and v >= vn):
+                    continue
+            r = _refine(j, sgn, buf, tab, c, zr, zi, nh, h, stol, wr, wi)
+            if cnt == 1 or r > best:
+                best = r
+        if side == 0:
+            fmax = best
+        else:
+            fmin = -best
     return max(fmax, mx), min(fmin, mn)
 
 

@@ -590,11 +590,26 @@ def preflight_dynamics(case, red: RVReducer) -> None:
     ParameterError
         The first failing check, naming its key.
     """
+    from gearte.errors import ParameterError
     from gearte.runners.rv_dynamics_sim import default_step
-    from gearte.solvers.ode import check_rk4_steps
+    from gearte.solvers.ode import check_rk4_steps, check_span
 
     model, _ = build_dynamic_model(case, red)
     a = case.analyses
+    for name in ("dte", "speed_sweep", "batch"):
+        o = getattr(a, name)
+        if o is None:
+            continue
+        try:  # the span each of its integrations gets: (0, settle + duration), settling first
+            check_span((0.0, o.settle_s + o.duration_s), o.settle_s)
+        except ParameterError as exc:
+            raise ParameterError(
+                f"analyses.{name}.duration_s",
+                o.duration_s,
+                f"leaves no simulated time after settle_s = {o.settle_s:g} s (settle_s + "
+                f"duration_s = {o.settle_s + o.duration_s:g} s in double precision; the "
+                f"integrator: {exc})",
+            ) from None
     spans = []
     if a.dte is not None and a.dte.method == "rk4":
         spans.append((a.dte.step_fraction, a.dte.duration_s + a.dte.settle_s))

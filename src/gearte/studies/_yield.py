@@ -39,7 +39,7 @@ per-quantity statistics, ``sobol_first`` / ``sobol_total`` per tolerance (with C
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal
 
 from pydantic import Field, model_validator
@@ -421,10 +421,13 @@ def yield_inputs(
     defaults: Mapping[str, ToleranceEntry] | None = None,
     families: Mapping[str, list[str]] | None = None,
     grade_um: Callable[[str, int], float | None] | None = None,
+    quantities: Sequence[str] | None = None,
 ) -> tuple[Any, dict[str, Any]]:
     """The tolerance set and allocation cost models of a yield section, checked against the
-    drive's error keys (arguments as :func:`yield_analysis`). :func:`yield_analysis` calls it
-    before any sample and the kinds' pre-flight (``gearte validate``) calls it without running.
+    drive's error keys (arguments as :func:`yield_analysis`), and its spec against the yield
+    model's ``quantities`` (its output names; not checked when ``None``). :func:`yield_analysis`
+    calls it before any sample and the kinds' pre-flight (``gearte validate``) calls it without
+    running.
 
     Returns
     -------
@@ -436,10 +439,20 @@ def yield_inputs(
     ParameterError
         A tolerance or cost naming a key the drive does not have
         (``analyses.yield.tolerances.<key>``, ``analyses.yield.allocation.costs.<key>``), a
-        tolerance in the wrong unit, a grade on an error that is not a gear's eccentricity.
+        tolerance in the wrong unit, a grade on an error that is not a gear's eccentricity, a
+        spec on a quantity the model does not give (``analyses.yield.spec.<quantity>``).
     """
     from gearte.errors import ParameterError
     from gearte.tolerance.allocation import CostModel, PriceTable
+
+    if quantities is not None:
+        for q in section.spec:
+            if q not in quantities:
+                raise ParameterError(
+                    f"analyses.yield.spec.{q}",
+                    q,
+                    f"is not a quantity of the model {sorted(quantities)}",
+                )
 
     ts = _tolerances(section, units, nominal, dict(defaults or {}), dict(families or {}), grade_um)
     costs: dict[str, CostModel | PriceTable] = {}
@@ -507,7 +520,9 @@ def yield_analysis(
 
     seed = section.seed if getattr(options, "seed", None) is None else int(options.seed)
     n = section.samples if getattr(options, "samples", None) is None else int(options.samples)
-    ts, costs = yield_inputs(section, units, nominal, defaults, families, grade_um)
+    ts, costs = yield_inputs(
+        section, units, nominal, defaults, families, grade_um, getattr(model, "quantities", None)
+    )
     spec = [SpecLimit(q, s.lower, s.upper) for q, s in section.spec.items()]
     progress = getattr(options, "progress", False)
     res = run_yield(

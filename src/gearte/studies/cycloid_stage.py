@@ -23,7 +23,7 @@ from typing import Literal
 import numpy as np
 from pydantic import ConfigDict, Field, model_validator
 
-from gearte.errors import ParameterError
+from gearte.errors import ConvergenceError, ParameterError
 from gearte.io.schema import CaseBase, StrictModel
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies._yield import YieldSection
@@ -332,25 +332,48 @@ def _geometric_te(st, case: Case, opts: GeometricTEOptions) -> AnalysisResult:
     )
 
 
-def _tooth_contact(st, o: ToothContactOptions) -> tuple[AnalysisResult, list[str]]:
+def _contact_solver(st, o: ToothContactOptions):
+    """``mesh_angle [rad] → ToothContact`` of ``[analyses.tooth_contact]``
+    (:func:`gearte.models.cycloid_contact.tooth_contact`). A torque the contact model refuses
+    once solved (a pin loaded beyond the elastic law's range, a normal deformation beyond its
+    range) is bad input naming ``analyses.tooth_contact.torque_Nm``, whichever mesh position
+    found it."""
     from gearte.models.cycloid_contact import tooth_contact
-    from gearte.units import Nm_to_Nmm, rad_to_deg
+    from gearte.units import Nm_to_Nmm
 
     T = float(Nm_to_Nmm(o.torque_Nm))
 
     def contact(mesh_angle):
-        return tooth_contact(
-            st,
-            T,
-            disc_share=o.disc_share,
-            E=o.youngs_modulus_MPa,
-            mu=o.poisson_ratio,
-            mesh_angle=mesh_angle,
-            F_start=o.start_force_N,
-            clearance_model=o.clearance_model,
-            contact_law=o.contact_law,
-        )
+        try:
+            return tooth_contact(
+                st,
+                T,
+                disc_share=o.disc_share,
+                E=o.youngs_modulus_MPa,
+                mu=o.poisson_ratio,
+                mesh_angle=mesh_angle,
+                F_start=o.start_force_N,
+                clearance_model=o.clearance_model,
+                contact_law=o.contact_law,
+            )
+        except ParameterError as exc:
+            if exc.field != "torque":
+                raise
+            raise ParameterError(
+                "analyses.tooth_contact.torque_Nm",
+                o.torque_Nm,
+                f"{exc.reason.removeprefix('[N·mm] ')} (with youngs_modulus_MPa = "
+                f"{o.youngs_modulus_MPa:g}, disc_share = {o.disc_share:g}, "
+                f"contact_law = {o.contact_law!r})",
+            ) from None
 
+    return contact
+
+
+def _tooth_contact(st, o: ToothContactOptions) -> tuple[AnalysisResult, list[str]]:
+    from gearte.units import rad_to_deg
+
+    contact = _contact_solver(st, o)
     tc = contact(0.0)
     values = {
         "contact_law": o.contact_law,
@@ -542,19 +565,37 @@ def _yield_keys(case: Case) -> tuple[dict, dict, dict]:
 
 def preflight(case: Case) -> None:
     """The checks :func:`run` makes before any analysis that the schema cannot make alone
-    (``gearte validate``, :func:`gearte.studies.run_case`): the yield's tolerance and cost keys
-    against the stage's error keys (:func:`~gearte.studies._yield.yield_inputs`).
+    (``gearte validate``, :func:`gearte.studies.run_case`): the tooth contact's solve at the
+    paper's mesh position (a torque that loads a pin beyond the elastic contact model's range;
+    the other mesh positions are checked when the analysis solves them), the yield's tolerance
+    and cost keys against the stage's error keys and its spec against the yield model's
+    quantities (:func:`~gearte.studies._yield.yield_inputs`).
 
     Raises
     ------
     ParameterError
-        Naming ``analyses.yield.tolerances.<key>`` or ``analyses.yield.allocation.costs.<key>``.
+        Naming ``analyses.tooth_contact.torque_Nm``, ``analyses.yield.tolerances.<key>``,
+        ``analyses.yield.allocation.costs.<key>`` or ``analyses.yield.spec.<quantity>``.
     """
+    if case.analyses.tooth_contact is not None:
+        # the paper's mesh position, the analysis's first solve (one position: milliseconds);
+        # the other positions are solved and checked when the analysis runs
+        try:
+            _contact_solver(build_stage(case.stage), case.analyses.tooth_contact)(0.0)
+        except ConvergenceError:
+            pass  # not a check of the input: the analysis reports it (exit 1)
     if case.analyses.yield_ is not None:
+        from gearte.runners.yield_models import CycloidGeometricTE
         from gearte.studies._yield import yield_inputs
 
         units, means, bands = _yield_keys(case)
-        yield_inputs(case.analyses.yield_, units, means, defaults=bands)
+        yield_inputs(
+            case.analyses.yield_,
+            units,
+            means,
+            defaults=bands,
+            quantities=CycloidGeometricTE.quantities,
+        )
 
 
 def _yield(st, case: Case, options) -> AnalysisResult:

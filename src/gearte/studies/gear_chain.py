@@ -626,37 +626,33 @@ def _stage_tolerances(case: Case, stages, drives: dict, backlash: dict) -> dict:
     return out
 
 
-def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> AnalysisResult:
-    """``[analyses.yield]``: each sample one assembled chain, combined at the joint by eq. (30).
+def _yield_setup(case: Case, sec: YieldSection, pairs: dict, defaults: dict):
+    """What the chain's yield model and its inputs are built from, nothing evaluated: the
+    :class:`~gearte.runners.chain_yield.GearChainYield`, the error keys' units and nominals, the
+    tolerances the stages imply (``defaults`` from :func:`_stage_tolerances`, updated: a pair
+    stage's law is replaced by its stack's contributors) and the grade reading.
 
-    A pair stage (``[pair]`` or a ``gear_pair`` drive) draws every contributor of its own
-    backlash stack (keys ``<stage slug>.<contributor>`` [µm]; gearte.runners.chain_yield) unless
-    the section gives a law for the whole stage by its name; every other stage draws its lost
-    motion from its law (:func:`_stage_tolerances`, key: the stage name [arcmin]). Yield against
-    ``[analyses.yield.spec]`` (``"joint_lost_motion [arcmin]"``, ``"<slug>.lost_motion
-    [arcmin]"``, ``"end_effector_error [mm]"``), contributions per tolerance.
+    ``pairs``: stage name → its gear pair (a ``[pair]`` stage's or a ``gear_pair`` drive's),
+    :func:`_stage_pairs`. :func:`_chain_yield` runs it; :func:`preflight` checks it.
     """
     from gearte.models.backlash import SpurPair
     from gearte.runners.chain_yield import ChainStage, GearChainYield, stack_terms
-    from gearte.studies._yield import ToleranceEntry, yield_analysis
+    from gearte.studies._yield import ToleranceEntry
     from gearte.tolerance.iso1328 import radial_composite_tolerances
 
-    sec = case.analyses.yield_ if case.analyses is not None else None
-    assert sec is not None
-    defaults = _stage_tolerances(case, stages, drives, backlash)
-    units = {s.name: "arcmin" for s in stages}
+    units = {s.name: "arcmin" for s in case.chain.stages}
     nominal = {k: float(t.nominal_arcmin or 0.0) for k, t in defaults.items()}
     chain: list[ChainStage] = []
-    pairs: dict[str, tuple[Any, str]] = {}
-    for s in stages:
+    drawn: dict[str, tuple[Any, str]] = {}
+    for s in case.chain.stages:
         slug = _slug(s.name)
-        pair = getattr(drives.get(s.name), "pair", None)
-        if s.name in backlash and backlash[s.name][3] is not None:
-            pair = backlash[s.name][3]
+        pair = pairs.get(s.name)
         if pair is None or s.name in sec.tolerances:
             chain.append(ChainStage(s.name, slug, s.ratio))
             continue
-        del defaults[s.name], units[s.name], nominal[s.name]
+        del units[s.name]
+        defaults.pop(s.name, None)
+        nominal.pop(s.name, None)
         terms, laws = stack_terms(slug, pair.backlash_stack())
         chain.append(
             ChainStage(s.name, slug, s.ratio, terms, pair.output_diameter, pair.pressure_angle)
@@ -670,17 +666,87 @@ def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> A
                 sigmas=6.0 if kind == "rayleigh" else None,
                 phase=kind == "rayleigh",
             )
-            pairs[key] = (pair, "driving" if ".driving_gear" in key else "driven")
+            drawn[key] = (pair, "driving" if ".driving_gear" in key else "driven")
 
     def grade_um(key: str, grade: int) -> float | None:
         """A spur gear's eccentricity: its ISO 1328-2 total radial composite tolerance F_i″."""
-        if not key.endswith("_gear_eccentricity") or key not in pairs:
+        if not key.endswith("_gear_eccentricity") or key not in drawn:
             return None
-        pair, which = pairs[key]
+        pair, which = drawn[key]
         if not isinstance(pair, SpurPair):
             return None
         teeth = getattr(pair, which).teeth
         return radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
+
+    model = GearChainYield(chain, nominal, case.chain.lever_length_mm)
+    return model, chain, units, nominal, defaults, grade_um
+
+
+def _stage_pairs(case: Case, drives: dict, built: dict) -> dict:
+    """Stage name → its gear pair: a ``[pair]`` stage's (``built``: name → the built pair) or a
+    ``gear_pair`` drive's (``drives``: name → the built drive)."""
+    out = {}
+    for s in case.chain.stages:
+        pair = built.get(s.name)
+        if pair is None:
+            pair = getattr(drives.get(s.name), "pair", None)
+        if pair is not None:
+            out[s.name] = pair
+    return out
+
+
+def preflight(case: Case) -> None:
+    """The checks :func:`run` makes on the built drives before any analysis (``gearte
+    validate``, :func:`gearte.studies.run_case`): each ``[drive]`` stage's drive is built
+    (:meth:`DriveSpec.build`) and each ``[pair]`` stage's pair, without computing a lost motion;
+    the yield's tolerance keys (a pair stage's backlash-stack contributors come from its pair),
+    cost keys, grades and spec quantities are checked against the yield model
+    (:func:`_yield_setup`, :func:`~gearte.studies._yield.yield_inputs`) as the yield does.
+
+    Raises
+    ------
+    ParameterError
+        Naming the key of the first failing check.
+    """
+    from gearte.studies._yield import yield_inputs
+
+    drives = {}
+    built = {}
+    for st in case.chain.stages:
+        if st.drive is not None:
+            drives[st.name] = st.drive.build(st.name)
+        elif st.lost_motion_max_arcmin is None and st.pair is not None:
+            built[st.name] = st.pair.build()
+    sec = case.analyses.yield_ if case.analyses is not None else None
+    if sec is None:
+        return
+    model, _, units, nominal, defaults, grade_um = _yield_setup(
+        case, sec, _stage_pairs(case, drives, built), {}
+    )
+    yield_inputs(sec, units, nominal, defaults, grade_um=grade_um, quantities=model.quantities)
+
+
+def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> AnalysisResult:
+    """``[analyses.yield]``: each sample one assembled chain, combined at the joint by eq. (30).
+
+    A pair stage (``[pair]`` or a ``gear_pair`` drive) draws every contributor of its own
+    backlash stack (keys ``<stage slug>.<contributor>`` [µm]; gearte.runners.chain_yield) unless
+    the section gives a law for the whole stage by its name; every other stage draws its lost
+    motion from its law (:func:`_stage_tolerances`, key: the stage name [arcmin]). Yield against
+    ``[analyses.yield.spec]`` (``"joint_lost_motion [arcmin]"``, ``"<slug>.lost_motion
+    [arcmin]"``, ``"end_effector_error [mm]"``), contributions per tolerance.
+    """
+    from gearte.studies._yield import yield_analysis
+
+    sec = case.analyses.yield_ if case.analyses is not None else None
+    assert sec is not None
+    built = {k: v[3] for k, v in backlash.items() if v[3] is not None}
+    model, chain, units, nominal, defaults, grade_um = _yield_setup(
+        case,
+        sec,
+        _stage_pairs(case, drives, built),
+        _stage_tolerances(case, stages, drives, backlash),
+    )
 
     radial = {t.key for st in chain for t in st.terms if t.radial}
 
@@ -711,7 +777,7 @@ def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> A
 
     res = yield_analysis(
         sec,
-        GearChainYield(chain, nominal, case.chain.lever_length_mm),
+        model,
         units,
         nominal,
         options=options,

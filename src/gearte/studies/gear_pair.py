@@ -808,6 +808,21 @@ def analyse_pair(
     return out
 
 
+def preflight(case: Case) -> None:
+    """The checks :func:`run` makes before any analysis (``gearte validate``,
+    :func:`gearte.studies.run_case`): the pair and its backlash stack are built as
+    :func:`analyse_pair` builds them (the schema already built them to check the pair can be
+    assembled, so this is a second call of the same functions, nothing computed).
+
+    Raises
+    ------
+    ParameterError
+        Naming the key.
+    """
+    case.pair.build()
+    case.pair.backlash_stack()
+
+
 def run(case: Case, options) -> StudyResult:
     """Run a ``gear_pair`` case (:func:`analyse_pair` on its pair); no I/O, no plotting.
 

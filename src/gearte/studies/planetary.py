@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 from fractions import Fraction
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Literal, get_args
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -25,17 +25,15 @@ from pydantic import Field, field_validator, model_validator
 from gearte.errors import ParameterError
 from gearte.geometry.planetary import EccentricityError, PlanetarySet, SunPlanetErrors
 from gearte.io.schema import CaseBase, Sign, StrictModel
-from gearte.models.planetary_errors import (
-    TermSet,
-    coupled_te,
-    derive_terms,
-    first_stage_keys,
-    frequency_basis,
-    terms_from_table,
-)
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies._yield import YieldSection
 from gearte.units import deg_to_rad, mm_to_um, rad_to_arcsec, rad_to_deg, um_to_mm
+
+if TYPE_CHECKING:
+    from gearte.models.planetary_errors import TermSet
+
+# the models (numba kernels) are imported where they are used: importing this module (to read
+# a case, or to unpickle its result in the report process) stays free of numba
 
 KIND = "planetary"
 REFERENCES = ["wang2013"]
@@ -153,7 +151,9 @@ class Errors(StrictModel):
     )
     magnitudes_um: dict[str, float] = Field(description="error magnitude per key [µm]")
     angles_deg: dict[str, float] = Field(
-        default_factory=dict, description="error angle per key [deg] (missing: 0)"
+        default_factory=dict,
+        description="error angle per key [deg] (missing: 0); |angle| <= 5729577.95 deg (1e5 rad, "
+        "the range of the compiled sine and cosine of the TE kernels)",
     )
     terms: list[TermRow] | None = Field(default=None, description="source='terms': the list")
     reference_angle: str | None = Field(
@@ -171,6 +171,20 @@ class Errors(StrictModel):
                 raise ValueError(f"magnitude {k!r} = {x!r}: must be a finite number >= 0 [µm]")
             if x > 10_000:
                 raise ValueError(f"magnitude {k!r} = {x!r}: must be <= 10000 µm")
+        return v
+
+    @field_validator("angles_deg")
+    @classmethod
+    def _bounded_angles(cls, v: dict[str, float]) -> dict[str, float]:
+        from gearte.solvers.trig_extremes import SINCOS_MAX_ARG
+
+        limit = float(rad_to_deg(SINCOS_MAX_ARG))
+        for k, x in v.items():
+            if not np.isfinite(x) or abs(x) > limit:
+                raise ValueError(
+                    f"angle {k!r} = {x!r}: must be a finite number with |angle| <= {limit:.9g} "
+                    f"deg ({SINCOS_MAX_ARG:g} rad, the range of the TE kernels' sine and cosine)"
+                )
         return v
 
     @model_validator(mode="after")
@@ -254,6 +268,7 @@ def _check_resources(case: Case, terms: TermSet) -> None:
     common period); each evaluation costs about ``8 n_max G`` sine-table products.
     """
     from gearte.limits import check_memory, check_time
+    from gearte.models.planetary_errors import frequency_basis
     from gearte.solvers.trig_extremes import grid_points
 
     _, harm, _ = frequency_basis(terms)
@@ -358,6 +373,8 @@ def first_stage_errors(case: Case) -> SunPlanetErrors:
 
 def build_terms(case: Case) -> tuple[TermSet, dict[str, float], dict[str, float]]:
     """The term set, magnitudes [mm] and angles [rad] of a case (keys checked)."""
+    from gearte.models.planetary_errors import derive_terms, first_stage_keys, terms_from_table
+
     pset = case.gearset.build()
     e = case.errors
     if e.source == "derived":
@@ -448,13 +465,16 @@ def preflight(case: Case) -> None:
     terms, mags, angs = build_terms(case)
     paper_rule_angles(terms, mags, angs)
     if case.analyses.yield_ is not None:
+        from gearte.runners.yield_models import PlanetaryCoupledTE
         from gearte.studies._yield import yield_inputs
 
-        yield_inputs(case.analyses.yield_, *_yield_keys(terms, mags, angs))
+        units, nominal = _yield_keys(terms, mags, angs)
+        yield_inputs(case.analyses.yield_, units, nominal, quantities=PlanetaryCoupledTE.quantities)
 
 
 def run(case: Case, options) -> StudyResult:
     """Derive (or read) the terms, then coupled TE, assembly phases and Monte-Carlo."""
+    from gearte.models.planetary_errors import coupled_te, frequency_basis
     from gearte.runners.planetary_assembly import (
         optimal_assembly,
         paper_rule_assembly,

@@ -203,7 +203,9 @@ def _sec(x):
     return x * ARCSEC_PER_RAD
 
 
-def run(case: Case, options) -> StudyResult:
+def _inputs(case: Case):
+    """``(reducer, its case, characteristic orders, TE traces, hysteresis curve)``: the
+    reducer case loaded and built, the bench files read (:mod:`gearte.io.bench`)."""
     from gearte.io.bench import read_hysteresis, read_te_folder, read_te_trace
     from gearte.models.orders import rv_characteristic_orders
 
@@ -215,6 +217,26 @@ def run(case: Case, options) -> StudyResult:
     if d.te is not None:
         traces = read_te_folder(d.te) if Path(d.te).is_dir() else [read_te_trace(d.te)]
     hyst = read_hysteresis(d.hysteresis) if d.hysteresis is not None else None
+    return reducer, rcase, sources, traces, hyst
+
+
+def preflight(case: Case) -> None:
+    """The checks :func:`run` makes before any analysis (``gearte validate``,
+    :func:`gearte.studies.run_case`): the reducer case is loaded and built, and the bench files
+    are read by the readers the run uses (:func:`_inputs`; a malformed file is one line naming
+    file, line and column), without any analysis. (``run`` reads them again: a few hundred ms
+    for the bundled bench.)
+
+    Raises
+    ------
+    ParameterError, BenchFileError
+        Naming the key or the file.
+    """
+    _inputs(case)
+
+
+def run(case: Case, options) -> StudyResult:
+    reducer, rcase, sources, traces, hyst = _inputs(case)
     a = case.analyses
     analyses: list[AnalysisResult] = []
     warnings: list[str] = []

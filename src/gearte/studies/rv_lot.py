@@ -255,6 +255,23 @@ def build_lot(case: Case):
     return red, out
 
 
+def preflight(case: Case) -> None:
+    """The checks :func:`run` makes before any analysis (``gearte validate``,
+    :func:`gearte.studies.run_case`): the design and the lot built from the measurement files
+    and checked against the design (:func:`build_lot`, :meth:`Lot.check`). Validating the case
+    already built it (kept for the run); a case built without validation is built here. The
+    selective-assembly settings the runners check again (indexings, spec, objective, grading
+    window) are bounded by the schema.
+
+    Raises
+    ------
+    ParameterError, MeasurementFileError
+        Naming the key or the file.
+    """
+    if case._built is None:
+        case._built = build_lot(case)
+
+
 def run(case: Case, options=None) -> StudyResult:
     """Selective assembly of the lot (and pin grading when asked).
 

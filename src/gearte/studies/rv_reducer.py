@@ -1383,7 +1383,9 @@ def preflight(case: Case) -> None:
     """The checks :func:`run` makes on the built reducer, before any analysis (called by
     ``gearte validate`` and by :func:`gearte.studies.run_case`): the dynamic model's derived
     masses (density), its elastic modes and RK4 step budgets
-    (:func:`_rv_dynamics.preflight_dynamics`); the yield's tolerance and cost keys against the
+    (:func:`_rv_dynamics.preflight_dynamics`); the tooth contact at the paper's mesh position
+    (:func:`gearte.studies.cycloid_stage.preflight` of :func:`build_stage_case`, which the
+    cycloid analyses run on); the yield's tolerance and cost keys against the
     reducer's error keys (:func:`~gearte.studies._yield.yield_inputs`).
 
     Raises
@@ -1398,9 +1400,14 @@ def preflight(case: Case) -> None:
         # the reducer the yield reads: the design without the case's errors
         red0 = build_reducer(case.reducer, with_errors=not case.reducer.errors)
         families, defaults, units = _yield_keys(case, red0, a.yield_)
-        yield_inputs(a.yield_, units, {}, defaults, families, _grade_um(case))
+        model, _ = _yield_model(case, red0, a.yield_)
+        yield_inputs(a.yield_, units, {}, defaults, families, _grade_um(case), model.quantities)
     if any(getattr(a, k) is not None for k in dyn.ANALYSES):
         dyn.preflight_dynamics(case, build_reducer(case.reducer))
+    if a.tooth_contact is not None:  # the cycloid analyses run as a cycloid_stage case
+        from gearte.studies import cycloid_stage as cs
+
+        cs.preflight(build_stage_case(case))
 
 
 def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyResult:
@@ -1507,6 +1514,33 @@ def _grade_um(case: Case):
     return grade_um
 
 
+def _yield_model(case: Case, red, sec: RVYieldSection):
+    """The yield model of ``[analyses.yield]`` (:class:`RVReducerYield`, wrapped in a
+    :class:`FirstStageBacklashYield` when the first stage's backlash is added) and that wrapper
+    (or ``None``); nothing is evaluated."""
+    from gearte.runners.yield_models import RVReducerYield
+
+    model = RVReducerYield(
+        build_reducer(case.reducer),
+        positions=sec.positions,
+        te_torque=None if sec.te_torque_Nm is None else float(Nm_to_Nmm(sec.te_torque_Nm)),
+    )
+    fs_terms = first_stage_terms(case.reducer.first_stage)
+    if fs_terms is not None and sec.first_stage_backlash == "additive":
+        from gearte.runners.rv_first_stage_yield import FirstStageBacklashYield
+
+        fs_model = FirstStageBacklashYield(
+            model,
+            fs_terms["given_um"],
+            fs_terms["r_sun"],
+            float(red.ratio),
+            fs_terms["alpha"],
+            nominal_um=fs_terms["nominal_um"],
+        )
+        return fs_model, fs_model
+    return model, None
+
+
 def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
     """``[analyses.yield]``: each sample one assembled reducer (errors drawn from the
     tolerances; errors without a tolerance keep the case's values) → catalogue test, angular TE
@@ -1515,29 +1549,11 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         MODIFICATION_FAMILIES,
         RV_PIN_FAMILIES,
         RV_VECTOR_PARTS,
-        RVReducerYield,
     )
     from gearte.studies._yield import yield_analysis
 
-    model = RVReducerYield(
-        build_reducer(case.reducer),
-        positions=sec.positions,
-        te_torque=None if sec.te_torque_Nm is None else float(Nm_to_Nmm(sec.te_torque_Nm)),
-    )
+    model, fs_model = _yield_model(case, red, sec)
     families, defaults, units = _yield_keys(case, red, sec)
-    fs_terms = first_stage_terms(case.reducer.first_stage)
-    fs_model = None
-    if fs_terms is not None and sec.first_stage_backlash == "additive":
-        from gearte.runners.rv_first_stage_yield import FirstStageBacklashYield
-
-        model = fs_model = FirstStageBacklashYield(  # type: ignore[assignment]
-            model,
-            fs_terms["given_um"],
-            fs_terms["r_sun"],
-            float(red.ratio),
-            fs_terms["alpha"],
-            nominal_um=fs_terms["nominal_um"],
-        )
 
     def worst_case(errors):
         d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
@@ -1600,7 +1616,7 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         grade_um=_grade_um(case),
     )
     res.values["first_stage_backlash"] = sec.first_stage_backlash
-    if fs_terms is not None and sec.first_stage_backlash == "additive":
+    if fs_model is not None:
         res.notes.append(
             "First-stage backlash added to lost motion, backlash and hysteresis loss: "
             "min_k j_t,k / (r_sun i) per sample, j_t,k = j_k − (E_sun + E_planet,k) + "

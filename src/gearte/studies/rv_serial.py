@@ -255,6 +255,39 @@ def build_serial(case: Case):
     return design, apply_measurements(red, **kw), measured
 
 
+def _design_case(case: Case, design):
+    """The ``rv_reducer`` case whose analyses run on the serial: the design with this case's
+    analyses."""
+    a = case.analyses
+    return design.model_copy(
+        update={
+            "analyses": rv.Analyses(
+                load_sharing=a.load_sharing,
+                transmission_error=a.transmission_error,
+                catalogue=a.catalogue,
+            )
+        }
+    )
+
+
+def preflight(case: Case) -> None:
+    """The checks :func:`run` makes before any analysis (``gearte validate``,
+    :func:`gearte.studies.run_case`): the serial's reducer built from the design and the
+    measurement files (:func:`build_serial`; validating the case already built it, kept for the
+    run) and the ``rv_reducer`` pre-flight of the analyses it runs on it
+    (:func:`gearte.studies.rv_reducer.preflight`).
+
+    Raises
+    ------
+    ParameterError, MeasurementFileError
+        Naming the key or the file.
+    """
+    if case._built is None:
+        case._built = build_serial(case)
+    design = case._built[0]
+    rv.preflight(_design_case(case, design))
+
+
 def run(case: Case, options=None) -> StudyResult:
     """The serial's pin loads, TE and lost motion with its measured parts.
 
@@ -266,16 +299,7 @@ def run(case: Case, options=None) -> StudyResult:
         Passed to the ``rv_reducer`` analyses.
     """
     design, red, measured = case._built if case._built is not None else build_serial(case)
-    a = case.analyses
-    dcase = design.model_copy(
-        update={
-            "analyses": rv.Analyses(
-                load_sharing=a.load_sharing,
-                transmission_error=a.transmission_error,
-                catalogue=a.catalogue,
-            )
-        }
-    )
+    dcase = _design_case(case, design)
     res = rv.run(dcase, options, reducer=red)
     design_inputs = [
         k
