@@ -36,6 +36,7 @@ import numpy as np
 from numba import njit
 
 from gearte.errors import ConvergenceError, ParameterError
+from gearte.solvers.dense import copy_into as _copy
 from gearte.solvers.dense import solve_spd_into as _spd_solve
 from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
@@ -178,7 +179,7 @@ class BatchSolution:
     iterations: np.ndarray
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _rows_dot(idx, val, q, r):
     s = 0.0
     for w in range(idx.shape[1]):
@@ -186,7 +187,7 @@ def _rows_dot(idx, val, q, r):
     return s
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _rows_times(idx, val, x, out):
     """``out[r] = B[r]·x`` for every stored row (rows of three columns: the columns' values
     read once per run of rows on the same columns)."""
@@ -209,7 +210,7 @@ def law_limit(a0: np.ndarray, a1: np.ndarray) -> np.ndarray:
     return np.exp(np.minimum((a0 - a1) / a1, 700.0))
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _law_force(d, a0, a1, fstar, f_prev, d_prev):
     """Force ``F`` with ``δ(F) = F (a0 − a1 ln F) = d`` for an approach ``d > 0`` [N].
 
@@ -245,7 +246,7 @@ def _law_force(d, a0, a1, fstar, f_prev, d_prev):
     return F
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _law_force_start(d, coef0, coef1, fstar):
     """One-term estimate of the force at approach ``d > 0`` (``F ≈ d / (a0 − a1 ln(d/a))``)."""
     den = coef0 - coef1 * np.log(max(d / max(coef0, coef1), 1e-300))
@@ -298,7 +299,7 @@ def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, 
     return e
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _assemble_rows3(cidx, cval, F, kt, H, grad):
     """:func:`_assemble`'s contact rows where each row has three columns (a disc's x, y and
     rotation): consecutive rows on the same columns are summed in registers and added to ``H``
@@ -330,7 +331,7 @@ def _assemble_rows3(cidx, cval, F, kt, H, grad):
         _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad)
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad):
     """Add a symmetric 3 × 3 block and its gradient on columns (i0, i1, i2) (repeated columns,
     the padding of :func:`sparse_rows`, carry zero entries and add nothing)."""
@@ -348,7 +349,7 @@ def _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad):
     H[i2, i1] += h12
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, F, kt, q, H, grad):
     """Gradient ``K0 q − f0 + Σ F_c B_c + bearings`` and Hessian ``K0 + Σ kt_c B_c B_cᵀ +
     bearings + reg I`` at ``q`` — the one contact-row assembly of every Newton variant here
@@ -417,9 +418,9 @@ def _newton(
                  dn, ktn)  # fmt: skip
     if not np.isfinite(e0):
         return 0, False
-    F[:] = Fn
-    d[:] = dn
-    kt[:] = ktn
+    _copy(Fn, F)
+    _copy(dn, d)
+    _copy(ktn, kt)
     for it in range(maxit):
         _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, F, kt, q, H, grad)
         _spd_solve(H, grad, L, dq)
@@ -446,10 +447,10 @@ def _newton(
         for c in range(nc):
             if (dn[c] > 0.0) != (d[c] > 0.0):
                 same = False
-        q[:] = qn
-        F[:] = Fn
-        d[:] = dn
-        kt[:] = ktn
+        _copy(qn, q)
+        _copy(Fn, F)
+        _copy(dn, d)
+        _copy(ktn, kt)
         e0 = e1
         big = 0.0
         for a in range(nd):
@@ -576,24 +577,27 @@ def _position(
     for a in range(q.size):
         qmax = max(qmax, abs(q[a]))
     qtol = 1e-13 * qmax
+    # the law flag of _newton as a run-time bool: a constant True/False argument would make
+    # numba compile _newton (and _energy) once per literal value (docs/numba.md)
+    secant = exact and not exact
     if law == LAW_SECANT_PER_CONTACT and exact:
-        w.q0[:] = q
-        w.F0[:] = force
-        w.d0[:] = approach
+        _copy(q, w.q0)
+        _copy(force, w.F0)
+        _copy(approach, w.d0)
         its, ok = _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q,
                                 force, approach, kt, w, 30)  # fmt: skip
         if not ok:
-            q[:] = w.q0
-            force[:] = w.F0
-            approach[:] = w.d0
-            more, ok = _newton(True, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef,
+            _copy(w.q0, q)
+            _copy(w.F0, force)
+            _copy(w.d0, approach)
+            more, ok = _newton(exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef,
                                kc, q, force, approach, kt, w, qtol, maxit)  # fmt: skip
             its += more
         if ok:
             return its, True
-        q[:] = w.q0
-        force[:] = w.F0
-        approach[:] = w.d0
+        _copy(w.q0, q)
+        _copy(w.F0, force)
+        _copy(w.d0, approach)
         for c in range(nc):  # the secant stiffness of the start as the fixed point's start
             if force[c] > 0.0 and approach[c] > 0.0:
                 kc[c] = force[c] / approach[c]
@@ -602,7 +606,7 @@ def _position(
             kc[c] = k[group[c]]
     total = 0
     for _outer in range(200):
-        its, ok = _newton(False, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc,
+        its, ok = _newton(secant, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc,
                           q, force, approach, kt, w, qtol, maxit)  # fmt: skip
         total += its
         if not ok:
@@ -687,11 +691,11 @@ def _solve_batch(
                 w.k[:] = kstart
                 w.kc[:] = kstart
             else:
-                q[:] = Q[u]
-                w.force[:] = FF[u]
-                w.approach[:] = DD[u]
-                w.k[:] = KG[u]
-                w.kc[:] = KC[u]
+                _copy(Q[u], q)
+                _copy(FF[u], w.force)
+                _copy(DD[u], w.approach)
+                _copy(KG[u], w.k)
+                _copy(KC[u], w.kc)
             for a in range(nd):
                 f0[a] = T * us[g, a] - Hs[s, g, a]
             its, ok = _position(
@@ -702,17 +706,17 @@ def _solve_batch(
                 iters[s, t] = -1
                 break
             iters[s, t] = its
-            Q[t] = q
-            FF[t] = w.force
-            DD[t] = w.approach
-            KG[t] = w.k
-            KC[t] = w.kc
+            _copy(q, Q[t])
+            _copy(w.force, FF[t])
+            _copy(w.approach, DD[t])
+            _copy(w.k, KG[t])
+            _copy(w.kc, KC[t])
             r = T * out_u[g] - out_h[s, g]
             for a in range(nd):
                 r += out_q[g, a] * q[a]
             rot[s, t] = r
             if rec[t] >= 0:
-                forces[s, rec[t]] = w.force
+                _copy(w.force, forces[s, rec[t]])
     return rot, forces, iters
 
 
@@ -916,8 +920,8 @@ def solve_batch(
 
 _KERNELS = ("_solve_batch", "_position", "_newton", "_newton_mixed", "_energy", "_assemble",
             "_assemble_rows3", "_add_block3", "_rows_times",
-            "_spd_solve", "_rows_dot", "_law_force", "_law_force_start", "_work", "_bearing_terms",
-            "_law_delta")  # fmt: skip
+            "_spd_solve", "_copy", "_rows_dot", "_law_force", "_law_force_start", "_work",
+            "_bearing_terms", "_law_delta")  # fmt: skip
 
 
 def _twin(kernel):
