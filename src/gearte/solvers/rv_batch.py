@@ -404,7 +404,7 @@ def _newton(
     ``exact=False``: fixed contact stiffnesses ``kc`` — :func:`gearte.solvers.rv_equilibrium.
     _newton` on sparse rows (same steps and tests). ``exact=True``: the exact load-dependent
     pin law (tangent ``1/δ'(F)``): the fixed point of the per-contact secant iteration of
-    :func:`gearte.solvers.rv_equilibrium._solve_position` is the root of this Π's gradient, and
+    :func:`gearte.solvers.rv_equilibrium._solve_all` is the root of this Π's gradient, and
     Newton reaches it quadratically. On entry ``F``, ``d`` hold warm (force, approach) pairs of
     the law (exact only); on return ``q`` the minimiser and ``F``, ``d``, ``kt`` its forces,
     approaches and tangents. ``w``: the work arrays (:func:`_work`). Returns (iterations, ok).
@@ -561,7 +561,7 @@ def _position(
     K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, group, ngroups, law, coef, q, w, tol,
     maxit, exact,
 ):  # fmt: skip
-    """:func:`gearte.solvers.rv_equilibrium._solve_position` on sparse rows, in place.
+    """:func:`gearte.solvers.rv_equilibrium._solve_all` on sparse rows, in place.
 
     State in ``q`` (displacements) and the work arrays ``w``: ``w.k`` (per disc) and ``w.kc``
     (per contact) stiffnesses, ``w.force`` and ``w.approach`` (the last solution's contact
