@@ -221,6 +221,27 @@ def test_kernel_reduction_equals_numpy_twin():
     np.testing.assert_allclose(r.percentiles[50.0], np.percentile(y, 50), atol=16 * st.sd / 50)
 
 
+def test_kernel_spec_counts_exact_when_the_limits_fall_inside_populated_bins():
+    """The kernel counts out-of-spec samples from the histogram (bins are monotone in y) and
+    compares y with the limit only in the limit's own bin: with the limits on sample values
+    (so that bin is populated, one sample sits exactly on each limit) the counts, extremes and
+    histogram equal the numpy twin's, and the pairwise block sums its sums to rounding."""
+    from gearte.execution import spawn_seeds
+
+    st = spur_pair().backlash_stack()
+    n = 3 * 1024 + 77  # full blocks and a partial one
+    y = kernel_samples(st, spawn_seeds(5, 1)[0], n)
+    lsl, usl = float(np.sort(y)[40]), float(np.sort(y)[-300])
+    r = monte_carlo(st, n, seed=5, chunk_size=n, nbins=64, lower_spec=lsl, upper_spec=usl)
+    lo, hi = st.mean - 8 * st.sd, st.mean + 8 * st.sd
+    twin = reduce_samples(y, shift=st.mean, lo=lo, hi=hi, nbins=64, lsl=lsl, usl=usl, keep=0)
+    assert (r.below_fraction * n, r.above_fraction * n) == (twin.below, twin.above) == (40, 299)
+    np.testing.assert_array_equal(r.hist_counts, twin.counts)
+    assert (r.min, r.max) == (twin.min, twin.max)
+    assert r.mean == pytest.approx(st.mean + twin.s1 / n, rel=1e-13)
+    assert r.sd == pytest.approx(math.sqrt((twin.s2 - twin.s1**2 / n) / (n - 1)), rel=1e-12)
+
+
 def _polar(stack):
     cs = [
         Contributor(c.name, RadialPhase(c.distribution.magnitude, polar=True), c.sensitivity)

@@ -15,8 +15,9 @@ contributors form one Gaussian group: their sum is drawn as *one* normal per sam
 sum of independent normals is normal with the summed mean and variance); the others are drawn
 one by one. Its plain reference, :func:`linear_stack_reference`, is a per-sample Python loop
 drawing the same numbers in the same order: the two give bit-identical samples (tested).
-(Issue 12 changed the samples of a seed twice — once when the normals were grouped, once when
-the kernel got its own generator; the distribution did not change.) Per-contributor values
+(Issue 12 changed the samples of a seed three times — when the normals were grouped, when the
+kernel got its own generator and when its main stream became 16 interleaved ones; the
+distribution did not change.) Per-contributor values
 (contributions, variance shares) come from :mod:`gearte.tolerance.stackup`, not from these
 samples. Everything else (function stacks, truncated distributions) runs vectorised in numpy
 (``numpy.random.default_rng`` of the chunk's seed), contributor by contributor, chunk by chunk.
@@ -35,14 +36,17 @@ from numba import njit, uint64
 from gearte.errors import ParameterError
 from gearte.execution import spawn_seeds
 from gearte.tolerance.rng import (
+    DRAWS,
+    LANES,
+    TAIL,
     Xoshiro256pp,
     ZigguratTables,
+    lane_states,
     next_u64,
+    normals_block,
     reference_normal,
     stream_states,
     u64_to_unit,
-    zig_fast,
-    zig_slow,
     ziggurat_tables,
 )
 from gearte.tolerance.stackup import FunctionStack, LinearStack
@@ -65,11 +69,12 @@ DEFAULT_BINS = 4000
 # ------------------------------------------------------------------------------------------------
 # compiled kernel
 # ------------------------------------------------------------------------------------------------
-# Streams (gearte.tolerance.rng): 0 main — one 64-bit number per sample for the Gaussian group's
-# normal; 1 tail — the ziggurat's rejections; 2 draws — the other contributors, in order. Each
-# sample takes exactly one main number, so the kernel draws them in blocks of _BLOCK and the
-# samples do not depend on the block size. Codes: see distributions.KERNEL_CODES.
-_BLOCK = 1024  # a multiple of 4 (the reduction runs four lanes)
+# Streams (gearte.tolerance.rng): rows 0 … LANES−1 main — one 64-bit number per sample for the
+# Gaussian group's normal, sample j from main stream j % LANES; TAIL — the ziggurat's rejections;
+# DRAWS — the other contributors, in order. Each sample takes exactly one main number, so the
+# kernel draws them in blocks of _BLOCK and the samples do not depend on the block size. Codes:
+# see distributions.KERNEL_CODES.
+_BLOCK = 1024  # a power of two (the pairwise sums) and a multiple of LANES
 
 
 def _group(codes: np.ndarray, params: np.ndarray, sens: np.ndarray) -> tuple[float, float, bool]:
@@ -115,42 +120,25 @@ def _draw_other(code, p0, p1, d0, d1, d2, d3, pool):  # pragma: no cover - compi
     return p0, d0, d1, d2, d3  # constant
 
 
-@njit(cache=True, nogil=True)
+@njit(inline="always")
 def _fill_block(
-    z, m, raw, rej, st, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
+    z, m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
 ):  # pragma: no cover - compiled
-    """``z[:m]`` <- the next ``m`` samples of the stack; the stream states ``st`` advance.
+    """``z[:m]`` <- the next ``m`` samples of the stack; the stream states advance.
 
-    Per sample: the Gaussian group's normal from one main number (ziggurat; rejections from the
-    tail stream), ``y = base + gsd·z``, then each other contributor in order from the draws
-    stream (the order of :func:`linear_stack_reference`). The ziggurat's fast path runs over the
-    whole block first and lists the ≈ 1.2 % rejected draws, which are then redrawn in sample
-    order (the tail stream is read in the same order as one sample at a time)."""
+    Per sample: the Gaussian group's normal (:func:`gearte.tolerance.rng.normals_block`: one
+    number of main stream ``j % LANES``, rejections from the tail stream), ``y = base + gsd·z``,
+    then each other contributor in order from the draws stream (the order of
+    :func:`linear_stack_reference`)."""
     if group:
-        s0, s1, s2, s3 = st[0, 0], st[0, 1], st[0, 2], st[0, 3]
-        for j in range(m):
-            r, s0, s1, s2, s3 = next_u64(s0, s1, s2, s3)
-            raw[j] = r
-        st[0, 0], st[0, 1], st[0, 2], st[0, 3] = s0, s1, s2, s3
-        nr = 0
-        for j in range(m):  # fast path, branch-free: the rejected ones are listed
-            x, ok, idx, v = zig_fast(raw[j], tk, tw)
-            z[j] = x
-            rej[nr] = j
-            nr += not ok
-        t0, t1, t2, t3 = st[1, 0], st[1, 1], st[1, 2], st[1, 3]
-        for i in range(nr):
-            j = rej[i]
-            x, ok, idx, v = zig_fast(raw[j], tk, tw)
-            z[j], t0, t1, t2, t3 = zig_slow(x, idx, v, t0, t1, t2, t3, tk, tw, tf)
-        st[1, 0], st[1, 1], st[1, 2], st[1, 3] = t0, t1, t2, t3
+        normals_block(z, m, raw, rej, lanes, st, tk, tw, tf)
         for j in range(m):
             z[j] = base + gsd * z[j]
     else:
         for j in range(m):
             z[j] = base
     if others.shape[0]:
-        d0, d1, d2, d3 = st[2, 0], st[2, 1], st[2, 2], st[2, 3]
+        d0, d1, d2, d3 = st[DRAWS, 0], st[DRAWS, 1], st[DRAWS, 2], st[DRAWS, 3]
         for j in range(m):
             y = z[j]
             for i in others:
@@ -159,28 +147,58 @@ def _fill_block(
                 )
                 y += sens[i] * v
             z[j] = y
-        st[2, 0], st[2, 1], st[2, 2], st[2, 3] = d0, d1, d2, d3
+        st[DRAWS, 0], st[DRAWS, 1], st[DRAWS, 2], st[DRAWS, 3] = d0, d1, d2, d3
+
+
+# The histogram bin of y is floor(clamp((y − lo)/width, −1, nbins)) + 1 (0 the underflow, nbins + 1
+# the overflow), the formula of reduce_samples. Adding 2⁵² to that small integer puts it, exactly,
+# in the low bits of the double: the bin loop stays in floating point (vectorised) and the
+# histogram loop reads the index from the bits.
+_BIN_OFFSET = 1.0 + 2.0**52
+_BIN_MASK = uint64(0xFFFFFFFF)
+
+
+@njit(inline="always")
+def _bin_index(y, lo, inv_width, top):  # pragma: no cover - compiled
+    t = (y - lo) * inv_width
+    t = t if t > -1.0 else -1.0
+    t = t if t < top else top
+    return uint64(int(math.floor(t)) + 1)
 
 
 @njit(cache=True, nogil=True)
 def _linear_stack_kernel(
-    states, n, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool,
+    states, lanes0, n, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool,
     shift, lo, hi, nbins, lsl, usl, keep,
 ):  # pragma: no cover - compiled  # fmt: skip
-    """Draw ``n`` samples block by block and reduce each block on the spot: sums of
-    ``y − shift`` and of its square (four lanes), extremes, spec counts, histogram; the first
-    ``keep`` samples kept. No sample array beyond one block."""
+    """Draw ``n`` samples block by block and reduce each block on the spot; the first ``keep``
+    samples kept. No sample array beyond one block.
+
+    Per full block of ``_BLOCK`` samples, the sums of ``y − shift`` and of its square and the
+    extremes by a fixed pairwise tree (elementwise loops LLVM runs on vector registers; the
+    tree depends on nothing but the block, so neither do the sums); a chunk's last, partial
+    block in order. The histogram bin (the formula of :func:`reduce_samples`) in a vector
+    loop, then the counts; out-of-spec counts from the histogram — bins are monotone in ``y``,
+    so only the samples in a limit's own bin are compared with it."""
     st = states.copy()
+    lanes = lanes0.copy()
     counts = np.zeros(nbins + 2, np.int64)
     kept = np.empty(min(keep, n))
     z = np.empty(_BLOCK)
     raw = np.empty(_BLOCK, np.uint64)
     rej = np.empty(_BLOCK, np.int64)
-    bins = np.empty(_BLOCK, np.int64)
+    fbin = np.empty(_BLOCK)
+    ibin = fbin.view(np.uint64)
     inv_width = nbins / (hi - lo)
     top = float(nbins)
-    a0 = a1 = a2 = a3 = 0.0
-    b0 = b1 = b2 = b3 = 0.0
+    klsl = _bin_index(lsl, lo, inv_width, top)
+    kusl = _bin_index(usl, lo, inv_width, top)
+    e1 = np.empty(_BLOCK // 2)
+    e2 = np.empty(_BLOCK // 2)
+    emn = np.empty(_BLOCK // 2)
+    emx = np.empty(_BLOCK // 2)
+    s1 = 0.0
+    s2 = 0.0
     mn = np.inf
     mx = -np.inf
     below = 0
@@ -189,73 +207,76 @@ def _linear_stack_kernel(
     while done < n:
         m = min(_BLOCK, n - done)
         _fill_block(
-            z, m, raw, rej, st, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
-        )
+            z, m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params, codes,
+            sens, pool,
+        )  # fmt: skip
         for j in range(min(m, keep - done)):
             kept[done + j] = z[j]
-        for j in range(0, m - 3, 4):  # four lanes: independent adds the CPU overlaps
-            d0 = z[j] - shift
-            d1 = z[j + 1] - shift
-            d2 = z[j + 2] - shift
-            d3 = z[j + 3] - shift
-            a0 += d0
-            a1 += d1
-            a2 += d2
-            a3 += d3
-            b0 += d0 * d0
-            b1 += d1 * d1
-            b2 += d2 * d2
-            b3 += d3 * d3
-        for j in range(m - m % 4, m):
-            d0 = z[j] - shift
-            a0 += d0
-            b0 += d0 * d0
+        if m == _BLOCK:  # pairwise (a fixed tree): elementwise loops, vector registers
+            h = _BLOCK // 2
+            for j in range(h):
+                u = z[j]
+                v = z[j + h]
+                d0 = u - shift
+                d1 = v - shift
+                e1[j] = d0 + d1
+                e2[j] = d0 * d0 + d1 * d1
+                emn[j] = u if u < v else v
+                emx[j] = u if u > v else v
+            while h > 1:
+                h //= 2
+                for j in range(h):
+                    e1[j] += e1[j + h]
+                    e2[j] += e2[j + h]
+                    emn[j] = emn[j] if emn[j] < emn[j + h] else emn[j + h]
+                    emx[j] = emx[j] if emx[j] > emx[j + h] else emx[j + h]
+            s1 += e1[0]
+            s2 += e2[0]
+            mn = emn[0] if emn[0] < mn else mn
+            mx = emx[0] if emx[0] > mx else mx
+        else:  # the chunk's last, partial block: in order
+            for j in range(m):
+                y = z[j]
+                d0 = y - shift
+                s1 += d0
+                s2 += d0 * d0
+                mn = y if y < mn else mn
+                mx = y if y > mx else mx
+        for j in range(m):  # bin + 1 as the low bits of a double (no branch: vector registers)
+            t = (z[j] - lo) * inv_width
+            t = t if t > -1.0 else -1.0
+            t = t if t < top else top
+            fbin[j] = math.floor(t) + _BIN_OFFSET
         for j in range(m):
-            y = z[j]
-            mn = y if y < mn else mn
-            mx = y if y > mx else mx
-            below += y < lsl
-            above += y > usl
-            t = min(max((y - lo) * inv_width, -1.0), top)
-            bins[j] = int(math.floor(t)) + 1  # 0 underflow, nbins + 1 overflow
-        for j in range(m):
-            counts[bins[j]] += 1
+            k = ibin[j] & _BIN_MASK  # 0 underflow, nbins + 1 overflow
+            counts[k] += 1
+            if k == klsl:  # the one bin where the spec limit decides
+                below += z[j] < lsl
+            if k == kusl:
+                above += z[j] > usl
         done += m
-    s1 = (a0 + a1) + (a2 + a3)
-    s2 = (b0 + b1) + (b2 + b3)
+    for k in range(klsl):  # bins are monotone in y: every sample of a lower bin is below
+        below += counts[k]
+    for k in range(kusl + 1, nbins + 2):
+        above += counts[k]
     return s1, s2, mn, mx, below, above, counts, kept
 
 
 @njit(cache=True, nogil=True)
 def _linear_stack_samples(
-    states, n, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
+    states, lanes0, n, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
 ):  # pragma: no cover - compiled
     st = states.copy()
+    lanes = lanes0.copy()
     out = np.empty(n)
     raw = np.empty(_BLOCK, np.uint64)
     rej = np.empty(_BLOCK, np.int64)
-    done = 0
-    while done < n:
+    for done in range(0, n, _BLOCK):
         m = min(_BLOCK, n - done)
         _fill_block(
-            out[done:],
-            m,
-            raw,
-            rej,
-            st,
-            tk,
-            tw,
-            tf,
-            group,
-            base,
-            gsd,
-            others,
-            params,
-            codes,
-            sens,
-            pool,
-        )
-        done += m
+            out[done:], m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params,
+            codes, sens, pool,
+        )  # fmt: skip
     return out
 
 
@@ -338,11 +359,13 @@ def linear_stack_reference(
                 y += c.sensitivity * c.distribution.draw_one(rng)
             out[j] = y
         return out
-    main, tail, draws = (Xoshiro256pp(row) for row in stream_states(seed))
+    states = stream_states(seed)
+    mains = [Xoshiro256pp(row) for row in states[:LANES]]
+    tail, draws = Xoshiro256pp(states[TAIL]), Xoshiro256pp(states[DRAWS])
     for j in range(n):
         y = ki.base
         if ki.group:
-            y = ki.base + ki.gsd * reference_normal(main, tail, ki.tables)
+            y = ki.base + ki.gsd * reference_normal(mains[j % LANES], tail, ki.tables)
         for i in ki.others:
             y += float(ki.sens[i]) * _draw_other_ref(int(ki.codes[i]), ki.params[i], draws, ki.pool)
         out[j] = y
@@ -355,7 +378,8 @@ def kernel_samples(stack: LinearStack, seed: int | np.random.SeedSequence, n: in
     ki = _KernelInput.of(stack)
     if ki is None:
         raise ParameterError("stack", stack.name, "has contributors the kernel cannot draw")
-    return _linear_stack_samples(stream_states(seed), int(n), *ki.args())
+    st = stream_states(seed)
+    return _linear_stack_samples(st, lane_states(st), int(n), *ki.args())
 
 
 # ------------------------------------------------------------------------------------------------
@@ -541,7 +565,8 @@ class _ChunkRunner:
         kw = dict(shift=self.shift, lo=self.lo, hi=self.hi, nbins=self.nbins)
         if self.kernel is not None:
             reduction = (self.shift, self.lo, self.hi, self.nbins, self.lsl, self.usl, task.keep)
-            args = (stream_states(task.seed), task.n, *self.kernel.args(), *reduction)
+            st = stream_states(task.seed)
+            args = (st, lane_states(st), task.n, *self.kernel.args(), *reduction)
             out = _linear_stack_kernel(*args)
             return ChunkStats(task.n, *out)
         rng = np.random.default_rng(task.seed)

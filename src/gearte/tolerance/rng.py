@@ -8,7 +8,11 @@ in registers inside the kernel.
 * **Generator**: xoshiro256++ (Blackman & Vigna 2021), 256 bits of state, period 2²⁵⁶ − 1,
   64-bit outputs that pass BigCrush and PractRand. Each chunk of a Monte-Carlo run seeds its
   streams from its own ``SeedSequence`` child (:func:`stream_states`), so a seed gives the same
-  numbers whatever the backend or the number of workers.
+  numbers whatever the backend or the number of workers. The normals' main numbers come from
+  ``LANES`` = 16 streams stepped side by side (sample ``j`` of a chunk from main stream
+  ``j % 16``): one xoshiro step has a chain of dependent shifts and xors, and sixteen
+  independent ones fill the CPU's vector registers (0.42 against 1.0 ns of CPU per number
+  in a micro-benchmark on the 2-core development machine).
 * **Uniform** ``[0, 1)``: the top 53 bits of an output times 2⁻⁵³ (every double of the form
   ``k·2⁻⁵³``).
 * **Standard normal**: the ziggurat of Marsaglia & Tsang (2000) with 256 layers, the layout of
@@ -17,13 +21,13 @@ in registers inside the kernel.
   ``|v| < k_i`` (≈ 98.8 % of draws, no transcendental function). Rejected draws go to the wedge
   test or, in the base layer, to Marsaglia's exact tail method beyond ``r = 3.6541528853610088``,
   drawing from a second stream (the *tail* stream): so every sample takes exactly one number of
-  the main stream, which lets the kernel draw the main numbers in blocks.
+  its main stream, which lets the kernel draw the main numbers in blocks.
 
 Exactness: the ziggurat is an exact rejection method (up to the 2⁻⁵² resolution of ``v``); the
 tests check the moments, a Kolmogorov–Smirnov test against the normal CDF and the tail masses.
 
-:class:`Xoshiro256pp` and :func:`reference_normal` are the plain Python twins (Python integers):
-they give bit-identical numbers (tested).
+:class:`Xoshiro256pp`, :func:`reference_normal` and :func:`reference_normals` are the plain
+Python twins (Python integers, one sample at a time): they give bit-identical numbers (tested).
 
 References
 ----------
@@ -49,11 +53,24 @@ __all__ = [
     "Xoshiro256pp",
     "reference_normal",
     "STREAMS",
+    "LANES",
+    "TAIL",
+    "DRAWS",
+    "lane_states",
+    "normals_block",
+    "reference_normals",
 ]
 
-#: Streams per chunk: 0 main (one number per sample), 1 tail (ziggurat rejections),
-#: 2 draws (contributors other than the Gaussian group).
-STREAMS = 3
+#: Interleaved main streams: sample ``j`` of a chunk takes its main number from main stream
+#: ``j % LANES`` (the compiled kernel steps the ``LANES`` generators side by side, in SIMD
+#: registers).
+LANES = 16
+#: Row of the tail stream (the ziggurat's rejections) in :func:`stream_states`.
+TAIL = LANES
+#: Row of the draws stream (contributors other than the Gaussian group).
+DRAWS = LANES + 1
+#: Streams per chunk: rows ``0 … LANES−1`` main, then tail, then draws.
+STREAMS = LANES + 2
 _MASK = (1 << 64) - 1
 ZIG_R = 3.6541528853610088  # right edge of the last layer, Marsaglia & Tsang (2000)
 ZIG_V = 0.00492867323399  # area of each layer
@@ -179,17 +196,67 @@ def zig_slow(x, idx, v, t0, t1, t2, t3, k, w, f):  # pragma: no cover - compiled
             return x, t0, t1, t2, t3
 
 
+def lane_states(states: np.ndarray) -> np.ndarray:
+    """The main streams' states of a chunk as ``(4, LANES)`` uint64, one row per state word
+    (the layout the SIMD step reads), from the rows ``0 … LANES−1`` of ``states``."""
+    return np.ascontiguousarray(states[:LANES].T)
+
+
+@njit(inline="always")
+def fill_u64(raw, m, lanes):  # pragma: no cover - compiled
+    """``raw[:m]`` <- the next numbers of the ``LANES`` main streams, interleaved (``raw[j]``
+    from stream ``j % LANES``); ``m`` is rounded up to a multiple of ``LANES`` (``raw`` must
+    hold it). ``lanes`` (4, LANES) advances. The inner loop over the lanes has a fixed trip
+    count and no dependency between lanes: LLVM runs it on vector registers."""
+    a = lanes[0]
+    b = lanes[1]
+    c = lanes[2]
+    d = lanes[3]
+    for g in range((m + LANES - 1) // LANES):
+        j = g * LANES
+        for i in range(LANES):
+            r, a[i], b[i], c[i], d[i] = next_u64(a[i], b[i], c[i], d[i])
+            raw[j + i] = r
+
+
+@njit(inline="always")
+def normals_block(z, m, raw, rej, lanes, st, k, w, f):  # pragma: no cover - compiled
+    """``z[:m]`` <- the next ``m`` standard normals of a chunk.
+
+    Main numbers from the interleaved main streams (``lanes``, advanced), the ziggurat's fast
+    path over the whole block (branch-free: it lists the ≈ 1.2 % rejected draws), then the
+    rejected ones redrawn in sample order from the tail stream ``st[TAIL]`` (advanced), so the
+    tail stream is read as it would be one sample at a time. ``raw`` and ``rej`` are work
+    arrays of ``m`` rounded up to ``LANES``."""
+    fill_u64(raw, m, lanes)
+    nr = 0
+    for j in range(m):
+        x, ok, idx, v = zig_fast(raw[j], k, w)
+        z[j] = x
+        rej[nr] = j
+        nr += not ok
+    if nr:
+        t0, t1, t2, t3 = st[TAIL, 0], st[TAIL, 1], st[TAIL, 2], st[TAIL, 3]
+        for i in range(nr):
+            j = rej[i]
+            x, ok, idx, v = zig_fast(raw[j], k, w)
+            z[j], t0, t1, t2, t3 = zig_slow(x, idx, v, t0, t1, t2, t3, k, w, f)
+        st[TAIL, 0], st[TAIL, 1], st[TAIL, 2], st[TAIL, 3] = t0, t1, t2, t3
+
+
+_NBLOCK = 1024  # a multiple of LANES
+
+
 @njit(cache=True, nogil=True)
-def _standard_normals(st, n, k, w, f):  # pragma: no cover - compiled
-    s0, s1, s2, s3 = st[0, 0], st[0, 1], st[0, 2], st[0, 3]
-    t0, t1, t2, t3 = st[1, 0], st[1, 1], st[1, 2], st[1, 3]
+def _standard_normals(states, lanes0, n, k, w, f):  # pragma: no cover - compiled
+    st = states.copy()
+    lanes = lanes0.copy()
     out = np.empty(n)
-    for j in range(n):
-        r, s0, s1, s2, s3 = next_u64(s0, s1, s2, s3)
-        x, ok, idx, v = zig_fast(r, k, w)
-        if not ok:
-            x, t0, t1, t2, t3 = zig_slow(x, idx, v, t0, t1, t2, t3, k, w, f)
-        out[j] = x
+    raw = np.empty(_NBLOCK, np.uint64)
+    rej = np.empty(_NBLOCK, np.int64)
+    for s in range(0, n, _NBLOCK):
+        m = min(_NBLOCK, n - s)
+        normals_block(out[s:], m, raw, rej, lanes, st, k, w, f)
     return out
 
 
@@ -207,7 +274,8 @@ def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
         How many numbers [-].
     """
     t = ziggurat_tables()
-    return _standard_normals(stream_states(seed), int(n), t.k, t.w, t.f)
+    st = stream_states(seed)
+    return _standard_normals(st, lane_states(st), int(n), t.k, t.w, t.f)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -249,6 +317,16 @@ def _fast_ref(r: int, t: ZigguratTables) -> tuple[float, bool, int, int]:
     v = (r - (1 << 64) if r >> 63 else r) >> 11
     x = float(v) * float(t.w[idx])
     return x, abs(v) < int(t.k[idx]), idx, v
+
+
+def reference_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
+    """Plain twin of :func:`standard_normals`: sample ``j`` from main stream ``j % LANES``
+    (:func:`reference_normal`), rejections from the tail stream, one sample at a time."""
+    st = stream_states(seed)
+    mains = [Xoshiro256pp(row) for row in st[:LANES]]
+    tail = Xoshiro256pp(st[TAIL])
+    t = ziggurat_tables()
+    return np.array([reference_normal(mains[j % LANES], tail, t) for j in range(n)])
 
 
 def reference_normal(
