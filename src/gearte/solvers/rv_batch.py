@@ -946,11 +946,13 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
         np.ascontiguousarray(p.bearing_c, dtype=float), p.group.astype(np.int64), p.ngroups,
         int(p.law), coef3, float(p.start_stiffness), np.ascontiguousarray(hc),
         np.ascontiguousarray(en, dtype=float), np.ascontiguousarray(gap, dtype=float),
-        np.asarray(step_g, dtype=np.int64), np.asarray(step_T, dtype=float), start, rec,
+        np.asarray(step_g, dtype=np.int64), np.array(step_T, dtype=float), start, rec,
         int((rec >= 0).sum()), np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
         np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact), gq,
         np.zeros((K, nc)), np.zeros((K, nc)), gkg, gkc, given,
     )  # fmt: skip
+    # step_T a fresh C array: solve_system passes a read-only broadcast ('A' layout), the yield
+    # a contiguous one; each compiled _solve_batch again (~7 s CPU, gear_chain's first run)
     if compiled:
         return _solve_batch(*args)
     with _TWIN_LOCK:
