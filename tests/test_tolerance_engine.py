@@ -221,11 +221,11 @@ def test_kernel_reduction_equals_numpy_twin():
     np.testing.assert_allclose(r.percentiles[50.0], np.percentile(y, 50), atol=16 * st.sd / 50)
 
 
-def test_kernel_spec_counts_exact_when_the_limits_fall_inside_populated_bins():
-    """The kernel counts out-of-spec samples from the histogram (bins are monotone in y) and
-    compares y with the limit only in the limit's own bin: with the limits on sample values
-    (so that bin is populated, one sample sits exactly on each limit) the counts, extremes and
-    histogram equal the numpy twin's, and the pairwise block sums its sums to rounding."""
+def test_kernel_reduction_exact_with_limits_on_sample_values():
+    """The kernel's vectorised reduction against the numpy twin with the spec limits on sample
+    values (one sample sits exactly on each limit and must count as in spec): out-of-spec
+    counts, extremes and histogram equal, the pairwise block sums to rounding; full blocks and
+    a partial one."""
     from gearte.execution import spawn_seeds
 
     st = spur_pair().backlash_stack()
