@@ -156,6 +156,7 @@ def _fill_block(
 # histogram loop reads the index from the bits.
 _BIN_OFFSET = 1.0 + 2.0**52
 _BIN_MASK = uint64(0xFFFFFFFF)
+_FLUSH = 1 << 30  # samples between additions of the int32 counts into the int64 ones
 
 
 @njit(cache=True, nogil=True)
@@ -175,12 +176,13 @@ def _linear_stack_kernel(
     st = states.copy()
     lanes = lanes0.copy()
     counts = np.zeros(nbins + 2, np.int64)
+    c32 = np.zeros(nbins + 2, np.int32)  # half the cache lines of int64; added in every 2³⁰
     kept = np.empty(min(keep, n))
     z = np.empty(_BLOCK)
     raw = np.empty(_BLOCK, np.uint64)
     rej = np.empty(_BLOCK, np.int64)
-    fbin = np.empty(_BLOCK)
-    ibin = fbin.view(np.uint64)
+    fbin = raw.view(np.float64)  # raw is free once the block's normals are drawn
+    ibin = raw
     inv_width = nbins / (hi - lo)
     top = float(nbins)
     specs = lsl > -np.inf or usl < np.inf
@@ -195,7 +197,12 @@ def _linear_stack_kernel(
     below = 0
     above = 0
     done = 0
+    added = 0
     while done < n:
+        if done - added >= _FLUSH:
+            counts += c32
+            c32[:] = 0
+            added = done
         m = min(_BLOCK, n - done)
         _fill_block(
             z, m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params, codes,
@@ -239,12 +246,13 @@ def _linear_stack_kernel(
             t = t if t < top else top
             fbin[j] = math.floor(t) + _BIN_OFFSET
         for j in range(m):
-            counts[ibin[j] & _BIN_MASK] += 1  # 0 underflow, nbins + 1 overflow
+            c32[ibin[j] & _BIN_MASK] += 1  # 0 underflow, nbins + 1 overflow
         if specs:  # integer sums of comparisons: vector registers
             for j in range(m):
                 below += z[j] < lsl
                 above += z[j] > usl
         done += m
+    counts += c32
     return s1, s2, mn, mx, below, above, counts, kept
 
 
