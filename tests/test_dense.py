@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from gearte.solvers.dense import dot, matvec_into, max_abs, solve_lu_into, solve_spd_into
+from gearte.solvers.dense import copy_into, dot, matvec_into, max_abs, solve_lu_into, solve_spd_into
 
 
 @pytest.mark.parametrize("compiled", [True, False])
@@ -26,6 +26,8 @@ def test_dense_kernels_match_numpy(compiled):
     assert f(dot)(A[0], b) == pytest.approx(float(A[0] @ b), rel=1e-13)
     assert f(max_abs)(b) == np.max(np.abs(b))
     assert np.isnan(f(max_abs)(np.array([1.0, np.nan, 2.0])))
+    f(copy_into)(A[2], out)  # a row of a 2-D array into a 1-D one
+    np.testing.assert_array_equal(out, A[2])
 
 
 def test_solve_spd_falls_back_to_pivoting_on_an_indefinite_matrix():

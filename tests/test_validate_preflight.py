@@ -274,3 +274,17 @@ def test_yield_model_whose_quantities_differ_from_its_outputs_is_a_bug():
     ts = ToleranceSet((Tolerance("x", "normal", 1.0),), ())
     with pytest.raises(RuntimeError, match="quantities"):
         run_yield(Wrong(), ts, [], 4, seed=1)
+
+
+def test_rv_tooth_contact_deformation_beyond_the_elastic_range_is_refused_by_validate(tmp_path):
+    """The reducer's cycloid analyses run as a cycloid_stage case: its pre-flight too."""
+    p = _mutant(
+        tmp_path,
+        "hu2020_rv80e_initial_reducer",
+        "youngs_modulus_MPa = 2.06e5",
+        "youngs_modulus_MPa = 0.12",
+    )
+    v, r = _validate_and_run(p, tmp_path)
+    assert v == r
+    assert v.startswith("analyses.tooth_contact.torque_Nm = ")
+    assert "beyond the elastic contact model's range" in v

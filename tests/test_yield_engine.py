@@ -242,3 +242,28 @@ def test_family_sobol_and_linear_share_group_members_and_groups_name_families():
     e = grouped.sample(np.random.default_rng(1), 1000)
     assert np.array_equal(e["p1"], e["p3"])
     assert grouped.with_tolerances({"pins": 0.06})["p2"].tolerance == 0.06
+
+
+def test_chunk_result_is_o1_in_samples_past_the_kept_head():
+    """Issue 14, bounded memory: a chunk past the run's first ``keep_head`` samples returns
+    counts, moment sums and its ``keep_worst`` worst samples only — the same size (pickled, as
+    Dask ships it) for 100 or 20 000 samples; the head is still the run's first samples."""
+    import pickle
+
+    from gearte.execution import seeded_chunks
+    from gearte.tolerance.yield_mc import _chunk, _Shared
+
+    ts = _lin_set()
+    spec = (SpecLimit("y", upper=1.03),)
+    sizes = {}
+    for n in (100, 20_000):
+        shared = _Shared(Linear(), ts, spec, 3, 50, {"y": 0.03}, n)
+        late = seeded_chunks(3 * n, n, 1)[2]  # starts past the 50 kept samples
+        p = _chunk(late, shared)
+        assert p.n == n and p.head["y"].size == 0 and len(p.worst) == 3
+        sizes[n] = len(pickle.dumps(p))
+    assert sizes[20_000] <= sizes[100] + 64  # (row indices pickle in a few more bytes)
+    r = run_yield(Linear(), ts, list(spec), 1000, seed=2, chunk_size=30, keep_head=50)
+    first = ts.sample(seeded_chunks(1000, 30, 2)[0].rng(), 30)
+    assert r.head["y"].size == 50
+    np.testing.assert_array_equal(r.head["y"][:30], Linear()(first)["y"])

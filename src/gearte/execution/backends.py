@@ -44,6 +44,12 @@ LOCAL_SCHEDULERS = ("sequential", "synchronous", "threads", "processes", "local-
 #: Seconds to wait for a Dask scheduler before giving up with :class:`SchedulerError`.
 CONNECT_TIMEOUT_S = 5.0
 
+#: Dask settings of the ``"local-cluster"`` that gearte starts (no dashboard to show profiles).
+_LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+}
+
 _CLUSTER_EXTRA = "pip install 'gearte[cluster]' (or: pip install 'dask[distributed]')"
 
 
@@ -425,13 +431,20 @@ class DaskExecutor(ChunkExecutor):
                 nw = default_workers() if workers is None else int(workers)
                 if nw < 1:
                     raise ParameterError("workers", workers, "must be ≥ 1")
-                cluster = distributed.LocalCluster(
-                    n_workers=nw,
-                    threads_per_worker=1,
-                    processes=True,
-                    dashboard_address=None,
-                    silence_logs=logging.ERROR,
-                )
+                # No dashboard, so no use for the workers' statistical profiler (it samples the
+                # running chunk's stack every 10 ms and keeps an hour of profiles) nor for a
+                # 20 ms event-loop watchdog tick: both cost CPU per second of wall time, not per
+                # chunk (an idle worker: 35–41 → 9–12 ms CPU per s; docs/cluster.md).
+                import dask
+
+                with dask.config.set(_LOCAL_CLUSTER_CONFIG):
+                    cluster = distributed.LocalCluster(
+                        n_workers=nw,
+                        threads_per_worker=1,
+                        processes=True,
+                        dashboard_address=None,
+                        silence_logs=logging.ERROR,
+                    )
                 self._owned.append(cluster)
                 self.client = distributed.Client(cluster, set_as_default=False)
                 self._owned.insert(0, self.client)

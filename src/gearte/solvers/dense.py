@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["matvec_into", "dot", "max_abs", "solve_spd_into", "solve_lu_into"]
+__all__ = ["copy_into", "matvec_into", "dot", "max_abs", "solve_spd_into", "solve_lu_into"]
 
 
 @njit(cache=True, nogil=True)
@@ -27,6 +27,15 @@ def dot(a, b):
     for i in range(a.shape[0]):
         s += a[i] * b[i]
     return s
+
+
+@njit(cache=True, nogil=True)
+def copy_into(src, out):
+    """out[i] = src[i] for 1-D arrays of the same length: ``out[:] = src`` inside a kernel
+    compiles numba's broadcasting and its shape-mismatch message (string formatting, ~1 s per
+    kernel, docs/numba.md); this loop compiles once for every caller."""
+    for i in range(out.shape[0]):
+        out[i] = src[i]
 
 
 @njit(cache=True, nogil=True)

@@ -1383,7 +1383,9 @@ def preflight(case: Case) -> None:
     """The checks :func:`run` makes on the built reducer, before any analysis (called by
     ``gearte validate`` and by :func:`gearte.studies.run_case`): the dynamic model's derived
     masses (density), its elastic modes and RK4 step budgets
-    (:func:`_rv_dynamics.preflight_dynamics`); the yield's tolerance and cost keys against the
+    (:func:`_rv_dynamics.preflight_dynamics`); the tooth contact at the paper's mesh position
+    (:func:`gearte.studies.cycloid_stage.preflight` of :func:`build_stage_case`, which the
+    cycloid analyses run on); the yield's tolerance and cost keys against the
     reducer's error keys (:func:`~gearte.studies._yield.yield_inputs`).
 
     Raises
@@ -1402,6 +1404,10 @@ def preflight(case: Case) -> None:
         yield_inputs(a.yield_, units, {}, defaults, families, _grade_um(case), model.quantities)
     if any(getattr(a, k) is not None for k in dyn.ANALYSES):
         dyn.preflight_dynamics(case, build_reducer(case.reducer))
+    if a.tooth_contact is not None:  # the cycloid analyses run as a cycloid_stage case
+        from gearte.studies import cycloid_stage as cs
+
+        cs.preflight(build_stage_case(case))
 
 
 def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyResult:

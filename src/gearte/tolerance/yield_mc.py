@@ -479,6 +479,7 @@ class _Shared:
     keep_worst: int
     keep_head: int
     scale: dict[str, float]
+    chunk_size: int  # samples per chunk (all but the last): where each chunk starts
 
 
 def _norm_margin(shared: _Shared, out: Mapping[str, np.ndarray], n: int) -> np.ndarray:
@@ -518,7 +519,10 @@ def _chunk(chunk: Any, shared: _Shared) -> _Partial:
                     "values": {k: float(v[j]) for k, v in out.items()},
                 }
             )
-    head = {k: v[: shared.keep_head].copy() for k, v in out.items()}
+    # only the chunks that hold the run's first ``keep_head`` samples return theirs: every other
+    # chunk's result is O(1) in its samples (counts, moment sums, the worst ``keep_worst``)
+    rows = max(0, min(n, shared.keep_head - int(chunk.index) * shared.chunk_size))
+    head = {k: v[:rows].copy() for k, v in out.items()}
     return _Partial(n, int(np.count_nonzero(ok)), stats, fails, worst, head)
 
 
@@ -619,7 +623,7 @@ def run_yield(
             lim = s.upper if s.upper is not None else s.lower
             assert lim is not None  # SpecLimit has at least one limit
             scale[s.quantity] = max(abs(lim), abs(float(nominal[s.quantity][0])), 1e-300)
-    shared = _Shared(model, tolerances, spec, keep_worst, keep_head, scale)
+    shared = _Shared(model, tolerances, spec, keep_worst, keep_head, scale, chunk_size)
     chunks = seeded_chunks(n, chunk_size, seed)
     total = map_chunks(
         _chunk,
