@@ -12,7 +12,10 @@ included) and prints, per case:
   study imports it, cache load or compile, in the preflight or the analyses), analyses (without
   numba: the work the user asked for), figures (build),
   render (PNG, forked workers), the slowest figure, html, csv, write, and *startup/exit* (the
-  wall time outside gearte's own timing: interpreter start, exit);
+  wall time outside gearte's own timing: interpreter start, exit); then, in the report process,
+  its warm-up (importing matplotlib, drawing a first figure; it runs beside the case load and
+  the analyses) and how long it then waited for the result (*rp idle*: ~0 means the warm-up, not
+  the analyses, held the report back);
 * *other* = wall − analyses: everything the user did not ask for, and its ratio to the analyses.
 
 Then one summary line per goal of issue 12: a warm run of a case whose analyses take < 1 s
@@ -38,7 +41,9 @@ import time
 from pathlib import Path
 
 STAGES = ["imports", "numba", "analyses", "figures", "render", "fig max", "html", "csv", "write",
-          "startup"]  # fmt: skip
+          "startup", "rp warm", "rp idle"]  # fmt: skip
+REPORT_PROCESS = {"report process: warm-up": "rp warm",
+                  "report process: waited for the result": "rp idle"}  # fmt: skip
 WANG_GOAL_S = 2.5
 FAST_GOAL_S = 1.5
 FIGURE_GOAL_S = 1.0
@@ -77,6 +82,8 @@ def run_once(case: str, cache_dir: str, out_dir: str) -> dict[str, float]:
             out["analyses"] += v
         elif k == "render: slowest figure":
             out["fig max"] = v
+        elif k in REPORT_PROCESS:
+            out[REPORT_PROCESS[k]] = v
         elif k in out:
             out[k] += v
     out["analyses"] = max(0.0, out["analyses"] - in_analyses)
@@ -84,6 +91,54 @@ def run_once(case: str, cache_dir: str, out_dir: str) -> dict[str, float]:
     out["wall"] = wall
     out["cpu"] = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     out["fallback"] = float(any(k.startswith("report process failed") for k in t))
+    return out
+
+
+# What any warm run of a case with a compiled kernel cannot avoid, each in a fresh process
+FLOOR_STEPS = [
+    ("interpreter", "pass"),
+    ("+ numpy", "import numpy"),
+    ("+ numba import", "import numpy, numba"),
+    (
+        "+ one cached kernel call",
+        "from gearte._blas import preload_scipy_blas; preload_scipy_blas()\n"
+        "from gearte.models.contact_law import max_contact_pressure_scalar as f\n"
+        "f(1000.0, -40.0, 3.0, 1.1e5, 10.0)",
+    ),
+    (
+        "+ load the case (pydantic)",
+        "from gearte._blas import preload_scipy_blas; preload_scipy_blas()\n"
+        "from gearte.io.case_file import load_case; load_case('hu2020_rv80e_initial')\n"
+        "from gearte.models.contact_law import max_contact_pressure_scalar as f\n"
+        "f(1000.0, -40.0, 3.0, 1.1e5, 10.0)",
+    ),
+    (
+        "report: matplotlib + 1 figure",
+        "import io\nfrom gearte.plotting import new_figure\n"
+        "fig, ax = new_figure(); ax.plot([0, 1], [0, 1]); ax.set_xlabel('x [mm]')\n"
+        "fig.savefig(io.BytesIO(), format='png', dpi=100)",
+    ),
+]
+
+
+def floor(cache_dir: str, repeat: int) -> dict[str, tuple[float, float]]:
+    """Each of :data:`FLOOR_STEPS` in fresh processes (after one untimed run that fills the numba
+    cache): the fastest wall [s] and the CPU [s] of that run."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    out: dict[str, tuple[float, float]] = {}
+    for label, code in FLOOR_STEPS:
+        runs = []
+        for i in range(repeat + 1):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t0 = time.perf_counter()
+            subprocess.run([sys.executable, "-c", code], env=env, check=True)
+            wall = time.perf_counter() - t0
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+            if i > 0:  # the first run fills the cache and the bytecode
+                runs.append((wall, cpu))
+        out[label] = min(runs)
     return out
 
 
@@ -121,6 +176,7 @@ def main() -> None:
     ap.add_argument(
         "--cache-dir", default="", help="numba cache folder to use and keep (default: a new one)"
     )
+    ap.add_argument("--no-floor", action="store_true", help="skip the floor measurement")
     args = ap.parse_args()
     names = [c for c in args.cases.split(",") if c] or list(list_cases())
     print(f"load average at start: {os.getloadavg()[0]:.2f} (cores: {os.cpu_count()})")
@@ -131,6 +187,9 @@ def main() -> None:
     warm_rows: dict[str, dict[str, float]] = {}
     with tempfile.TemporaryDirectory() as tmp:
         shared = args.cache_dir or str(Path(tmp) / "numba")
+        floors = {} if args.no_floor else floor(shared, max(3, args.repeat))
+        for label, (wall, cpu) in floors.items():
+            print(f"floor: {label:32s} wall {wall:6.3f} s  cpu {cpu:6.3f} s", flush=True)
         for name in names:
             cache = str(Path(tmp) / f"numba-{name}") if args.cold else shared
             cold = run_once(name, cache, str(Path(tmp) / "out"))
@@ -154,6 +213,15 @@ def main() -> None:
         print(_summary(f"Wang 2013 whole warm run ≤ {WANG_GOAL_S} s wall", wang))
     cpu = sum(r["cpu"] for r in warm_rows.values())
     print(f"warm runs: {len(warm_rows)} cases, {cpu:.1f} s CPU in all")
+    if floors:
+        w, c = floors["+ load the case (pydantic)"]
+        print(
+            f"floor of a warm run with a compiled kernel (interpreter, numpy, numba, one cached "
+            f"kernel call, loading a case; no report): {w:.2f} s wall, {c:.2f} s CPU — "
+            f"{FAST_GOAL_S - w:+.2f} s left of the {FAST_GOAL_S} s goal for the analyses and the "
+            "report (matplotlib and one figure alone: "
+            f"{floors['report: matplotlib + 1 figure'][0]:.2f} s wall in its own process)"
+        )
 
 
 if __name__ == "__main__":

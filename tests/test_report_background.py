@@ -54,7 +54,10 @@ def same_report():
     a, b = mine["report"].read_text(), alone["report"].read_text()
     assert page(a) == page(b), "pages differ"
     assert a.count("data:image/png;base64,") == b.count("data:image/png;base64,") > 0
-    need = {"figures", "render", "render: slowest figure", "html"}
+    pngs = lambda html: re.findall(r"data:image/png;base64,[A-Za-z0-9+/=]+", html)
+    assert pngs(a) == pngs(b), "the report process drew other pixels"
+    need = {"figures", "render", "render: slowest figure", "html", "report process: warm-up",
+            "report process: waited for the result"}
     assert need <= set(result.timings), result.timings
     assert reaped(pid), "zombie left"
 

@@ -273,18 +273,18 @@ def run(
         from gearte.studies import RunOptions, run_case
 
         t1 = time.perf_counter()
-        c = load_case(case)
-        t2 = time.perf_counter()
-        default = os.path.join("out", safe_label(c.case.name or c.case.kind))
-        target = check_output_dir(out_dir if out_dir is not None else default)
-        # the report's process (forked with the case's kind imported: its result unpickles
-        # there) imports matplotlib while this one runs the analyses
+        # the report's process, forked first, imports matplotlib and the case's study kind (its
+        # result unpickles there) while this one loads the case and runs the analyses
         renderer = None
         if not no_report:
             from gearte.report.background import ReportWorker
 
-            renderer = ReportWorker.start()
+            renderer = ReportWorker.start(case)
         try:
+            c = load_case(case)
+            t2 = time.perf_counter()
+            default = os.path.join("out", safe_label(c.case.name or c.case.kind))
+            target = check_output_dir(out_dir if out_dir is not None else default)
             with _executor(scheduler, workers) as executor:
                 opts = RunOptions(
                     progress=not no_progress,

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 from fractions import Fraction
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Literal, get_args
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -25,17 +25,15 @@ from pydantic import Field, field_validator, model_validator
 from gearte.errors import ParameterError
 from gearte.geometry.planetary import EccentricityError, PlanetarySet, SunPlanetErrors
 from gearte.io.schema import CaseBase, Sign, StrictModel
-from gearte.models.planetary_errors import (
-    TermSet,
-    coupled_te,
-    derive_terms,
-    first_stage_keys,
-    frequency_basis,
-    terms_from_table,
-)
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies._yield import YieldSection
 from gearte.units import deg_to_rad, mm_to_um, rad_to_arcsec, rad_to_deg, um_to_mm
+
+if TYPE_CHECKING:
+    from gearte.models.planetary_errors import TermSet
+
+# the models (numba kernels) are imported where they are used: importing this module (to read
+# a case, or to unpickle its result in the report process) stays free of numba
 
 KIND = "planetary"
 REFERENCES = ["wang2013"]
@@ -270,6 +268,7 @@ def _check_resources(case: Case, terms: TermSet) -> None:
     common period); each evaluation costs about ``8 n_max G`` sine-table products.
     """
     from gearte.limits import check_memory, check_time
+    from gearte.models.planetary_errors import frequency_basis
     from gearte.solvers.trig_extremes import grid_points
 
     _, harm, _ = frequency_basis(terms)
@@ -374,6 +373,8 @@ def first_stage_errors(case: Case) -> SunPlanetErrors:
 
 def build_terms(case: Case) -> tuple[TermSet, dict[str, float], dict[str, float]]:
     """The term set, magnitudes [mm] and angles [rad] of a case (keys checked)."""
+    from gearte.models.planetary_errors import derive_terms, first_stage_keys, terms_from_table
+
     pset = case.gearset.build()
     e = case.errors
     if e.source == "derived":
@@ -473,6 +474,7 @@ def preflight(case: Case) -> None:
 
 def run(case: Case, options) -> StudyResult:
     """Derive (or read) the terms, then coupled TE, assembly phases and Monte-Carlo."""
+    from gearte.models.planetary_errors import coupled_te, frequency_basis
     from gearte.runners.planetary_assembly import (
         optimal_assembly,
         paper_rule_assembly,
