@@ -14,7 +14,9 @@ the run, from ``getrusage`` in each worker), the CPU the model itself spent per 
 inside the chunk with ``time.thread_time``: what is left is the backend's overhead), and the
 resident memory (RSS) of each worker and of this process, polled every ``--poll`` seconds over
 the whole run. Prints whether every statistic is identical and one summary line per goal;
-``--log FILE`` also writes everything (RSS timelines included) as JSON.
+``--log FILE`` also writes everything (RSS timelines included) as JSON, and appends each chunk
+(time, process, its model CPU) and each RSS reading to ``FILE.trace.txt`` as it happens (a run
+stopped early still leaves its timeline).
 
     PYTHONPATH=src:benchmarks python benchmarks/bench_yield_dask.py [--drive rv] [--samples N]
 """
@@ -41,14 +43,17 @@ class TimedModel:
     """The study's model, plus the thread CPU time of each call as an extra quantity (one value
     per chunk, repeated for its samples) — the model's own share of a chunk's CPU."""
 
-    def __init__(self, inner) -> None:
-        self.inner = inner
+    def __init__(self, inner, trace: str | None = None) -> None:
+        self.inner, self.trace = inner, trace
 
     def __call__(self, errors):
         c = time.thread_time()
         out = dict(self.inner(errors))
         dt = time.thread_time() - c
         n = np.asarray(next(iter(out.values()))).shape[0] if out else 1
+        if self.trace:  # a line per chunk, for long runs
+            with open(self.trace, "a") as f:
+                f.write(f"{time.time():.1f} {os.getpid()} chunk {n} {dt:.4f}\n")
         out[CPU_KEY] = np.full(n, dt)
         return out
 
@@ -73,9 +78,10 @@ def _profiler_on() -> bool:
 class RSSPoller:
     """RSS [MiB] of some processes every ``period`` seconds, in a background thread."""
 
-    def __init__(self, pids: dict[str, int], period: float) -> None:
+    def __init__(self, pids: dict[str, int], period: float, trace: str | None = None) -> None:
         import psutil
 
+        self.trace = trace
         self.procs = {k: psutil.Process(p) for k, p in pids.items()}
         self.period = period
         self.t0 = time.perf_counter()
@@ -91,7 +97,10 @@ class RSSPoller:
                 try:
                     self.series[k].append((round(t, 1), p.memory_info().rss / 2**20))
                 except Exception:  # noqa: BLE001 - a process that ended
-                    pass
+                    continue
+                if self.trace:
+                    with open(self.trace, "a") as f:
+                        f.write(f"{time.time():.1f} {p.pid} rss {k} {self.series[k][-1][1]:.1f}\n")
             if self._stop.wait(self.period):
                 return
 
@@ -145,7 +154,8 @@ def main() -> None:
         )
         spec = [SpecLimit("coupled_te_amplitude [arcsec]", upper=400.0)]
         q = "coupled_te_amplitude [arcsec]"
-    model = TimedModel(model)
+    trace = f"{a.log}.trace.txt" if a.log else None
+    model = TimedModel(model, trace)
     kw = {"seed": 6, "chunk_size": a.chunk}
     n_chunks = -(-a.samples // a.chunk)
     log: dict = {"drive": a.drive, "samples": a.samples, "chunk": a.chunk, "runs": {}}
@@ -187,7 +197,7 @@ def main() -> None:
     print(f"{what} through the yield engine, {a.samples} samples, chunks of {a.chunk}", flush=True)
     if a.backend in ("both", "threads"):
         run_yield(model, ts, spec, 4, seed=0, chunk_size=2, options=_Opt(2))  # compile / load
-        poll = RSSPoller({"this process": os.getpid()}, a.poll)
+        poll = RSSPoller({"this process": os.getpid()}, a.poll, trace)
         t, c = time.perf_counter(), time.process_time()
         r = run_yield(model, ts, spec, a.samples, options=_Opt(2), **kw)
         wall, cpu = time.perf_counter() - t, time.process_time() - c
@@ -205,7 +215,7 @@ def main() -> None:
             prof = set(client.run(_profiler_on).values())
             pids = {w.rsplit(":", 1)[-1]: v["pid"] for w, v in before.items()}
             pids["this process"] = os.getpid()
-            poll = RSSPoller(pids, a.poll)
+            poll = RSSPoller(pids, a.poll, trace)
             t = time.perf_counter()
             r = run_yield(model, ts, spec, a.samples, options=_Opt(2, ex), **kw)
             wall = time.perf_counter() - t

@@ -332,3 +332,24 @@ def test_results_are_handed_back_in_task_order_whatever_the_timing(durations, wo
         expected += 0.1 * i + 1e-17 * i * i
     assert order == list(range(len(durations)))
     assert total == expected
+
+
+def _worker_dask_settings() -> tuple[bool, str]:
+    import dask
+
+    return (
+        bool(dask.config.get("distributed.worker.profile.enabled")),
+        str(dask.config.get("distributed.admin.tick.interval")),
+    )
+
+
+def test_local_cluster_workers_run_without_profiler_and_with_a_slow_tick(reference):
+    """Issue 14: the ``"local-cluster"`` gearte starts serves no dashboard, so its workers run
+    without Dask's statistical profiler and with a 1 s event-loop tick (both cost worker CPU per
+    second of wall time); this process's Dask settings are left as they were; same bits."""
+    before = _worker_dask_settings()
+    with open_executor("local-cluster", 1) as ex:
+        settings = set(ex.client.run(_worker_dask_settings).values())
+        assert settings == {(False, "1s")}
+        assert _stats(scheduler=ex).as_tuple() == reference.as_tuple()
+    assert _worker_dask_settings() == before

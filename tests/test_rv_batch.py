@@ -54,9 +54,10 @@ def _every_family(red) -> ToleranceSet:
 def test_batched_rv_yield_equals_the_per_case_solver_on_sampled_reducers(clearance_um):
     """Three reducers drawn with every error family: the batched solver (rows mapped from the
     drawn errors, condensed, all steps in one call) gives the per-sample path's catalogue values,
-    TE, pin load and pressure. With the secant fixed point (the per-case algorithm) to 1e-9
-    relative; with Newton on the exact law to 1e-9 relative or 1e-9 arcmin (the per-case fixed
-    point stops at a relative stiffness change of 1e-9: that is its own accuracy)."""
+    TE, pin load and pressure. The per-sample path solves each reducer's positions through the
+    same kernel (``solve_positions``' default, Newton on the exact law): to 1e-9 relative; with
+    the secant fixed point (the former per-case algorithm) to 1e-9 relative or 1e-9 arcmin (the
+    fixed point stops at a relative stiffness change of 1e-9: that is its own accuracy)."""
     red = _reducer(clearance_um)
     per_case = RVReducerYield(red, positions=12, batched=False)
     batched = RVReducerYield(red, positions=12)
@@ -65,8 +66,8 @@ def test_batched_rv_yield_equals_the_per_case_solver_on_sampled_reducers(clearan
     fixed_point = rb.batch_quantities(batched, errs, 3, exact=False)
     newton = batched(errs)
     for k, v in ref.items():
-        np.testing.assert_allclose(fixed_point[k], v, rtol=1e-9, atol=0.0, err_msg=k)
-        np.testing.assert_allclose(newton[k], v, rtol=1e-9, atol=1e-9, err_msg=k)
+        np.testing.assert_allclose(newton[k], v, rtol=1e-9, atol=0.0, err_msg=k)
+        np.testing.assert_allclose(fixed_point[k], v, rtol=1e-9, atol=1e-9, err_msg=k)
     assert np.ptp(ref["angular_te [arcmin]"]) > 0  # the samples differ
 
 
@@ -98,3 +99,37 @@ def test_batched_error_rows_are_linear_in_the_drawn_errors():
         one = model.reducer_for({k: float(v[s]) for k, v in errs.items()})
         sys_ = assemble(one, p.theta)
         np.testing.assert_allclose(gap[s], sys_.contact_gap, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize(
+    ("law_name", "clearance_um"),
+    [("line_contact", 0.0), ("hu2020", 0.0), ("line_contact", 10.0)],
+    ids=["per_contact_law", "per_disc_law", "cam_clearance"],
+)
+def test_solve_positions_batched_equals_the_per_position_solver(law_name, clearance_um):
+    """``solve_positions``' default (the positions as the steps of one batched-kernel sample,
+    condensed, exact-law Newton) against its dense per-position kernel (the secant fixed point)
+    on han2023_rv110e with its measured errors: displacements, pin forces, the loaded pins'
+    secant stiffness and the per-disc stiffness to 1e-9 relative (the fixed point's tolerance),
+    cold and warm-started; the plain-Python twin of the batched path to round-off."""
+    from gearte.models.rv_load_sharing import assemble, contact_law, output_positions, solver_law
+    from gearte.solvers.rv_equilibrium import solve_positions
+
+    red = _reducer(clearance_um)
+    system = assemble(red, output_positions(5))
+    law = solver_law(red, system, contact_law(red, law_name))
+    T = red.rated_torque
+    ref = solve_positions(system, T, law, method="per_position")
+    start = {"q0": ref.q[2], "k0": ref.contact_stiffness[2]}
+    for kw in ({}, start):
+        a = solve_positions(system, T, law, **kw)
+        b = solve_positions(system, T, law, method="per_position", **kw)
+        scale = np.abs(b.q).max(axis=0)
+        np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-9 * scale.max())
+        fmax = b.contact_force.max()
+        np.testing.assert_allclose(a.contact_force, b.contact_force, rtol=0, atol=1e-9 * fmax)
+        loaded = b.contact_force > 1e-6 * fmax
+        np.testing.assert_allclose(a.pin_stiffness[loaded], b.pin_stiffness[loaded], rtol=1e-9)
+        np.testing.assert_allclose(a.contact_stiffness, b.contact_stiffness, rtol=1e-9)
+    twin = solve_positions(system, T, law, compiled=False)
+    np.testing.assert_allclose(twin.q, solve_positions(system, T, law).q, rtol=1e-12, atol=1e-18)

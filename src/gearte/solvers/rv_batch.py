@@ -54,6 +54,7 @@ __all__ = [
     "BatchSolution",
     "problem_from_system",
     "solve_batch",
+    "solve_system",
 ]
 
 _TWIN_LOCK = threading.Lock()
@@ -89,15 +90,15 @@ def sparse_rows(B: np.ndarray, *, pairs: bool = False) -> SparseRows:
             raise ParameterError("rows", R, "pairs=True needs an even number of rows")
         both = nz[0::2] | nz[1::2]
         nz = np.repeat(both, 2, axis=0)
-    W = max(1, int(nz.sum(axis=1).max(initial=0)))
-    index = np.zeros((R, W), dtype=np.int64)
-    value = np.zeros((G, R, W))
-    for r in range(R):
-        cols = np.flatnonzero(nz[r])
-        index[r, : cols.size] = cols
-        if cols.size:
-            index[r, cols.size :] = cols[0]
-            value[:, r, : cols.size] = B[:, r, cols]
+    count = nz.sum(axis=1)
+    W = max(1, int(count.max(initial=0)))
+    # each row's non-zero columns in increasing order, then padding: its first column again
+    # (value 0; a row with no entry: column 0)
+    order = np.argsort(~nz, axis=1, kind="stable")[:, :W]
+    pad = np.arange(W)[None, :] >= count[:, None]
+    index = np.ascontiguousarray(np.where(pad, order[:, :1], order), dtype=np.int64)
+    value = np.take_along_axis(B, index[None], axis=2)
+    value[:, pad] = 0.0
     return SparseRows(index, value)
 
 
@@ -657,12 +658,18 @@ def _position(
 @njit(cache=True, nogil=True)
 def _solve_batch(
     K0s, us, regs, cidx, cvals, nidx, nvals, kn, cn, group, ngroups, law, coefs, kstart, Hs, ENs,
-    GAPs, step_g, step_T, start, rec, nrec, out_u, out_h, out_q, tol, maxit, exact,
+    GAPs, step_g, step_T, start, rec, nrec, out_u, out_h, out_q, tol, maxit, exact, given_q,
+    given_f, given_d, given_kg, given_kc, given,
 ):  # fmt: skip
     """All samples × steps. The system is the condensed one (:func:`condense`): stiffness
     ``K0s[g]``, load ``T us[g] − Hs[s, g]``; the output rotation is recovered as
     ``T out_u[g] − out_h[s, g] + out_q[g] · q``. ``start[t]``: the step whose solution (of the
-    same sample) starts step ``t`` (−1: zero displacements and the law's start stiffness)."""
+    same sample) starts step ``t`` (−1: zero displacements and the law's start stiffness);
+    where ``given[t]``, step ``t`` starts from ``given_q[t]`` (displacements), ``given_f[t]``,
+    ``given_d[t]`` (contact forces and approaches), ``given_kg[t]``, ``given_kc[t]`` (per-disc
+    and per-contact stiffness) instead. Returns the output rotation, the recorded forces and the
+    iterations per step, and the state of every step of the last sample (``Q, F, D, KG, KC``:
+    a one-sample batch's whole solution)."""
     S = Hs.shape[0]
     K = step_g.size
     nd = us.shape[1]
@@ -684,7 +691,13 @@ def _solve_batch(
             g = step_g[t]
             T = step_T[t]
             u = start[t]
-            if u < 0:
+            if given[t]:
+                _copy(given_q[t], q)
+                _copy(given_f[t], w.force)
+                _copy(given_d[t], w.approach)
+                _copy(given_kg[t], w.k)
+                _copy(given_kc[t], w.kc)
+            elif u < 0:
                 q[:] = 0.0
                 w.force[:] = 0.0
                 w.approach[:] = 0.0
@@ -717,7 +730,7 @@ def _solve_batch(
             rot[s, t] = r
             if rec[t] >= 0:
                 _copy(w.force, forces[s, rec[t]])
-    return rot, forces, iters
+    return rot, forces, iters, Q, FF, DD, KG, KC
 
 
 @dataclass(frozen=True)
@@ -730,9 +743,14 @@ class Condensed:
     ``K_ff`` is not positive definite (a degree of freedom held only by contacts or clearance
     bearings) nothing is condensed. ``reg``: the Newton regularisation, 1e-13 of the largest
     diagonal entry of the full ``K0`` (as the per-case solver), added to the Hessian only.
+    ``keep``, ``free``: the iterated and the condensed degrees of freedom; ``Kffinv`` (G, nf, nf)
+    ``K_ff⁻¹`` and ``KffKfc`` (G, nf, m) ``K_ff⁻¹ K_fc``, which recover ``q_f`` from a solution.
     """
 
     keep: np.ndarray
+    free: np.ndarray
+    Kffinv: np.ndarray
+    KffKfc: np.ndarray
     K: np.ndarray
     reg: np.ndarray
     u: np.ndarray
@@ -769,8 +787,9 @@ def condense(problem: BatchProblem) -> Condensed:
         Kfc = K0[:, free][:, :, keep]
         X = np.linalg.solve(Kff, np.concatenate([Kfc, np.eye(free.size)[None].repeat(G, 0)], 2))
         KffKfc, Kffinv = X[:, :, : keep.size], X[:, :, keep.size :]
-        M = np.einsum("gfc,gfe->gce", Kfc, Kffinv)  # K_cf K_ff⁻¹, (G, m, nf)
-        K = Kcc - np.einsum("gfc,gfe->gce", Kfc, KffKfc)
+        KcfT = Kfc.transpose(0, 2, 1)
+        M = np.matmul(KcfT, Kffinv)  # K_cf K_ff⁻¹, (G, m, nf)
+        K = Kcc - np.matmul(KcfT, KffKfc)
         K = 0.5 * (K + K.transpose(0, 2, 1))
     else:
         Kffinv = np.zeros((G, 0, 0))
@@ -778,7 +797,7 @@ def condense(problem: BatchProblem) -> Condensed:
         M = np.zeros((G, keep.size, 0))
         K = Kcc
     u = p.unit_load
-    uc = u[keep][None] - np.einsum("gcf,f->gc", M, u[free])
+    uc = u[keep][None] - M @ u[free]
     out_q = np.zeros((G, keep.size))
     out_hrow = np.zeros((G, nd))
     if pos[p.output] >= 0:
@@ -798,8 +817,9 @@ def condense(problem: BatchProblem) -> Condensed:
         return SparseRows(np.ascontiguousarray(idx, dtype=np.int64), rows.value)
 
     reg = 1e-13 * np.abs(np.diagonal(p.K0, axis1=1, axis2=2)).max(axis=1)
-    return Condensed(keep, np.ascontiguousarray(K), reg, np.ascontiguousarray(uc), Mfull, out_u,
-                     out_hrow, out_q, remap(p.contacts), remap(p.bearings))  # fmt: skip
+    return Condensed(keep, free, Kffinv, KffKfc, np.ascontiguousarray(K), reg,
+                     np.ascontiguousarray(uc), Mfull, out_u, out_hrow, out_q, remap(p.contacts),
+                     remap(p.bearings))  # fmt: skip
 
 
 def solve_batch(
@@ -875,38 +895,8 @@ def solve_batch(
     if record is not None:
         r = np.flatnonzero(np.asarray(record, dtype=bool))
         rec[r] = np.arange(r.size)
-    nrec = int((rec >= 0).sum())
-    p = problem
-    cd = problem.__dict__.get("_condensed")
-    if cd is None:
-        cd = condense(p)
-        object.__setattr__(problem, "_condensed", cd)
-    coef3 = np.ascontiguousarray(
-        np.concatenate([p.coef, law_limit(p.coef[..., :1], p.coef[..., 1:2])], axis=-1)
-        if p.law != LAW_LINEAR
-        else np.zeros(p.coef.shape[:-1] + (3,))
-    )
-    h = np.asarray(h, dtype=float)
-    hc = np.einsum("gcn,sgn->sgc", cd.M, h)  # condensed loads, (S, G, m)
-    out_h = np.einsum("gn,sgn->sg", cd.out_hrow, h)
-    en = np.asarray(bearing_offset, dtype=float)
-    gap = np.asarray(gap, dtype=float)
-    args = (
-        cd.K, cd.u, cd.reg, cd.contacts.index, np.ascontiguousarray(cd.contacts.value),
-        cd.bearings.index, np.ascontiguousarray(cd.bearings.value),
-        np.ascontiguousarray(p.bearing_k, dtype=float),
-        np.ascontiguousarray(p.bearing_c, dtype=float), p.group.astype(np.int64), p.ngroups,
-        int(p.law), coef3, float(p.start_stiffness),
-        np.ascontiguousarray(hc), np.ascontiguousarray(en), np.ascontiguousarray(gap),
-        np.asarray(step_geometry, dtype=np.int64), np.asarray(step_torque, dtype=float), start,
-        rec, nrec, np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
-        np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact),
-    )  # fmt: skip
-    if compiled:
-        rot, forces, iters = _solve_batch(*args)
-    else:
-        with _TWIN_LOCK:
-            rot, forces, iters = _twin(_solve_batch)(*args)
+    rot, forces, iters = _run(problem, h, bearing_offset, gap, step_geometry, step_torque,
+                              start, rec, tol, maxit, exact, compiled)[:3]  # fmt: skip
     if np.any(iters < 0):
         s, t = (int(v[0]) for v in np.nonzero(iters < 0))
         raise ConvergenceError(
@@ -916,6 +906,133 @@ def solve_batch(
             "(or a pin force beyond the range of the contact law)"
         )
     return BatchSolution(rot, forces, iters)
+
+
+def _condensed(problem: BatchProblem) -> Condensed:
+    """:func:`condense` of ``problem``, computed once and kept on it."""
+    cd = problem.__dict__.get("_condensed")
+    if cd is None:
+        cd = condense(problem)
+        object.__setattr__(problem, "_condensed", cd)
+    return cd
+
+
+def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, compiled,
+         first=None):  # fmt: skip
+    """The kernel's raw outputs for the inputs of :func:`solve_batch` (``rec``: index of each
+    step among the recorded ones, −1 if not recorded); ``first``: an optional start state
+    ``(q condensed, k per disc, kc per contact)`` of step 0."""
+    p = problem
+    cd = _condensed(p)
+    coef3 = np.ascontiguousarray(
+        np.concatenate([p.coef, law_limit(p.coef[..., :1], p.coef[..., 1:2])], axis=-1)
+        if p.law != LAW_LINEAR
+        else np.zeros(p.coef.shape[:-1] + (3,))
+    )
+    h = np.asarray(h, dtype=float)
+    hc = np.matmul(cd.M[None], h[..., None])[..., 0]  # condensed loads, (S, G, m)
+    out_h = np.sum(cd.out_hrow[None] * h, axis=2)
+    K = np.asarray(step_g).size
+    nd, nc, ng = cd.K.shape[1], np.shape(gap)[2], p.ngroups
+    given = np.zeros(K, dtype=np.bool_)
+    gq, gkg, gkc = np.zeros((K, nd)), np.zeros((K, ng)), np.zeros((K, nc))
+    if first is not None and K:
+        given[0] = True
+        gq[0], gkg[0], gkc[0] = first
+    args = (
+        cd.K, cd.u, cd.reg, cd.contacts.index, np.ascontiguousarray(cd.contacts.value),
+        cd.bearings.index, np.ascontiguousarray(cd.bearings.value),
+        np.ascontiguousarray(p.bearing_k, dtype=float),
+        np.ascontiguousarray(p.bearing_c, dtype=float), p.group.astype(np.int64), p.ngroups,
+        int(p.law), coef3, float(p.start_stiffness), np.ascontiguousarray(hc),
+        np.ascontiguousarray(en, dtype=float), np.ascontiguousarray(gap, dtype=float),
+        np.asarray(step_g, dtype=np.int64), np.array(step_T, dtype=float), start, rec,
+        int((rec >= 0).sum()), np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
+        np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact), gq,
+        np.zeros((K, nc)), np.zeros((K, nc)), gkg, gkc, given,
+    )  # fmt: skip
+    # step_T a fresh C array: solve_system passes a read-only broadcast ('A' layout), the yield
+    # a contiguous one; each compiled _solve_batch again (~7 s CPU, gear_chain's first run)
+    if compiled:
+        return _solve_batch(*args)
+    with _TWIN_LOCK:
+        return _twin(_solve_batch)(*args)
+
+
+def solve_system(
+    system,
+    torque: float | np.ndarray,
+    law,
+    *,
+    q0: np.ndarray | None = None,
+    k0: np.ndarray | None = None,
+    tol: float = 1e-9,
+    maxit: int = 100,
+    compiled: bool = True,
+):
+    """:func:`gearte.solvers.rv_equilibrium.solve_positions` through the batched kernel.
+
+    The positions of ``system`` are the steps of one sample, each warm-started from the
+    previous one (the first from ``q0``, ``k0`` or cold), solved condensed (:func:`condense`)
+    with Newton on the exact law where the law is per contact (its limit is the per-case secant
+    fixed point's: equal to ``tol``); the linear degrees of freedom are recovered exactly
+    afterwards. Parameters and result as ``solve_positions`` (an
+    :class:`~gearte.solvers.rv_equilibrium.EquilibriumSolution`); with a per-contact law each
+    contact's secant stiffness is ``F/δ(F) = 1/(a0 − a1 ln F)`` where it is loaded, an open
+    contact keeps its last loaded value (as the per-case fixed point), and the per-disc value is
+    the stiffest loaded contact's.
+
+    Raises
+    ------
+    ConvergenceError
+        Naming the first position without an equilibrium.
+    """
+    from gearte.solvers.rv_equilibrium import EquilibriumSolution, as_solver_law
+
+    law = as_solver_law(law, system)
+    P = system.theta.size
+    torque = np.broadcast_to(np.asarray(torque, dtype=float), (P,))
+    problem, h, en, gap = problem_from_system(system, law)
+    cd = _condensed(problem)
+    nd, ng = problem.unit_load.size, problem.ngroups
+    group = problem.group
+    kg0 = np.full(ng, law.stiffness) if k0 is None else np.asarray(k0, dtype=float)
+    first = None
+    if q0 is not None or k0 is not None:
+        qs = np.zeros(nd) if q0 is None else np.asarray(q0, dtype=float)
+        first = (qs[cd.keep], kg0, kg0[group])
+    steps = np.arange(P)
+    exact = problem.law == LAW_SECANT_PER_CONTACT
+    _, _, iters, Q, F, _, KG, KC = _run(problem, h, en, gap, steps, torque, steps - 1,
+                                        np.full(P, -1), tol, maxit, exact, compiled,
+                                        first)  # fmt: skip
+    iters = iters[0]
+    if np.any(iters < 0):
+        p = int(np.argmax(iters < 0))
+        raise ConvergenceError(
+            f"rv_equilibrium: no equilibrium at position {p} (theta = {system.theta[p]:.6f} rad) "
+            f"within {maxit} Newton iterations / 200 stiffness iterations, tolerance {tol:g} "
+            "(or a pin force beyond the range of the contact law)"
+        )
+    f0 = torque[:, None] * problem.unit_load[None] - h[0]
+    q = np.empty((P, nd))
+    q[:, cd.keep] = Q
+    if cd.free.size:
+        q[:, cd.free] = (np.matmul(cd.Kffinv, f0[:, cd.free, None])
+                         - np.matmul(cd.KffKfc, Q[..., None]))[..., 0]  # fmt: skip
+    if exact:
+        loaded = F > 0.0
+        a0, a1 = problem.coef[..., 0], problem.coef[..., 1]
+        sec = np.where(loaded, 1.0 / (a0 - a1 * np.log(np.where(loaded, F, 1.0))), 0.0)
+        last = np.maximum.accumulate(np.where(loaded, steps[:, None], -1), axis=0)
+        KC = np.where(last >= 0, sec[np.maximum(last, 0), np.arange(F.shape[1])],
+                      kg0[group][None])  # fmt: skip
+        KG = np.empty((P, ng))
+        for g in range(ng):
+            kg = np.max(sec[:, group == g], axis=1, initial=0.0)
+            last = np.maximum.accumulate(np.where(kg > 0.0, steps, -1))
+            KG[:, g] = np.where(last >= 0, kg[np.maximum(last, 0)], kg0[g])
+    return EquilibriumSolution(q, F, KG, iters, KC)
 
 
 _KERNELS = ("_solve_batch", "_position", "_newton", "_newton_mixed", "_energy", "_assemble",

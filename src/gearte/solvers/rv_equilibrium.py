@@ -396,9 +396,9 @@ def _split_springs(system):
 
 def _linear_parts(spring_B, spring_e, spring_k, load):
     """``K0 = Σ k B Bᵀ`` and ``f0 = load − Σ k e B`` per position."""
-    kB = spring_B * spring_k[None, :, None]
-    K0 = np.einsum("psi,psj->pij", kB, spring_B)
-    f0 = load - np.einsum("psi,ps->pi", kB, spring_e)
+    kBt = (spring_B * spring_k[None, :, None]).transpose(0, 2, 1)
+    K0 = np.matmul(kBt, spring_B)  # batched BLAS products (einsum does not use BLAS here)
+    f0 = load - np.matmul(kBt, spring_e[..., None])[..., 0]
     return np.ascontiguousarray(K0), np.ascontiguousarray(f0)
 
 
@@ -412,6 +412,7 @@ def solve_positions(
     tol: float = 1e-9,
     maxit: int = 100,
     compiled: bool = True,
+    method: str = "batched",
 ) -> EquilibriumSolution:
     """Quasi-static equilibrium at every position of ``system`` under output torque(s).
 
@@ -431,12 +432,26 @@ def solve_positions(
         Most fixed-point iterations per position [-].
     compiled : bool
         ``False`` runs the plain-Python twin of the same kernel (for tests).
+    method : str
+        ``"batched"`` (default): the positions as the steps of one sample of the batched kernel
+        (:func:`gearte.solvers.rv_batch.solve_system`: condensed onto the degrees of freedom
+        the contacts and clearance bearings touch, Newton on the exact law where the law is per
+        contact — the limit of the secant fixed point, equal to ``tol``); ``"per_position"``:
+        the dense per-position kernel of this module (the secant fixed point around an
+        active-set Newton; the flat reference the batched kernel is tested against).
 
     Raises
     ------
     ConvergenceError
         If Newton or the stiffness fixed point fails at some position.
     """
+    if method == "batched":
+        from gearte.solvers.rv_batch import solve_system
+
+        return solve_system(system, torque, law, q0=q0, k0=k0, tol=tol, maxit=maxit,
+                            compiled=compiled)  # fmt: skip
+    if method != "per_position":
+        raise ParameterError("method", method, "must be 'batched' or 'per_position'")
     P = system.theta.size
     law = as_solver_law(law, system)
     torque = np.broadcast_to(np.asarray(torque, dtype=float), (P,))
