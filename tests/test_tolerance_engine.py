@@ -221,11 +221,11 @@ def test_kernel_reduction_equals_numpy_twin():
     np.testing.assert_allclose(r.percentiles[50.0], np.percentile(y, 50), atol=16 * st.sd / 50)
 
 
-def test_kernel_spec_counts_exact_when_the_limits_fall_inside_populated_bins():
-    """The kernel counts out-of-spec samples from the histogram (bins are monotone in y) and
-    compares y with the limit only in the limit's own bin: with the limits on sample values
-    (so that bin is populated, one sample sits exactly on each limit) the counts, extremes and
-    histogram equal the numpy twin's, and the pairwise block sums its sums to rounding."""
+def test_kernel_reduction_exact_with_limits_on_sample_values():
+    """The kernel's vectorised reduction against the numpy twin with the spec limits on sample
+    values (one sample sits exactly on each limit and must count as in spec): out-of-spec
+    counts, extremes and histogram equal, the pairwise block sums to rounding; full blocks and
+    a partial one."""
     from gearte.execution import spawn_seeds
 
     st = spur_pair().backlash_stack()
@@ -240,6 +240,26 @@ def test_kernel_spec_counts_exact_when_the_limits_fall_inside_populated_bins():
     assert (r.min, r.max) == (twin.min, twin.max)
     assert r.mean == pytest.approx(st.mean + twin.s1 / n, rel=1e-13)
     assert r.sd == pytest.approx(math.sqrt((twin.s2 - twin.s1**2 / n) / (n - 1)), rel=1e-12)
+
+
+def test_kernel_int32_counts_flushed_into_int64_equal_the_compiled_kernel(monkeypatch):
+    """The kernel counts into int32 and adds them into the int64 totals every ``_FLUSH``
+    samples: its plain-Python run with a flush every 1500 samples gives the compiled kernel's
+    statistics and histogram exactly (5000 samples: several flushes and a partial block)."""
+    import gearte.tolerance.montecarlo as mc
+    from gearte.tolerance.rng import lane_states, stream_states
+
+    st = spur_pair().backlash_stack()
+    ki = mc._KernelInput.of(st)
+    s = stream_states(4)
+    lo, hi = st.mean - 8 * st.sd, st.mean + 8 * st.sd
+    args = (s, lane_states(s), 5000, *ki.args(), st.mean, lo, hi, 64, st.mean, np.inf, 3)
+    compiled = mc._linear_stack_kernel(*args)
+    monkeypatch.setattr(mc, "_FLUSH", 1500)
+    plain = mc._linear_stack_kernel.py_func(*args)
+    assert plain[:6] == compiled[:6]
+    np.testing.assert_array_equal(plain[6], compiled[6])
+    assert plain[6].sum() == 5000
 
 
 def _polar(stack):

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 from gearte.cases import list_cases
 from gearte.cli import main
-from gearte.warm import BENCH_CASES, WARM_CASES, WARM_CHAINS, _chains
+from gearte.warm import BENCH_CASES, WARM_CASES, WARM_CHAINS, WARM_USES, _chains
 
 
 def _kind_of(path) -> str:
@@ -39,7 +39,12 @@ def test_warm_chains_hold_every_warm_up_case_once_and_bench_cases_one_per_kind()
         assert _kind_of(bundled[case]) == kind
     # a kind filter keeps only that kind's cases, in chain order
     assert _chains(["rv_serial"]) == [[("rv_serial", "synthetic_rv110e_serial")]]
-    assert _chains(["gear_chain", "rv_lot"]) == []
+    # a kind without warm-up cases of its own warms the kinds whose kernels it uses
+    assert _chains(["rv_lot"]) == _chains(["rv_reducer"]) != []
+    chain_cases = {c for ch in _chains(["gear_chain"]) for _, c in ch}
+    assert chain_cases == set(WARM_CASES["gear_pair"]) | set(WARM_CASES["rv_reducer"])
+    for kind, uses in WARM_USES.items():
+        assert not WARM_CASES[kind] and set(uses) <= set(WARM_CASES)
 
 
 def test_warm_cache_refuses_an_unknown_kind():

@@ -9,8 +9,9 @@ prints them as they finish and ``make demo`` calls it.
 
 Only cases that compile something are run: a case whose kernels another warm-up case already
 compiled (same kernels, same argument types) is left out, and so are kinds without kernels of
-their own (``gear_chain``: its stages are drives of the other kinds). ``benchmarks/bench_compile.py
---coverage`` checks that after the warm-up no bundled case compiles anything.
+their own (``gear_chain``: its stages are drives of the other kinds); warming such a kind warms
+the kinds whose kernels it uses (:data:`WARM_USES`). ``benchmarks/bench_compile.py --coverage``
+checks that after the warm-up no bundled case compiles anything.
 
 In parallel (:func:`warm_cache_parallel`) the cases run in :data:`WARM_CHAINS`: cases that share
 kernels run one after the other in the same process (the later ones load what the first one
@@ -26,7 +27,14 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
-__all__ = ["WARM_CASES", "WARM_CHAINS", "BENCH_CASES", "warm_cache", "warm_cache_parallel"]
+__all__ = [
+    "WARM_CASES",
+    "WARM_CHAINS",
+    "WARM_USES",
+    "BENCH_CASES",
+    "warm_cache",
+    "warm_cache_parallel",
+]
 
 WARM_CASES: dict[str, tuple[str, ...]] = {
     "cycloid_stage": ("hu2020_rv80e_initial",),
@@ -42,6 +50,16 @@ WARM_CASES: dict[str, tuple[str, ...]] = {
 no earlier warm-up case compiles (measured with ``bench_compile.py --coverage`` on 2026-11-25:
 after these, every other bundled case compiles nothing — e.g. ``rv_bench`` and ``rv_lot`` use
 the RV reducer's kernels, ``gear_chain`` those of its stages' kinds)."""
+
+WARM_USES: dict[str, tuple[str, ...]] = {
+    "gear_chain": ("gear_pair", "rv_reducer"),
+    "rv_bench": ("rv_reducer",),
+    "rv_lot": ("rv_reducer",),
+}
+"""Kinds without warm-up cases of their own and the kinds whose kernels their bundled cases
+call (a chain's RV stage: the RV quasi-static solver; its pair stages' yield: the tolerance
+Monte-Carlo): ``gearte warm-cache --kind gear_chain`` warms those (it warmed nothing, and the
+first ``gear_chain`` run compiled for ~15 s CPU)."""
 
 WARM_CHAINS: tuple[tuple[str, ...], ...] = (
     ("han2023_rv110e_yield",),  # the batched RV solver (solvers/rv_batch.py)
@@ -80,8 +98,10 @@ def _check(kinds: Sequence[str] | None) -> list[str]:
 
 
 def _chains(kinds: Sequence[str] | None) -> list[list[tuple[str, str]]]:
-    """:data:`WARM_CHAINS` as (kind, case) pairs, restricted to ``kinds``; empty chains dropped."""
+    """:data:`WARM_CHAINS` as (kind, case) pairs, restricted to ``kinds`` and the kinds they use
+    (:data:`WARM_USES`); empty chains dropped."""
     names = set(_check(kinds))
+    names |= {u for k in list(names) for u in WARM_USES.get(k, ())}
     kind_of = {c: k for k, cases in WARM_CASES.items() for c in cases}
     out = []
     for chain in WARM_CHAINS:

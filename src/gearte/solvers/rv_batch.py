@@ -405,7 +405,7 @@ def _newton(
     ``exact=False``: fixed contact stiffnesses ``kc`` — :func:`gearte.solvers.rv_equilibrium.
     _newton` on sparse rows (same steps and tests). ``exact=True``: the exact load-dependent
     pin law (tangent ``1/δ'(F)``): the fixed point of the per-contact secant iteration of
-    :func:`gearte.solvers.rv_equilibrium._solve_position` is the root of this Π's gradient, and
+    :func:`gearte.solvers.rv_equilibrium._solve_all` is the root of this Π's gradient, and
     Newton reaches it quadratically. On entry ``F``, ``d`` hold warm (force, approach) pairs of
     the law (exact only); on return ``q`` the minimiser and ``F``, ``d``, ``kt`` its forces,
     approaches and tangents. ``w``: the work arrays (:func:`_work`). Returns (iterations, ok).
@@ -586,7 +586,7 @@ def _position(
     K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, group, ngroups, law, coef, q, w, tol,
     maxit, exact,
 ):  # fmt: skip
-    """:func:`gearte.solvers.rv_equilibrium._solve_position` on sparse rows, in place.
+    """:func:`gearte.solvers.rv_equilibrium._solve_all` on sparse rows, in place.
 
     State in ``q`` (displacements) and the work arrays ``w``: ``w.k`` (per disc) and ``w.kc``
     (per contact) stiffnesses, ``w.force`` and ``w.approach`` (the last solution's contact
@@ -976,11 +976,13 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
         np.ascontiguousarray(p.bearing_c, dtype=float), p.group.astype(np.int64), p.ngroups,
         int(p.law), coef3, float(p.start_stiffness), np.ascontiguousarray(hc),
         np.ascontiguousarray(en, dtype=float), np.ascontiguousarray(gap, dtype=float),
-        np.asarray(step_g, dtype=np.int64), np.asarray(step_T, dtype=float), start, rec,
+        np.asarray(step_g, dtype=np.int64), np.array(step_T, dtype=float), start, rec,
         int((rec >= 0).sum()), np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
         np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact), gq,
         np.zeros((K, nc)), np.zeros((K, nc)), gkg, gkc, given,
     )  # fmt: skip
+    # step_T a fresh C array: solve_system passes a read-only broadcast ('A' layout), the yield
+    # a contiguous one; each compiled _solve_batch again (~7 s CPU, gear_chain's first run)
     if compiled:
         return _solve_batch(*args)
     with _TWIN_LOCK:

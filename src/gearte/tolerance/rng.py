@@ -128,9 +128,7 @@ def stream_states(seed: int | np.random.SeedSequence, streams: int = STREAMS) ->
     """
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     st = ss.generate_state(4 * streams, np.uint64).reshape(streams, 4)
-    for row in st:
-        if not row.any():  # pragma: no cover - probability 2**-256
-            row[0] = 1
+    st[~st.any(axis=1), 0] = 1  # probability 2**-256 per row
     return st
 
 
