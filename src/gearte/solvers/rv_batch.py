@@ -55,6 +55,7 @@ __all__ = [
     "problem_from_system",
     "solve_batch",
     "solve_system",
+    "solve_positions",
 ]
 
 _TWIN_LOCK = threading.Lock()
@@ -987,6 +988,38 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
         return _solve_batch(*args)
     with _TWIN_LOCK:
         return _twin(_solve_batch)(*args)
+
+
+def solve_positions(
+    system,
+    torque: float | np.ndarray,
+    law,
+    *,
+    q0: np.ndarray | None = None,
+    k0: np.ndarray | None = None,
+    tol: float = 1e-9,
+    maxit: int = 100,
+    compiled: bool = True,
+    method: str = "batched",
+):
+    """Quasi-static equilibrium at every position of ``system`` under output torque(s): the
+    solver of ``load_sharing``, ``transmission_error`` and the catalogue loop.
+
+    Parameters and result as :func:`gearte.solvers.rv_equilibrium.solve_positions`;
+    ``method``: ``"batched"`` (default, :func:`solve_system`: the positions as the steps of one
+    sample of the batched kernel, condensed, Newton on the exact law where the law is per
+    contact — the limit of the secant fixed point, equal to ``tol``) or ``"per_position"`` (the
+    dense per-position kernel, the flat reference it is tested against).
+    """
+    from gearte.solvers import rv_equilibrium
+
+    if method == "batched":
+        return solve_system(system, torque, law, q0=q0, k0=k0, tol=tol, maxit=maxit,
+                            compiled=compiled)  # fmt: skip
+    if method != "per_position":
+        raise ParameterError("method", method, "must be 'batched' or 'per_position'")
+    return rv_equilibrium.solve_positions(system, torque, law, q0=q0, k0=k0, tol=tol,
+                                          maxit=maxit, compiled=compiled)  # fmt: skip
 
 
 def solve_system(
