@@ -12,12 +12,19 @@ processes (``gearte run CASE --no-report --no-progress --timings --samples 256``
 ``--coverage`` runs, after the warm-up, every bundled case (not only one per kind) and lists any
 that still compiles a kernel: the warm-up must leave none.
 
+``--kernels N`` prints, per kind, the N kernels of the cold run with the most compile CPU of
+their own (exclusive: their callees' compiles subtracted; LLVM's re-optimisation of the callees
+linked into a caller counts for the caller) and every kernel compiled for more than one
+signature (a duplicate specialisation: a literal argument, a read-only or non-contiguous array,
+an int where a float is meant — ``docs/numba.md``).
+
 Goals (issue 12): after ``make demo`` ≤ 5 s of compile/cache load on the first run of any kind;
 cold, without warm-up, ≤ 10 s CPU per kind. The cold run is the baseline of the warm one; both
 are measured in the same invocation. CPU times, as the shared machine's load stretches wall
 times; the cold runs go ``--jobs`` at a time (default 2), which leaves their CPU times alone.
 
     python benchmarks/bench_compile.py [--kinds planetary,gear_pair] [--coverage] [--jobs 2]
+                                       [--kernels 8]
 """
 
 from __future__ import annotations
@@ -45,20 +52,27 @@ def _child_main(argv: list[str]) -> None:
     count = [0]
     cpu = [0.0]
     depth = [0]
-    starts: list[float] = []
+    starts: list[list[float]] = []  # [start CPU, CPU of the nested compiles]
+    kernels: list[tuple[str, str, float]] = []  # name, signature, exclusive CPU
 
     class Count(event.Listener):
         def on_start(self, ev: event.Event) -> None:
             depth[0] += 1
-            starts.append(time.process_time())
+            starts.append([time.process_time(), 0.0])
 
         def on_end(self, ev: event.Event) -> None:
             depth[0] -= 1
-            t0 = starts.pop()
-            if ev.data["dispatcher"].py_func.__module__.startswith("gearte"):
+            t0, nested = starts.pop()
+            dt = time.process_time() - t0
+            if starts:
+                starts[-1][1] += dt
+            f = ev.data["dispatcher"].py_func
+            if f.__module__.startswith("gearte"):
                 count[0] += 1
+                sig = ", ".join(str(a) for a in ev.data.get("args", ()))
+                kernels.append((f"{f.__module__}.{f.__qualname__}", sig, dt - nested))
             if depth[0] == 0:
-                cpu[0] += time.process_time() - t0
+                cpu[0] += dt
 
     event.register("numba:compile", Count())
     from gearte.cli import main as gearte_main
@@ -67,9 +81,10 @@ def _child_main(argv: list[str]) -> None:
         gearte_main(argv, standalone_mode=False)
     finally:
         print(f"compiled: {json.dumps({'kernels': count[0], 'cpu': cpu[0]})}", file=sys.stderr)
+        print(f"kernels: {json.dumps(kernels)}", file=sys.stderr)
 
 
-def run_cpu(args: list[str], cache: str) -> dict[str, float]:
+def run_cpu(args: list[str], cache: str) -> dict:
     """Wall s, CPU s (the child and its worker processes: ``wait4``), gearte's timings and
     numba's compiles of ``gearte ARGS`` in a fresh process with ``NUMBA_CACHE_DIR=cache``."""
     env = {**os.environ, "NUMBA_CACHE_DIR": cache}
@@ -82,13 +97,15 @@ def run_cpu(args: list[str], cache: str) -> dict[str, float]:
     wall = time.perf_counter() - w0
     if os.waitstatus_to_exitcode(status) != 0:
         raise SystemExit(f"gearte {' '.join(args)} failed:\n{err[-2000:]}{out[-500:]}")
-    res: dict[str, float] = {"wall": wall, "cpu": ru.ru_utime + ru.ru_stime}
+    res: dict = {"wall": wall, "cpu": ru.ru_utime + ru.ru_stime}
     for line in err.splitlines():
         if line.startswith("timings [s]: "):
             res.update(json.loads(line[len("timings [s]: ") :]))
         if line.startswith("compiled: "):
             c = json.loads(line[len("compiled: ") :])
             res["kernels"], res["compile_cpu"] = c["kernels"], c["cpu"]
+        if line.startswith("kernels: "):
+            res["kernel_list"] = json.loads(line[len("kernels: ") :])
     return res
 
 
@@ -99,11 +116,36 @@ def case_args(case: str, out: str) -> list[str]:
     ]
 
 
+def print_kernels(kind: str, kernels: list, n: int) -> None:
+    """The ``n`` gearte kernels of a cold run with the most exclusive compile CPU, and those
+    compiled for more than one signature."""
+    print(f"{kind}: the {n} costliest of {len(kernels)} gearte compiles (exclusive CPU s)")
+    for name, _sig, dt in sorted(kernels, key=lambda r: -r[2])[:n]:
+        print(f"  {dt:6.2f}  {name}")
+    sigs: dict[str, list[tuple[str, float]]] = {}
+    for name, sig, dt in kernels:
+        sigs.setdefault(name, []).append((sig, dt))
+    dup = {k: v for k, v in sigs.items() if len(v) > 1}
+    for name, v in dup.items():
+        print(f"  duplicate: {name} compiled {len(v)}× ({sum(d for _, d in v):.2f} s):")
+        for sig, dt in v:
+            print(f"      {dt:6.2f}  ({sig[:160]})")
+    if not dup:
+        print("  no kernel compiled for more than one signature")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--kinds", default=",".join(BENCH_CASES))
     ap.add_argument("--coverage", action="store_true", help="also run every bundled case warm")
     ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
+    ap.add_argument(
+        "--kernels",
+        type=int,
+        default=0,
+        metavar="N",
+        help="per kind, the N costliest kernels of the cold run and the duplicate specialisations",
+    )
     args = ap.parse_args()
     kinds = args.kinds.split(",")
     load0 = os.getloadavg()[0]
@@ -165,6 +207,8 @@ def main() -> None:
         f"{sum(int(warms[k].get('kernels', 0)) for k in kinds)} — "
         f"{'met' if ww <= WARM_GOAL else 'NOT met'}"
     )
+    for k in kinds[: len(kinds) if args.kernels else 0]:
+        print_kernels(k, colds[k].get("kernel_list", []), args.kernels)
     if args.coverage:
         bad = {c: r for c, r in cov.items() if r.get("kernels", 0)}
         worst = max(cov, key=lambda c: cov[c].get("numba load/compile", 0.0))

@@ -70,6 +70,10 @@ class StrictModel(BaseModel):
         strict=True,
         validate_default=True,
         str_strip_whitespace=True,
+        # validators are built on first use, not at import: importing a study kind (the report
+        # process does only that) took ~0.25 s CPU building every section's schema; importing and
+        # validating a case 0.65-0.80 -> 0.36-0.62 s (issue 12, docs/report.md)
+        defer_build=True,
     )
 
     @model_validator(mode="before")

@@ -102,8 +102,9 @@ def solve_lu_into(A, b, LU, x):
 
 @njit(cache=True, nogil=True)
 def solve_spd_into(H, b, L, x):
-    """Solve ``H x = b`` for a symmetric positive definite ``H`` by Cholesky (lower factor in
-    the work array ``L``, result in ``x``); Gaussian elimination with partial pivoting
+    """Solve ``H x = b`` for a symmetric positive definite ``H`` by Cholesky (the lower factor
+    in the work array ``L``, its diagonal stored as reciprocals: one division per column, the
+    rest multiplications; result in ``x``); Gaussian elimination with partial pivoting
     (:func:`solve_lu_into`) where a pivot is not positive."""
     n = b.shape[0]
     for j in range(n):
@@ -113,20 +114,20 @@ def solve_spd_into(H, b, L, x):
         if not s > 0.0:
             solve_lu_into(H, b, L, x)
             return
-        d = np.sqrt(s)
-        L[j, j] = d
+        r = 1.0 / np.sqrt(s)
+        L[j, j] = r
         for i in range(j + 1, n):
             t = H[i, j]
             for k in range(j):
                 t -= L[i, k] * L[j, k]
-            L[i, j] = t / d
+            L[i, j] = t * r
     for i in range(n):
         t = b[i]
         for k in range(i):
             t -= L[i, k] * x[k]
-        x[i] = t / L[i, i]
+        x[i] = t * L[i, i]
     for i in range(n - 1, -1, -1):
         t = x[i]
         for k in range(i + 1, n):
             t -= L[k, i] * x[k]
-        x[i] = t / L[i, i]
+        x[i] = t * L[i, i]

@@ -205,7 +205,9 @@ def _rk4_template(
         o = output(t0, y, args)
         _stats_update(stats, o)
         if n_env > 0:
-            _env_update(env, 0, o)
+            # bucket 0 as an int64 (0 * n_env), not the literal 0: numba compiles a kernel once
+            # per literal argument, and _env_update is called with an int64 below
+            _env_update(env, 0 * n_env, o)
         if rec_every > 0:
             if cap_t > 0:
                 trace[0] = o

@@ -55,6 +55,7 @@ __all__ = [
     "problem_from_system",
     "solve_batch",
     "solve_system",
+    "solve_positions",
 ]
 
 _TWIN_LOCK = threading.Lock()
@@ -305,7 +306,9 @@ def _assemble_rows3(cidx, cval, F, kt, H, grad):
     """:func:`_assemble`'s contact rows where each row has three columns (a disc's x, y and
     rotation): consecutive rows on the same columns are summed in registers and added to ``H``
     and ``grad`` once per run (the contacts of one disc are consecutive)."""
-    i0 = i1 = i2 = -1
+    # -1 as an int64, not a literal: numba would compile _add_block3 a second time for
+    # Literal[int](-1) columns at one of its two call sites (docs/numba.md)
+    i0 = i1 = i2 = np.int64(-1)
     g0 = g1 = g2 = h00 = h01 = h02 = h11 = h12 = h22 = 0.0
     for c in range(kt.size):
         k = kt[c]
@@ -405,7 +408,7 @@ def _newton(
     ``exact=False``: fixed contact stiffnesses ``kc`` — :func:`gearte.solvers.rv_equilibrium.
     _newton` on sparse rows (same steps and tests). ``exact=True``: the exact load-dependent
     pin law (tangent ``1/δ'(F)``): the fixed point of the per-contact secant iteration of
-    :func:`gearte.solvers.rv_equilibrium._solve_position` is the root of this Π's gradient, and
+    :func:`gearte.solvers.rv_equilibrium._solve_all` is the root of this Π's gradient, and
     Newton reaches it quadratically. On entry ``F``, ``d`` hold warm (force, approach) pairs of
     the law (exact only); on return ``q`` the minimiser and ``F``, ``d``, ``kt`` its forces,
     approaches and tangents. ``w``: the work arrays (:func:`_work`). Returns (iterations, ok).
@@ -476,7 +479,10 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     ``K0 q − f0 + Σ F_c B_c (+ bearings) = 0`` and ``δ(F_c) = d_c(q)``. Linearising the law,
     ``ΔF_c = (B_c·Δq − (δ(F_c) − d_c)) / δ'(F_c)``, and eliminating ``ΔF`` leaves the Hessian of
     :func:`_newton` with the force replaced by its tangent prediction
-    ``F̃_c = F_c + (d_c − δ(F_c))/δ'(F_c)``: one logarithm per closed contact and iteration.
+    ``F̃_c = F_c + (d_c − δ(F_c))/δ'(F_c)``. ``ln F_c`` is computed at the first iteration and
+    where a contact closes, then carried along the force updates (:func:`_log_update`: a
+    series where the force changed by less than 2⁻¹⁰ relative). The approaches follow the
+    steps (``d ← d − B Δq``) and are recomputed from ``q`` at the end.
     A contact opens where its updated force is not positive; an open one closes where its
     approach is positive (start force :func:`_law_force_start`). Converged when the step in
     ``q`` is below 1e-9 and every force moved by less than 1e-7 of the largest, with no contact
@@ -488,25 +494,33 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     """
     nd = q.size
     nc = gc.size
-    H, L, grad, dq, Ft, Bdq = w.H, w.L, w.grad, w.dq, w.Fn, w.dn
+    H, L, grad, dq, Ft, Bdq, lf = w.H, w.L, w.grad, w.dq, w.Fn, w.dn, w.ktn
     for it in range(maxit):
         changed = False
-        _rows_times(cidx, cval, q, d)
+        if it == 0:
+            _rows_times(cidx, cval, q, d)
+            for c in range(nc):
+                d[c] -= gc[c]
+        else:  # q moved by −dq: the approaches by −B dq (computed below for the forces)
+            for c in range(nc):
+                d[c] -= Bdq[c]
         for c in range(nc):
-            dc = d[c] - gc[c]
-            d[c] = dc
+            dc = d[c]
             f = F[c]
             if not f > 0.0:
                 if dc > 0.0:
                     f = _law_force_start(dc, coef[c, 0], coef[c, 1], coef[c, 2])
                     changed = True
+                    lf[c] = np.log(f)
                 else:
                     kt[c] = 0.0
                     Ft[c] = 0.0
                     F[c] = 0.0
                     continue
+            elif it == 0:
+                lf[c] = np.log(f)
             a1 = coef[c, 1]
-            rest = coef[c, 0] - a1 * np.log(f)  # δ/F = a0 − a1 ln F
+            rest = coef[c, 0] - a1 * lf[c]  # δ/F = a0 − a1 ln F
             slope = rest - a1  # δ'(F)
             if not slope > 0.0:
                 return it, False  # beyond the law's range
@@ -527,8 +541,10 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
             if kt[c] > 0.0:
                 fn = Ft[c] - kt[c] * Bdq[c]
                 if fn > 0.0:
-                    fbig = max(fbig, abs(fn - F[c]))
+                    df = fn - F[c]
+                    fbig = max(fbig, abs(df))
                     fmax = max(fmax, fn)
+                    lf[c] = _log_update(lf[c], fn, df / F[c])
                     F[c] = fn
                 else:
                     F[c] = 0.0
@@ -542,6 +558,17 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
                     kt[c] = 0.0
             return it + 1, True
     return maxit, False
+
+
+@njit(cache=True, nogil=True)
+def _log_update(lf, f, r):
+    """``ln f`` from ``lf = ln(f / (1 + r))``: ``lf + log1p(r)`` by its series where
+    ``|r| < 2⁻¹⁰`` (five terms: the first omitted, ``r⁶/6``, is below 2e-19 — under the
+    rounding of ``lf``), else ``ln f`` itself. Near convergence the forces change by far less:
+    one logarithm per closed contact and iteration becomes a few multiplications."""
+    if abs(r) < 0.0009765625:
+        return lf + r * (1.0 - r * (0.5 - r * (1.0 / 3.0 - r * (0.25 - r * 0.2))))
+    return np.log(f)
 
 
 _Work = namedtuple("_Work", "H L grad dq qn Fn dn ktn kt q0 F0 d0 f0 force approach k kc")
@@ -562,7 +589,7 @@ def _position(
     K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, group, ngroups, law, coef, q, w, tol,
     maxit, exact,
 ):  # fmt: skip
-    """:func:`gearte.solvers.rv_equilibrium._solve_position` on sparse rows, in place.
+    """:func:`gearte.solvers.rv_equilibrium._solve_all` on sparse rows, in place.
 
     State in ``q`` (displacements) and the work arrays ``w``: ``w.k`` (per disc) and ``w.kc``
     (per contact) stiffnesses, ``w.force`` and ``w.approach`` (the last solution's contact
@@ -709,12 +736,15 @@ def _solve_batch(
                 _copy(DD[u], w.approach)
                 _copy(KG[u], w.k)
                 _copy(KC[u], w.kc)
-            for a in range(nd):
-                f0[a] = T * us[g, a] - Hs[s, g, a]
-            its, ok = _position(
-                K0s[g], regs[g], f0, nidx, nvals[g], ENs[s, g], kn, cn, cidx, cvals[g],
-                GAPs[s, g], group, ngroups, law, coefs[g], q, w, tol, maxit, exact,
-            )  # fmt: skip
+            if u >= 0 and not given[t] and step_g[u] == g and step_T[u] == T:
+                its, ok = 0, True  # the same equilibrium (unique): its solution as it is
+            else:
+                for a in range(nd):
+                    f0[a] = T * us[g, a] - Hs[s, g, a]
+                its, ok = _position(
+                    K0s[g], regs[g], f0, nidx, nvals[g], ENs[s, g], kn, cn, cidx, cvals[g],
+                    GAPs[s, g], group, ngroups, law, coefs[g], q, w, tol, maxit, exact,
+                )  # fmt: skip
             if not ok:
                 iters[s, t] = -1
                 break
@@ -930,7 +960,10 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
         else np.zeros(p.coef.shape[:-1] + (3,))
     )
     h = np.asarray(h, dtype=float)
-    hc = np.matmul(cd.M[None], h[..., None])[..., 0]  # condensed loads, (S, G, m)
+    # condensed loads (S, G, m), one small product per sample and geometry: a sample's value
+    # does not depend on its place in the batch (a BLAS product over the samples rounds rows
+    # differently; equal samples must give equal results, bit for bit)
+    hc = np.matmul(cd.M[None], h[..., None])[..., 0]
     out_h = np.sum(cd.out_hrow[None] * h, axis=2)
     K = np.asarray(step_g).size
     nd, nc, ng = cd.K.shape[1], np.shape(gap)[2], p.ngroups
@@ -946,15 +979,49 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
         np.ascontiguousarray(p.bearing_c, dtype=float), p.group.astype(np.int64), p.ngroups,
         int(p.law), coef3, float(p.start_stiffness), np.ascontiguousarray(hc),
         np.ascontiguousarray(en, dtype=float), np.ascontiguousarray(gap, dtype=float),
-        np.asarray(step_g, dtype=np.int64), np.asarray(step_T, dtype=float), start, rec,
+        np.asarray(step_g, dtype=np.int64), np.array(step_T, dtype=float), start, rec,
         int((rec >= 0).sum()), np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
         np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact), gq,
         np.zeros((K, nc)), np.zeros((K, nc)), gkg, gkc, given,
     )  # fmt: skip
+    # step_T a fresh C array: solve_system passes a read-only broadcast ('A' layout), the yield
+    # a contiguous one; each compiled _solve_batch again (~7 s CPU, gear_chain's first run)
     if compiled:
         return _solve_batch(*args)
     with _TWIN_LOCK:
         return _twin(_solve_batch)(*args)
+
+
+def solve_positions(
+    system,
+    torque: float | np.ndarray,
+    law,
+    *,
+    q0: np.ndarray | None = None,
+    k0: np.ndarray | None = None,
+    tol: float = 1e-9,
+    maxit: int = 100,
+    compiled: bool = True,
+    method: str = "batched",
+):
+    """Quasi-static equilibrium at every position of ``system`` under output torque(s): the
+    solver of ``load_sharing``, ``transmission_error`` and the catalogue loop.
+
+    Parameters and result as :func:`gearte.solvers.rv_equilibrium.solve_positions`;
+    ``method``: ``"batched"`` (default, :func:`solve_system`: the positions as the steps of one
+    sample of the batched kernel, condensed, Newton on the exact law where the law is per
+    contact — the limit of the secant fixed point, equal to ``tol``) or ``"per_position"`` (the
+    dense per-position kernel, the flat reference it is tested against).
+    """
+    from gearte.solvers import rv_equilibrium
+
+    if method == "batched":
+        return solve_system(system, torque, law, q0=q0, k0=k0, tol=tol, maxit=maxit,
+                            compiled=compiled)  # fmt: skip
+    if method != "per_position":
+        raise ParameterError("method", method, "must be 'batched' or 'per_position'")
+    return rv_equilibrium.solve_positions(system, torque, law, q0=q0, k0=k0, tol=tol,
+                                          maxit=maxit, compiled=compiled)  # fmt: skip
 
 
 def solve_system(
@@ -1036,6 +1103,7 @@ def solve_system(
 _KERNELS = ("_solve_batch", "_position", "_newton", "_newton_mixed", "_energy", "_assemble",
             "_assemble_rows3", "_add_block3", "_rows_times",
             "_spd_solve", "_copy", "_rows_dot", "_law_force", "_law_force_start", "_work",
+            "_log_update",
             "_bearing_terms", "_law_delta")  # fmt: skip
 
 

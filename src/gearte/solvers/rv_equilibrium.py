@@ -19,7 +19,7 @@ coefficients (its own flank curvature). This outer fixed point is a contraction 
 stiffness varies with ``ln F``) and is iterated to a relative change below ``tol``. Positions are
 solved in sequence, each warm-started from the previous one.
 
-A compiled kernel (numba) and its plain-Python twin (``_solve_position.py_func``) run the same
+A compiled kernel (numba) and its plain-Python twin (``_solve_all.py_func``) run the same
 algorithm; :func:`solve_reference` is an independent scipy check.
 """
 
@@ -258,79 +258,21 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
 
 
 @njit(cache=True, nogil=True)
-def _solve_position(
-    K0, f0, Bn, en, kn, cn, Bc, gc, group, ngroups, law, coef, k0, kc0, q0, tol, maxit
-):
-    """One position: Newton inside, fixed point on the contact stiffness outside.
-
-    ``law``: LAW_LINEAR (``k0`` per disc, fixed), LAW_SECANT_PER_DISC (per-disc secant at the
-    disc's largest force, with that contact's coefficients) or LAW_SECANT_PER_CONTACT (``kc``
-    per contact). Returns (q, k per disc, kc per contact, forces, iterations, ok).
-    """
-    q = q0.copy()
-    k = k0.copy()
-    nc = gc.size
-    kc = np.empty(nc)
-    for c in range(nc):
-        kc[c] = kc0[c] if law == LAW_SECANT_PER_CONTACT else k[group[c]]
-    total = 0
-    qtol = 1e-13 * max(1.0, max_abs(q0))
-    for _outer in range(200):
-        q, its, ok = _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, qtol, maxit)
-        total += its
-        if not ok:
-            return q, k, kc, np.zeros(nc), total, False
-        force = np.zeros(nc)
-        for c in range(nc):
-            d = dot(Bc[c], q) - gc[c]
-            if d > 0.0:
-                force[c] = kc[c] * d
-        if law == LAW_LINEAR:
-            return q, k, kc, force, total, True
-        change = 0.0
-        if law == LAW_SECANT_PER_DISC:
-            for g in range(ngroups):
-                fmax = 0.0
-                cm = -1
-                for c in range(nc):
-                    if group[c] == g and force[c] > fmax:
-                        fmax = force[c]
-                        cm = c
-                if fmax > 0.0:
-                    if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
-                        return q, k, kc, np.zeros(nc), total, False  # beyond the law's range
-                    knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
-                    change = max(change, abs(knew / k[g] - 1.0))
-                    k[g] = knew
-            for c in range(nc):
-                kc[c] = k[group[c]]
-        else:
-            for c in range(nc):
-                if force[c] > 0.0:
-                    if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
-                        return q, k, kc, np.zeros(nc), total, False  # beyond the law's range
-                    knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
-                    change = max(change, abs(knew / kc[c] - 1.0))
-                    kc[c] = knew
-            for g in range(ngroups):  # reported per disc: the stiffest loaded contact's secant
-                kg = 0.0
-                for c in range(nc):
-                    if group[c] == g and force[c] > 0.0 and kc[c] > kg:
-                        kg = kc[c]
-                if kg > 0.0:
-                    k[g] = kg
-        if change < tol:
-            for c in range(nc):
-                d = dot(Bc[c], q) - gc[c]
-                force[c] = kc[c] * d if d > 0.0 else 0.0
-            return q, k, kc, force, total, True
-    return q, k, kc, np.zeros(nc), total, False
-
-
-@njit(cache=True, nogil=True)
 def _solve_all(
     K0s, f0s, Bns, ens, kn, cn, Bcs, gcs, group, ngroups, law, coefs, k0, q0, tol, maxit
 ):
+    """Every position in turn, each warm-started from the previous one: Newton (:func:`_newton`)
+    inside, the fixed point on the contact stiffness outside.
+
+    ``law``: LAW_LINEAR (``k0`` per disc, fixed), LAW_SECANT_PER_DISC (per-disc secant at the
+    disc's largest force, with that contact's coefficients) or LAW_SECANT_PER_CONTACT (``kc``
+    per contact). Returns (q, forces, k per disc, kc per contact, iterations) per position;
+    iterations −1 at the first position without an equilibrium (the later ones are not solved).
+
+    One kernel for the positions and the fixed point (it was two): numba links and re-optimises
+    every callee's code into each caller, so a level less saves seconds of first-run compile
+    (``docs/numba.md``).
+    """
     P = K0s.shape[0]
     nd = q0.size
     nc = gcs.shape[1]
@@ -342,24 +284,85 @@ def _solve_all(
     q = q0.copy()
     k = k0.copy()
     kc = np.empty(nc)
+    force = np.zeros(nc)
     for c in range(nc):
         kc[c] = k[group[c]]
     for p in range(P):
-        q, k, kc, f, n, ok = _solve_position(
-            K0s[p], f0s[p], Bns[p], ens[p], kn, cn, Bcs[p], gcs[p], group, ngroups, law,
-            coefs[p], k, kc, q, tol, maxit,
-        )  # fmt: skip
+        Bc = Bcs[p]
+        gc = gcs[p]
+        coef = coefs[p]
+        if law != LAW_SECANT_PER_CONTACT:
+            for c in range(nc):
+                kc[c] = k[group[c]]
+        total = 0
+        qtol = 1e-13 * max(1.0, max_abs(q))
+        ok = False
+        for _outer in range(200):
+            q, n, converged = _newton(K0s[p], f0s[p], Bns[p], ens[p], kn, cn, Bc, gc, kc, q,
+                                      qtol, maxit)  # fmt: skip
+            total += n
+            if not converged:
+                break
+            for c in range(nc):
+                d = dot(Bc[c], q) - gc[c]
+                force[c] = kc[c] * d if d > 0.0 else 0.0
+            if law == LAW_LINEAR:
+                ok = True
+                break
+            change = 0.0
+            in_range = True
+            if law == LAW_SECANT_PER_DISC:
+                for g in range(ngroups):
+                    fmax = 0.0
+                    cm = -1
+                    for c in range(nc):
+                        if group[c] == g and force[c] > fmax:
+                            fmax = force[c]
+                            cm = c
+                    if fmax > 0.0:
+                        if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
+                            in_range = False  # beyond the law's range
+                            break
+                        knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
+                        change = max(change, abs(knew / k[g] - 1.0))
+                        k[g] = knew
+                for c in range(nc):
+                    kc[c] = k[group[c]]
+            else:
+                for c in range(nc):
+                    if force[c] > 0.0:
+                        if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
+                            in_range = False  # beyond the law's range
+                            break
+                        knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
+                        change = max(change, abs(knew / kc[c] - 1.0))
+                        kc[c] = knew
+                for g in range(ngroups):  # reported per disc: the stiffest loaded contact's secant
+                    kg = 0.0
+                    for c in range(nc):
+                        if group[c] == g and force[c] > 0.0 and kc[c] > kg:
+                            kg = kc[c]
+                    if kg > 0.0:
+                        k[g] = kg
+            if not in_range:
+                break
+            if change < tol:
+                for c in range(nc):
+                    d = dot(Bc[c], q) - gc[c]
+                    force[c] = kc[c] * d if d > 0.0 else 0.0
+                ok = True
+                break
         if not ok:
             its[p] = -1
             return Q, F, Ks, KC, its
         for a in range(nd):
             Q[p, a] = q[a]
         for c in range(nc):
-            F[p, c] = f[c]
+            F[p, c] = force[c]
             KC[p, c] = kc[c]
         for g in range(ngroups):
             Ks[p, g] = k[g]
-        its[p] = n
+        its[p] = total
     return Q, F, Ks, KC, its
 
 
@@ -412,9 +415,10 @@ def solve_positions(
     tol: float = 1e-9,
     maxit: int = 100,
     compiled: bool = True,
-    method: str = "batched",
 ) -> EquilibriumSolution:
-    """Quasi-static equilibrium at every position of ``system`` under output torque(s).
+    """Quasi-static equilibrium at every position of ``system`` under output torque(s), by the
+    dense per-position kernel (the secant fixed point around an active-set Newton): the flat
+    reference of :func:`gearte.solvers.rv_batch.solve_positions`, which the models call.
 
     Parameters
     ----------
@@ -432,26 +436,11 @@ def solve_positions(
         Most fixed-point iterations per position [-].
     compiled : bool
         ``False`` runs the plain-Python twin of the same kernel (for tests).
-    method : str
-        ``"batched"`` (default): the positions as the steps of one sample of the batched kernel
-        (:func:`gearte.solvers.rv_batch.solve_system`: condensed onto the degrees of freedom
-        the contacts and clearance bearings touch, Newton on the exact law where the law is per
-        contact — the limit of the secant fixed point, equal to ``tol``); ``"per_position"``:
-        the dense per-position kernel of this module (the secant fixed point around an
-        active-set Newton; the flat reference the batched kernel is tested against).
-
     Raises
     ------
     ConvergenceError
         If Newton or the stiffness fixed point fails at some position.
     """
-    if method == "batched":
-        from gearte.solvers.rv_batch import solve_system
-
-        return solve_system(system, torque, law, q0=q0, k0=k0, tol=tol, maxit=maxit,
-                            compiled=compiled)  # fmt: skip
-    if method != "per_position":
-        raise ParameterError("method", method, "must be 'batched' or 'per_position'")
     P = system.theta.size
     law = as_solver_law(law, system)
     torque = np.broadcast_to(np.asarray(torque, dtype=float), (P,))
@@ -471,7 +460,7 @@ def solve_positions(
         # lock for the duration of the call; compiled callers do not look these names up)
         g = _solve_all.py_func.__globals__
         _TWIN_LOCK.acquire()
-        saved = {n: g[n] for n in ("_solve_position", "_newton", "_energy", "_law_delta")}
+        saved = {n: g[n] for n in ("_newton", "_energy", "_law_delta")}
         for n in saved:
             g[n] = saved[n].py_func
         try:
