@@ -306,7 +306,9 @@ def _assemble_rows3(cidx, cval, F, kt, H, grad):
     """:func:`_assemble`'s contact rows where each row has three columns (a disc's x, y and
     rotation): consecutive rows on the same columns are summed in registers and added to ``H``
     and ``grad`` once per run (the contacts of one disc are consecutive)."""
-    i0 = i1 = i2 = -1
+    # -1 as an int64, not a literal: numba would compile _add_block3 a second time for
+    # Literal[int](-1) columns at one of its two call sites (docs/numba.md)
+    i0 = i1 = i2 = np.int64(-1)
     g0 = g1 = g2 = h00 = h01 = h02 = h11 = h12 = h22 = 0.0
     for c in range(kt.size):
         k = kt[c]
