@@ -1007,11 +1007,31 @@ def solve_positions(
     """Quasi-static equilibrium at every position of ``system`` under output torque(s): the
     solver of ``load_sharing``, ``transmission_error`` and the catalogue loop.
 
-    Parameters and result as :func:`gearte.solvers.rv_equilibrium.solve_positions`;
-    ``method``: ``"batched"`` (default, :func:`solve_system`: the positions as the steps of one
-    sample of the batched kernel, condensed, Newton on the exact law where the law is per
-    contact — the limit of the secant fixed point, equal to ``tol``) or ``"per_position"`` (the
-    dense per-position kernel, the flat reference it is tested against).
+    Result as :func:`gearte.solvers.rv_equilibrium.solve_positions`.
+
+    Parameters
+    ----------
+    system : gearte.models.rv_load_sharing.RVSystem
+        Spring and contact rows at ``P`` positions.
+    torque : float or numpy.ndarray
+        Output load torque, scalar or (P,) [N·mm].
+    law : ContactLaw or a model-level law with ``for_system(system)``
+        Pin-contact law.
+    q0 : numpy.ndarray, optional
+        Warm start of the first position: displacements [mm, rad].
+    k0 : numpy.ndarray, optional
+        Warm start of the first position: per-disc contact stiffness [N/mm].
+    tol : float
+        Relative tolerance of the contact-stiffness fixed point [-].
+    maxit : int
+        Most Newton iterations per solve [-].
+    compiled : bool
+        ``False`` runs the plain-Python twin [-].
+    method : str
+        ``"batched"`` (default, :func:`solve_system`: the positions as the steps of one sample
+        of the batched kernel, condensed, Newton on the exact law where the law is per contact
+        — the limit of the secant fixed point, equal to ``tol``) or ``"per_position"`` (the
+        dense per-position kernel, the flat reference it is tested against) [-].
     """
     from gearte.solvers import rv_equilibrium
 
@@ -1046,6 +1066,25 @@ def solve_system(
     contact's secant stiffness is ``F/δ(F) = 1/(a0 − a1 ln F)`` where it is loaded, an open
     contact keeps its last loaded value (as the per-case fixed point), and the per-disc value is
     the stiffest loaded contact's.
+
+    Parameters
+    ----------
+    system : gearte.models.rv_load_sharing.RVSystem
+        Spring and contact rows at ``P`` positions.
+    torque : float or numpy.ndarray
+        Output load torque, scalar or (P,) [N·mm].
+    law : ContactLaw or a model-level law with ``for_system(system)``
+        Pin-contact law.
+    q0 : numpy.ndarray, optional
+        Warm start of the first position: displacements [mm, rad].
+    k0 : numpy.ndarray, optional
+        Warm start of the first position: per-disc contact stiffness [N/mm].
+    tol : float
+        Relative tolerance of the contact-stiffness fixed point [-].
+    maxit : int
+        Most Newton iterations per solve [-].
+    compiled : bool
+        ``False`` runs the plain-Python twin [-].
 
     Raises
     ------
