@@ -10,7 +10,7 @@ baseline, a numpy active-set Newton vectorised over all 360 positions at once (d
 batched ``np.matmul`` Hessians and ``np.linalg.solve``, masks for the positions still iterating;
 ``benchmarks/_numpy_rv.py``), with the per-contact secant fixed point (the per-case algorithm)
 and with Newton on the exact law (the batched kernel's algorithm); against gearte's
-:func:`gearte.solvers.rv_equilibrium.solve_positions` — the path ``load_sharing`` and so
+:func:`gearte.solvers.rv_batch.solve_positions` — the path ``load_sharing`` and so
 ``gearte run`` of an rv_reducer case take: the positions as the steps of one sample of the
 batched kernel (condensed onto the disc degrees of freedom, exact law, warm-started along the
 positions), its set-up from the assembled system included — its former dense per-position
@@ -39,11 +39,14 @@ from _numpy_rv import Systems, dense_rows  # noqa: E402
 from _numpy_rv import solve as numpy_solve  # noqa: E402
 from gearte.io.case_file import load_case  # noqa: E402
 from gearte.models.rv_load_sharing import assemble, contact_law, output_positions  # noqa: E402
-from gearte.solvers.rv_batch import problem_from_system, solve_batch  # noqa: E402
+from gearte.solvers.rv_batch import (  # noqa: E402
+    problem_from_system,
+    solve_batch,
+    solve_positions,
+)
 from gearte.solvers.rv_equilibrium import (  # noqa: E402
     _law_delta,
     _linear_parts,
-    solve_positions,
 )
 from gearte.studies.rv_reducer import build_reducer  # noqa: E402
 

@@ -15,7 +15,7 @@ every worker thread, so the CPU ratio is per core — and wall):
   same reduction as gearte's (sums of ``y − mean`` and of its square, extremes, the same
   4000-bin histogram), in two codings: gearte's numpy twin ``reduce_samples`` (fresh arrays),
   and a tuned one (buffers allocated once, ``standard_normal(out=…)``, in-place arithmetic,
-  the sum of squares as a BLAS ``dot``, ``bincount`` of the clipped bins). Its speed depends on
+  the sum of squares by ``einsum``, ``bincount`` of the clipped bins). Its speed depends on
   the chunk size, so the tuned coding is scanned over chunk sizes and timed at its best one and
   at gearte's default (10⁶); the goal (issue 12, ≥ 5× per core) is judged against the faster
   coding at each of the two sizes;
@@ -92,7 +92,8 @@ def numpy_grouped(stack: LinearStack, n: int, seed: int, chunk: int = 1_000_000)
 
 def numpy_tuned(stack: LinearStack, n: int, seed: int, chunk: int = 1_000_000) -> float:
     """Strong numpy baseline, tuned: one vectorised normal per sample into buffers allocated
-    once, in-place arithmetic, the sum of squares as a BLAS ``dot``, the histogram of
+    once, in-place arithmetic, the sum of squares by ``einsum`` (no temporary; single-threaded,
+    unlike a BLAS ``dot``), the histogram of
     :func:`reduce_samples` (same bin formula) by ``bincount``; extremes too. Returns the mean
     [mm]."""
     mu, sd = stack.mean, stack.sd
@@ -114,7 +115,7 @@ def numpy_tuned(stack: LinearStack, n: int, seed: int, chunk: int = 1_000_000) -
         ym += mu
         np.subtract(ym, mu, out=dm)
         s1 += float(dm.sum())
-        s2 += float(np.dot(dm, dm))
+        s2 += float(np.einsum("i,i->", dm, dm))  # one thread (a BLAS dot may start more)
         mn, mx = min(mn, float(ym.min())), max(mx, float(ym.max()))
         np.subtract(ym, lo, out=dm)
         dm *= inv

@@ -113,7 +113,7 @@ def test_solve_positions_batched_equals_the_per_position_solver(law_name, cleara
     secant stiffness and the per-disc stiffness to 1e-9 relative (the fixed point's tolerance),
     cold and warm-started; the plain-Python twin of the batched path to round-off."""
     from gearte.models.rv_load_sharing import assemble, contact_law, output_positions, solver_law
-    from gearte.solvers.rv_equilibrium import solve_positions
+    from gearte.solvers.rv_batch import solve_positions
 
     red = _reducer(clearance_um)
     system = assemble(red, output_positions(5))

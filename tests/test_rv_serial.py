@@ -149,7 +149,7 @@ def test_reproducer_serial_te_at_default_zero_load_fraction_with_measured_cleara
     nearest it. The equilibrium is unique, so the result is the old sweep's with a 10× longer
     Newton budget, to round-off."""
     from gearte.models import rv_load_sharing as ls
-    from gearte.solvers.rv_equilibrium import solve_positions
+    from gearte.solvers.rv_batch import solve_positions
     from gearte.studies.rv_serial import build_serial
 
     case = load_case(case_path("synthetic_rv110e_serial"))

@@ -34,7 +34,8 @@ from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer
 from gearte.models.catalogue import ZERO_TORQUE_FRACTION, hysteresis_values
 from gearte.models.rv_load_sharing import PinContactLaw, assemble, contact_law, solver_law
-from gearte.solvers.rv_equilibrium import ContactLaw, solve_positions
+from gearte.solvers.rv_batch import solve_positions
+from gearte.solvers.rv_equilibrium import ContactLaw
 
 __all__ = [
     "TorsionTest",

@@ -54,11 +54,11 @@ from gearte.models.contact_law import (
     log_law_coefficients,
     max_contact_pressure,
 )
+from gearte.solvers.rv_batch import solve_positions
 from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
     ContactLaw,
     as_solver_law,
-    solve_positions,
 )
 
 __all__ = [

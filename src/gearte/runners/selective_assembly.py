@@ -54,7 +54,8 @@ from gearte.models.rv_load_sharing import (
     load_sharing,
     solver_law,
 )
-from gearte.solvers.rv_equilibrium import CLEARANCE_RESIDUAL, solve_positions
+from gearte.solvers.rv_batch import solve_positions
+from gearte.solvers.rv_equilibrium import CLEARANCE_RESIDUAL
 
 __all__ = [
     "Lot",

@@ -64,8 +64,19 @@ def nm_start(
     ist: np.ndarray,
 ) -> None:
     """Initial simplex around ``x0`` (SciPy's: 5 % along each axis, 0.00025 where a coordinate
-    is 0); the first point to evaluate in ``vec[2]``; at most ``maxiter`` [-] iterations. Plain
-    numpy (called once per start, nothing to compile)."""
+    is 0) and the first point to evaluate in ``vec[2]``. Plain numpy (called once per start,
+    nothing to compile).
+
+    Parameters
+    ----------
+    x0 : ndarray, shape (N,)
+        Start point [the objective's units].
+    maxiter : int
+        Iterations at most [-].
+    sim, fsim, vec, ist : ndarray
+        The state arrays of the module docstring, filled here (shapes (N + 1, N), (N + 2,),
+        (4, N), (4,) int64) [the point's, the objective's, the point's units; counters -].
+    """
     N = x0.shape[0]
     sim[:] = x0
     for k in range(1, N + 1):
@@ -84,7 +95,18 @@ def nm_tell(f, xatol, fatol, sim, fsim, vec, ist):
 
     Phases (``ist[0]``): 0 initial vertex ``ist[1]``, 1 reflection, 2 expansion, 3 outside /
     4 inside contraction, 5 shrunk vertex ``ist[1]``. Each step (replace the worst vertex, sort,
-    test, next trial point) is written once: every call site of a helper compiles a copy."""
+    test, next trial point) is written once: every call site of a helper compiles a copy.
+
+    Parameters
+    ----------
+    f : float
+        The objective at ``vec[2]`` [the objective's units].
+    xatol, fatol : float
+        SciPy's absolute tolerances on the vertices [the point's units] and on their values
+        [the objective's units].
+    sim, fsim, vec, ist : ndarray
+        The state arrays of the module docstring, from :func:`nm_start`, updated in place.
+    """
     N = sim.shape[1]
     dim = float(N)
     rho = 1.0
@@ -189,7 +211,15 @@ def nm_tell(f, xatol, fatol, sim, fsim, vec, ist):
 
 
 def nm_best(fsim: np.ndarray, N: int) -> float:
-    """The smallest of the N + 1 vertex values (plain Python: called once per run)."""
+    """The smallest of the N + 1 vertex values (plain Python: called once per run).
+
+    Parameters
+    ----------
+    fsim : ndarray, shape (N + 2,)
+        The vertex values of the state (module docstring) [the objective's units].
+    N : int
+        Dimension [-].
+    """
     best = float(fsim[0])
     for k in range(1, N + 1):
         best = min(best, float(fsim[k]))

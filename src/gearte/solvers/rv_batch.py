@@ -55,6 +55,7 @@ __all__ = [
     "problem_from_system",
     "solve_batch",
     "solve_system",
+    "solve_positions",
 ]
 
 _TWIN_LOCK = threading.Lock()
@@ -305,7 +306,9 @@ def _assemble_rows3(cidx, cval, F, kt, H, grad):
     """:func:`_assemble`'s contact rows where each row has three columns (a disc's x, y and
     rotation): consecutive rows on the same columns are summed in registers and added to ``H``
     and ``grad`` once per run (the contacts of one disc are consecutive)."""
-    i0 = i1 = i2 = -1
+    # -1 as an int64, not a literal: numba would compile _add_block3 a second time for
+    # Literal[int](-1) columns at one of its two call sites (docs/numba.md)
+    i0 = i1 = i2 = np.int64(-1)
     g0 = g1 = g2 = h00 = h01 = h02 = h11 = h12 = h22 = 0.0
     for c in range(kt.size):
         k = kt[c]
@@ -989,6 +992,58 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
         return _twin(_solve_batch)(*args)
 
 
+def solve_positions(
+    system,
+    torque: float | np.ndarray,
+    law,
+    *,
+    q0: np.ndarray | None = None,
+    k0: np.ndarray | None = None,
+    tol: float = 1e-9,
+    maxit: int = 100,
+    compiled: bool = True,
+    method: str = "batched",
+):
+    """Quasi-static equilibrium at every position of ``system`` under output torque(s): the
+    solver of ``load_sharing``, ``transmission_error`` and the catalogue loop.
+
+    Result as :func:`gearte.solvers.rv_equilibrium.solve_positions`.
+
+    Parameters
+    ----------
+    system : gearte.models.rv_load_sharing.RVSystem
+        Spring and contact rows at ``P`` positions.
+    torque : float or numpy.ndarray
+        Output load torque, scalar or (P,) [N·mm].
+    law : ContactLaw or a model-level law with ``for_system(system)``
+        Pin-contact law.
+    q0 : numpy.ndarray, optional
+        Warm start of the first position: displacements [mm, rad].
+    k0 : numpy.ndarray, optional
+        Warm start of the first position: per-disc contact stiffness [N/mm].
+    tol : float
+        Relative tolerance of the contact-stiffness fixed point [-].
+    maxit : int
+        Most Newton iterations per solve [-].
+    compiled : bool
+        ``False`` runs the plain-Python twin [-].
+    method : str
+        ``"batched"`` (default, :func:`solve_system`: the positions as the steps of one sample
+        of the batched kernel, condensed, Newton on the exact law where the law is per contact
+        — the limit of the secant fixed point, equal to ``tol``) or ``"per_position"`` (the
+        dense per-position kernel, the flat reference it is tested against) [-].
+    """
+    from gearte.solvers import rv_equilibrium
+
+    if method == "batched":
+        return solve_system(system, torque, law, q0=q0, k0=k0, tol=tol, maxit=maxit,
+                            compiled=compiled)  # fmt: skip
+    if method != "per_position":
+        raise ParameterError("method", method, "must be 'batched' or 'per_position'")
+    return rv_equilibrium.solve_positions(system, torque, law, q0=q0, k0=k0, tol=tol,
+                                          maxit=maxit, compiled=compiled)  # fmt: skip
+
+
 def solve_system(
     system,
     torque: float | np.ndarray,
@@ -1011,6 +1066,25 @@ def solve_system(
     contact's secant stiffness is ``F/δ(F) = 1/(a0 − a1 ln F)`` where it is loaded, an open
     contact keeps its last loaded value (as the per-case fixed point), and the per-disc value is
     the stiffest loaded contact's.
+
+    Parameters
+    ----------
+    system : gearte.models.rv_load_sharing.RVSystem
+        Spring and contact rows at ``P`` positions.
+    torque : float or numpy.ndarray
+        Output load torque, scalar or (P,) [N·mm].
+    law : ContactLaw or a model-level law with ``for_system(system)``
+        Pin-contact law.
+    q0 : numpy.ndarray, optional
+        Warm start of the first position: displacements [mm, rad].
+    k0 : numpy.ndarray, optional
+        Warm start of the first position: per-disc contact stiffness [N/mm].
+    tol : float
+        Relative tolerance of the contact-stiffness fixed point [-].
+    maxit : int
+        Most Newton iterations per solve [-].
+    compiled : bool
+        ``False`` runs the plain-Python twin [-].
 
     Raises
     ------

@@ -415,9 +415,10 @@ def solve_positions(
     tol: float = 1e-9,
     maxit: int = 100,
     compiled: bool = True,
-    method: str = "batched",
 ) -> EquilibriumSolution:
-    """Quasi-static equilibrium at every position of ``system`` under output torque(s).
+    """Quasi-static equilibrium at every position of ``system`` under output torque(s), by the
+    dense per-position kernel (the secant fixed point around an active-set Newton): the flat
+    reference of :func:`gearte.solvers.rv_batch.solve_positions`, which the models call.
 
     Parameters
     ----------
@@ -435,26 +436,11 @@ def solve_positions(
         Most fixed-point iterations per position [-].
     compiled : bool
         ``False`` runs the plain-Python twin of the same kernel (for tests).
-    method : str
-        ``"batched"`` (default): the positions as the steps of one sample of the batched kernel
-        (:func:`gearte.solvers.rv_batch.solve_system`: condensed onto the degrees of freedom
-        the contacts and clearance bearings touch, Newton on the exact law where the law is per
-        contact — the limit of the secant fixed point, equal to ``tol``); ``"per_position"``:
-        the dense per-position kernel of this module (the secant fixed point around an
-        active-set Newton; the flat reference the batched kernel is tested against).
-
     Raises
     ------
     ConvergenceError
         If Newton or the stiffness fixed point fails at some position.
     """
-    if method == "batched":
-        from gearte.solvers.rv_batch import solve_system
-
-        return solve_system(system, torque, law, q0=q0, k0=k0, tol=tol, maxit=maxit,
-                            compiled=compiled)  # fmt: skip
-    if method != "per_position":
-        raise ParameterError("method", method, "must be 'batched' or 'per_position'")
     P = system.theta.size
     law = as_solver_law(law, system)
     torque = np.broadcast_to(np.asarray(torque, dtype=float), (P,))

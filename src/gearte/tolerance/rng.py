@@ -196,7 +196,13 @@ def zig_slow(x, idx, v, t0, t1, t2, t3, k, w, f):  # pragma: no cover - compiled
 
 def lane_states(states: np.ndarray) -> np.ndarray:
     """The main streams' states of a chunk as ``(4, LANES)`` uint64, one row per state word
-    (the layout the SIMD step reads), from the rows ``0 … LANES−1`` of ``states``."""
+    (the layout the SIMD step reads).
+
+    Parameters
+    ----------
+    states : np.ndarray
+        The chunk's stream states [-] (:func:`stream_states`); rows ``0 … LANES−1`` are used.
+    """
     return np.ascontiguousarray(states[:LANES].T)
 
 
@@ -224,8 +230,23 @@ def normals_block(z, m, raw, rej, lanes, st, k, w, f):  # pragma: no cover - com
     Main numbers from the interleaved main streams (``lanes``, advanced), the ziggurat's fast
     path over the whole block (branch-free: it lists the ≈ 1.2 % rejected draws), then the
     rejected ones redrawn in sample order from the tail stream ``st[TAIL]`` (advanced), so the
-    tail stream is read as it would be one sample at a time. ``raw`` and ``rej`` are work
-    arrays of ``m`` rounded up to ``LANES``."""
+    tail stream is read as it would be one sample at a time.
+
+    Parameters
+    ----------
+    z : np.ndarray
+        Output, at least ``m`` long [-].
+    m : int
+        Number of normals [-].
+    raw, rej : np.ndarray
+        Work arrays (uint64, int64) of at least ``m`` rounded up to ``LANES`` [-].
+    lanes : np.ndarray
+        The main streams' states, ``(4, LANES)`` uint64 (:func:`lane_states`) [-].
+    st : np.ndarray
+        The chunk's stream states (:func:`stream_states`); row ``TAIL`` advances [-].
+    k, w, f : np.ndarray
+        The ziggurat tables (:class:`ZigguratTables`) [-].
+    """
     fill_u64(raw, m, lanes)
     nr = 0
     for j in range(m):
@@ -319,7 +340,15 @@ def _fast_ref(r: int, t: ZigguratTables) -> tuple[float, bool, int, int]:
 
 def reference_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
     """Plain twin of :func:`standard_normals`: sample ``j`` from main stream ``j % LANES``
-    (:func:`reference_normal`), rejections from the tail stream, one sample at a time."""
+    (:func:`reference_normal`), rejections from the tail stream, one sample at a time.
+
+    Parameters
+    ----------
+    seed : int or SeedSequence
+        Seed of the streams (:func:`stream_states`).
+    n : int
+        How many numbers [-].
+    """
     st = stream_states(seed)
     mains = [Xoshiro256pp(row) for row in st[:LANES]]
     tail = Xoshiro256pp(st[TAIL])
