@@ -506,22 +506,28 @@ class MCResult:
         return self.below_fraction + self.above_fraction
 
 
-def _percentile_from_hist(
-    q: float, counts: np.ndarray, lo: float, hi: float, mn: float, mx: float
-) -> float:
+def _percentiles_from_hist(
+    qs: Sequence[float], counts: np.ndarray, lo: float, hi: float, mn: float, mx: float
+) -> dict[float, float]:
+    """The values at the percent levels ``qs``, interpolated in the histogram (edges and
+    cumulative counts built once for all levels)."""
     nbins = counts.size - 2
     n = counts.sum()
-    target = q / 100.0 * n
     edges = np.concatenate([[min(mn, lo)], np.linspace(lo, hi, nbins + 1), [max(mx, hi)]])
     cum = np.concatenate([[0], np.cumsum(counts)])
-    k = int(np.searchsorted(cum, target, side="left"))
-    k = min(max(k, 1), counts.size)
-    c0, c1 = cum[k - 1], cum[k]
-    left, right = edges[k - 1], edges[k]
-    if c1 == c0:
-        return float(left)
-    val = left + (target - c0) / (c1 - c0) * (right - left)
-    return float(min(max(val, mn), mx))
+    out = {}
+    for q in qs:
+        target = q / 100.0 * n
+        k = int(np.searchsorted(cum, target, side="left"))
+        k = min(max(k, 1), counts.size)
+        c0, c1 = cum[k - 1], cum[k]
+        left, right = edges[k - 1], edges[k]
+        if c1 == c0:
+            out[float(q)] = float(left)
+            continue
+        val = left + (target - c0) / (c1 - c0) * (right - left)
+        out[float(q)] = float(min(max(val, mn), mx))
+    return out
 
 
 def _map_chunks(func, tasks: Sequence[Any], *, options: Any, progress: bool, description: str):
@@ -667,10 +673,7 @@ def monte_carlo(
     mean = centre + total.s1 / total.n
     var = max(total.s2 - total.s1**2 / total.n, 0.0) / (total.n - 1)
     sd = math.sqrt(var)
-    pct = {
-        float(q): _percentile_from_hist(q, total.counts, lo, hi, total.min, total.max)
-        for q in percentiles
-    }
+    pct = _percentiles_from_hist(percentiles, total.counts, lo, hi, total.min, total.max)
     cp, cpk = process_capability(mean, sd, lower_spec, upper_spec)
     return MCResult(
         n=total.n,
