@@ -155,6 +155,27 @@ def _fill_block(
 # in the low bits of the double: the bin loop stays in floating point (vectorised) and the
 # histogram loop reads the index from the bits.
 _BIN_OFFSET = 1.0 + 2.0**52
+
+
+@njit(inline="always")
+def _bin(y, lo, inv_width, top):  # pragma: no cover - compiled
+    """Histogram bin + 1 of ``y`` as the low bits of a double (no branch: vector registers)."""
+    t = (y - lo) * inv_width
+    t = t if t > -1.0 else -1.0
+    t = t if t < top else top
+    return math.floor(t) + _BIN_OFFSET
+
+
+@njit(inline="always")
+def _min(a, b):  # pragma: no cover - compiled
+    return a if a < b else b
+
+
+@njit(inline="always")
+def _max(a, b):  # pragma: no cover - compiled
+    return a if a > b else b
+
+
 _BIN_MASK = uint64(0xFFFFFFFF)
 _FLUSH = 1 << 30  # samples between additions of the int32 counts into the int64 ones
 
@@ -169,9 +190,10 @@ def _linear_stack_kernel(
 
     Per full block of ``_BLOCK`` samples, the sums of ``y − shift`` and of its square and the
     extremes by a fixed pairwise tree (elementwise loops LLVM runs on vector registers; the
-    tree depends on nothing but the block, so neither do the sums); a chunk's last, partial
-    block in order. The histogram bin (the formula of :func:`reduce_samples`) in a vector
-    loop, then the counts; the out-of-spec counts (only with a finite limit) in a vector loop
+    tree depends on nothing but the block, so neither do the sums) whose first three levels
+    run in registers, eight samples per step, with the histogram bins of those samples (the
+    formula of :func:`reduce_samples`); a chunk's last, partial block in order. Then the
+    counts; the out-of-spec counts (only with a finite limit) in a vector loop
     of integer sums."""
     st = states.copy()
     lanes = lanes0.copy()
@@ -211,16 +233,26 @@ def _linear_stack_kernel(
         for j in range(min(m, keep - done)):
             kept[done + j] = z[j]
         if m == _BLOCK:  # pairwise (a fixed tree): elementwise loops, vector registers
-            h = _BLOCK // 2
-            for j in range(h):
-                u = z[j]
-                v = z[j + h]
-                d0 = u - shift
-                d1 = v - shift
-                e1[j] = d0 + d1
-                e2[j] = d0 * d0 + d1 * d1
-                emn[j] = u if u < v else v
-                emx[j] = u if u > v else v
+            h = _BLOCK // 8
+            for j in range(h):  # the first three levels in registers: samples j + i·h, i < 8
+                y0, y1, y2, y3 = z[j], z[j + h], z[j + 2 * h], z[j + 3 * h]
+                y4, y5, y6, y7 = z[j + 4 * h], z[j + 5 * h], z[j + 6 * h], z[j + 7 * h]
+                d0, d1, d2, d3 = y0 - shift, y1 - shift, y2 - shift, y3 - shift
+                d4, d5, d6, d7 = y4 - shift, y5 - shift, y6 - shift, y7 - shift
+                e1[j] = ((d0 + d4) + (d2 + d6)) + ((d1 + d5) + (d3 + d7))
+                e2[j] = ((d0 * d0 + d4 * d4) + (d2 * d2 + d6 * d6)) + (
+                    (d1 * d1 + d5 * d5) + (d3 * d3 + d7 * d7)
+                )
+                emn[j] = _min(_min(_min(y0, y4), _min(y2, y6)), _min(_min(y1, y5), _min(y3, y7)))
+                emx[j] = _max(_max(_max(y0, y4), _max(y2, y6)), _max(_max(y1, y5), _max(y3, y7)))
+                fbin[j] = _bin(y0, lo, inv_width, top)
+                fbin[j + h] = _bin(y1, lo, inv_width, top)
+                fbin[j + 2 * h] = _bin(y2, lo, inv_width, top)
+                fbin[j + 3 * h] = _bin(y3, lo, inv_width, top)
+                fbin[j + 4 * h] = _bin(y4, lo, inv_width, top)
+                fbin[j + 5 * h] = _bin(y5, lo, inv_width, top)
+                fbin[j + 6 * h] = _bin(y6, lo, inv_width, top)
+                fbin[j + 7 * h] = _bin(y7, lo, inv_width, top)
             while h > 1:
                 h //= 2
                 for j in range(h):
@@ -240,11 +272,7 @@ def _linear_stack_kernel(
                 s2 += d0 * d0
                 mn = y if y < mn else mn
                 mx = y if y > mx else mx
-        for j in range(m):  # bin + 1 as the low bits of a double (no branch: vector registers)
-            t = (z[j] - lo) * inv_width
-            t = t if t > -1.0 else -1.0
-            t = t if t < top else top
-            fbin[j] = math.floor(t) + _BIN_OFFSET
+                fbin[j] = _bin(y, lo, inv_width, top)
         for j in range(m):
             c32[ibin[j] & _BIN_MASK] += 1  # 0 underflow, nbins + 1 overflow
         if specs:  # integer sums of comparisons: vector registers
