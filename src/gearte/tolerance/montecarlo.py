@@ -74,7 +74,7 @@ DEFAULT_BINS = 4000
 # DRAWS — the other contributors, in order. Each sample takes exactly one main number, so the
 # kernel draws them in blocks of _BLOCK and the samples do not depend on the block size. Codes:
 # see distributions.KERNEL_CODES.
-_BLOCK = 1024  # a power of two (the pairwise sums) and a multiple of LANES
+_BLOCK = 1024  # a power of two ≥ 512 (the pairwise tree folds 8 and 8) and a multiple of LANES
 
 
 def _group(codes: np.ndarray, params: np.ndarray, sens: np.ndarray) -> tuple[float, float, bool]:
@@ -192,9 +192,9 @@ def _linear_stack_kernel(
     extremes by a fixed pairwise tree (elementwise loops LLVM runs on vector registers; the
     tree depends on nothing but the block, so neither do the sums) whose first three levels
     run in registers, eight samples per step, with the histogram bins of those samples (the
-    formula of :func:`reduce_samples`); a chunk's last, partial block in order. Then the
-    counts; the out-of-spec counts (only with a finite limit) in a vector loop
-    of integer sums."""
+    formula of :func:`reduce_samples`), and the next three levels likewise; a chunk's last,
+    partial block in order. Then the counts; the out-of-spec counts (only with a finite
+    limit) in a vector loop of integer sums."""
     st = states.copy()
     lanes = lanes0.copy()
     counts = np.zeros(nbins + 2, np.int64)
@@ -253,7 +253,23 @@ def _linear_stack_kernel(
                 fbin[j + 5 * h] = _bin(y5, lo, inv_width, top)
                 fbin[j + 6 * h] = _bin(y6, lo, inv_width, top)
                 fbin[j + 7 * h] = _bin(y7, lo, inv_width, top)
-            while h > 1:
+            h = h // 8
+            for j in range(h):  # the next three levels: entries j + i·h, i < 8
+                e1[j] = ((e1[j] + e1[j + 4 * h]) + (e1[j + 2 * h] + e1[j + 6 * h])) + (
+                    (e1[j + h] + e1[j + 5 * h]) + (e1[j + 3 * h] + e1[j + 7 * h])
+                )
+                e2[j] = ((e2[j] + e2[j + 4 * h]) + (e2[j + 2 * h] + e2[j + 6 * h])) + (
+                    (e2[j + h] + e2[j + 5 * h]) + (e2[j + 3 * h] + e2[j + 7 * h])
+                )
+                emn[j] = _min(
+                    _min(_min(emn[j], emn[j + 4 * h]), _min(emn[j + 2 * h], emn[j + 6 * h])),
+                    _min(_min(emn[j + h], emn[j + 5 * h]), _min(emn[j + 3 * h], emn[j + 7 * h])),
+                )
+                emx[j] = _max(
+                    _max(_max(emx[j], emx[j + 4 * h]), _max(emx[j + 2 * h], emx[j + 6 * h])),
+                    _max(_max(emx[j + h], emx[j + 5 * h]), _max(emx[j + 3 * h], emx[j + 7 * h])),
+                )
+            while h > 1:  # the last four levels
                 h //= 2
                 for j in range(h):
                     e1[j] += e1[j + h]
