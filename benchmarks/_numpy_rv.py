@@ -13,6 +13,14 @@ iterating. Two contact-stiffness schemes:
   Newton) — the algorithm of gearte's batched kernel;
 * ``"secant"``: the per-contact secant fixed point around the active-set Newton with frozen
   stiffness — the algorithm of gearte's per-case solver.
+
+:func:`solve_batch_numpy` (the yield benchmark's baseline) runs the algorithm of gearte's
+batched kernel step for step: the problem condensed onto the degrees of freedom the contacts
+touch (gearte's own :func:`~gearte.solvers.rv_batch.condense`, once per plan), Newton on the
+equilibrium and the pin law together (:func:`newton_mixed`, gearte's ``_newton_mixed``: one
+logarithm per closed contact and iteration, no line search, no inner law solves) with its
+stopping rule, falling back to the line-searched Newton on Π (:func:`newton`) for the samples
+that do not converge in 30 iterations — as the kernel does.
 """
 
 from __future__ import annotations
@@ -218,12 +226,129 @@ def dense_rows(sparse, nd):
     return out
 
 
+def law_force_start(d, a0, a1):
+    """One-term estimate of the force at approach ``d > 0`` (gearte's ``_law_force_start``)."""
+    fstar = a1 * 0.0 + np.exp(np.minimum((a0 - a1) / a1, 700.0))
+    den = a0 - a1 * np.log(np.maximum(d / np.maximum(a0, a1), 1e-300))
+    return np.where(den > 0, d / np.where(den > 0, den, 1.0), 0.5 * fstar)
+
+
+def newton_mixed(K, B, BB, reg, f0, gap, a0, a1, q, F, maxit=30):
+    """gearte's ``_newton_mixed`` vectorised over the systems: unknowns ``q`` (S, m) and the
+    forces ``F`` (S, nc) of the closed contacts, shared ``K`` (m, m), rows ``B`` (nc, m)
+    (``BB`` (nc, m·m) their outer products), per-system load ``f0`` (S, m) and clearances
+    ``gap`` (S, nc), law coefficients ``a0, a1`` (nc,). The systems that have converged leave
+    the batch. Returns ``(q, F, iterations, failed)``; ``failed``: no convergence within
+    ``maxit`` or a force beyond the law's range (state of those rows undefined)."""
+    S, m = q.shape
+    q, F = q.copy(), F.copy()
+    its = np.zeros(S, np.int64)
+    failed = np.zeros(S, bool)
+    live = np.arange(S)
+    ql, Fl, fl, gl = q, F, f0, gap
+    d = ql @ B.T - gl
+    eye = reg * np.eye(m)
+    for it in range(maxit):
+        closing = (Fl <= 0) & (d > 0)
+        changed = closing.any(axis=1)
+        if changed.any():
+            Fl[closing] = law_force_start(
+                d[closing], np.broadcast_to(a0, d.shape)[closing],
+                np.broadcast_to(a1, d.shape)[closing],
+            )  # fmt: skip
+        act = Fl > 0
+        rest = a0 - a1 * np.log(np.where(act, Fl, 1.0))  # δ/F
+        slope = rest - a1  # δ'(F)
+        bad = np.any(act & ~(slope > 0), axis=1)  # beyond the law's range
+        k = np.where(act, 1.0 / np.where(slope > 0, slope, 1.0), 0.0)
+        Ft = np.where(act, Fl + (d - Fl * rest) * k, 0.0)
+        H = (k @ BB).reshape(-1, m, m) + (K + eye)
+        grad = ql @ K - fl + Ft @ B
+        dq = np.linalg.solve(H, grad[..., None])[..., 0]
+        ql = ql - dq
+        Bdq = dq @ B.T
+        Fn = Ft - k * Bdq
+        opened = np.any(act & ~(Fn > 0), axis=1)
+        Fn = np.where(act & (Fn > 0), Fn, 0.0)
+        fbig = np.max(np.abs(Fn - Fl), axis=1)
+        done = ~(changed | opened) & (np.max(np.abs(dq), axis=1) < 1e-9)
+        done &= fbig <= 1e-7 * np.max(Fn, axis=1)
+        Fl, d = Fn, d - Bdq
+        its[live] = it + 1
+        out = done | bad
+        if out.any():
+            idx = live[out]
+            q[idx], F[idx], failed[idx] = ql[out], Fl[out], bad[out]
+            keep = ~out
+            live, ql, Fl, fl, gl, d = live[keep], ql[keep], Fl[keep], fl[keep], gl[keep], d[keep]
+            if live.size == 0:
+                break
+    failed[live] = True
+    return q, F, its, failed
+
+
 def solve_batch_numpy(
     problem, h, en, gap, step_g, step_T, cold, record, exact=True, start=None, **_
 ):
     """Drop-in for :func:`gearte.solvers.rv_batch.solve_batch`: every step solved for all
-    samples at once (vectorised over samples), warm-started along each sequence like gearte
-    (``start``: the earlier step whose solution starts each step, −1 cold, as gearte)."""
+    samples at once (vectorised over samples) by gearte's batched algorithm (condensed,
+    :func:`newton_mixed`, the line-searched :func:`newton` where that fails), warm-started along
+    each sequence like gearte (``start``: the earlier step whose solution starts each step, −1
+    cold; a step that repeats its start's geometry and torque keeps that solution, as gearte)."""
+    from gearte.solvers.rv_batch import BatchSolution, _condensed
+
+    if problem.bearing_k.size:
+        raise NotImplementedError("the numpy baseline codes no clearance bearings")
+    if not exact:
+        return solve_batch_numpy_dense(problem, h, en, gap, step_g, step_T, cold, record,
+                                       exact=exact, start=start)  # fmt: skip
+    cd = _condensed(problem)  # once per problem (cached on it), as in gearte
+    S = h.shape[0]
+    m = cd.K.shape[1]
+    Bd = dense_rows(cd.contacts, m)  # (G, nc, m)
+    G, nc, _ = Bd.shape
+    BB = np.einsum("gca,gcb->gcab", Bd, Bd).reshape(G, nc, m * m)
+    hc = np.einsum("gmn,sgn->sgm", cd.M, h)  # condensed loads
+    out_h = np.einsum("gn,sgn->sg", cd.out_hrow, h)
+    a0s, a1s = problem.coef[..., 0], problem.coef[..., 1]
+    K = len(step_g)
+    rot = np.zeros((S, K))
+    rec = np.flatnonzero(record)
+    forces = np.zeros((S, rec.size, nc))
+    iters = np.zeros((S, K), np.int64)
+    if start is None:
+        start = np.where(np.asarray(cold, bool), -1, np.arange(K) - 1)
+    Q, FF = {}, {}
+    for t in range(K):
+        g, T, u = step_g[t], step_T[t], start[t]
+        if u < 0:
+            q, F = np.zeros((S, m)), np.zeros((S, nc))
+        else:
+            q, F = Q[u], FF[u]
+        if not (u >= 0 and step_g[u] == g and step_T[u] == T):
+            f0 = T * cd.u[g][None] - hc[:, g]
+            q1, F1, its, failed = newton_mixed(cd.K[g], Bd[g], BB[g], cd.reg[g], f0, gap[:, g],
+                                               a0s[g], a1s[g], q, F)  # fmt: skip
+            if failed.any():  # the line-searched Newton on Π from the same start
+                s = Systems(cd.K[g], Bd[g], f0[failed], gap[failed, g], a0s[g], a1s[g])
+                s.reg = cd.reg[g]
+                q1[failed], F1[failed], _ = newton(s, q[failed], F=F[failed], scheme="exact")
+            q, F = q1, F1
+            iters[:, t] = its
+        Q[t], FF[t] = q, F
+        rot[:, t] = T * cd.out_u[g] - out_h[:, g] + q @ cd.out_q[g]
+        if record[t]:
+            forces[:, int(np.searchsorted(rec, t))] = F
+    return BatchSolution(rot, forces, iters)
+
+
+def solve_batch_numpy_dense(
+    problem, h, en, gap, step_g, step_T, cold, record, exact=True, start=None, **_
+):
+    """The earlier baseline (before 2026-11-26): the full (uncondensed) system and the
+    line-searched Newton on Π with a vectorised scalar Newton for the forces at every trial
+    point (``exact``), or the secant fixed point — gearte's batched algorithm before its
+    rework; every step solved for all samples at once, warm-started like gearte."""
     from gearte.solvers.rv_batch import BatchSolution
 
     if problem.bearing_k.size:

@@ -36,11 +36,13 @@ import time
 
 import numpy as np
 
-from gearte.execution import default_workers
+from gearte.execution import default_workers, spawn_seeds
 from gearte.models.backlash import SpurGear, SpurPair
 from gearte.studies import RunOptions
+from gearte.tolerance import montecarlo as mc
 from gearte.tolerance.distributions import RadialPhase
 from gearte.tolerance.montecarlo import monte_carlo, reduce_samples
+from gearte.tolerance.rng import lane_states, stream_states
 from gearte.tolerance.stackup import Contributor, LinearStack
 
 UM = 1e-3
@@ -128,6 +130,22 @@ def numpy_tuned(stack: LinearStack, n: int, seed: int, chunk: int = 1_000_000) -
     return mu + s1 / n
 
 
+def kernel_alone(stack: LinearStack, n: int, seed: int, chunk: int = 1_000_000):
+    """gearte's compiled kernel called directly on the chunks ``monte_carlo`` would run (same
+    seeds, no sample kept, no Python layer): the share of ``monte_carlo``'s time outside it."""
+    ki = mc._KernelInput.of(stack)
+    mu, sd = stack.mean, stack.sd
+    red = (mu, mu - 8 * sd, mu + 8 * sd, 4000, -np.inf, np.inf, 0)
+    states = [stream_states(s) for s in spawn_seeds(seed, math.ceil(n / chunk))]
+    lanes = [lane_states(s) for s in states]
+
+    def run() -> None:
+        for k, (s, ln) in enumerate(zip(states, lanes, strict=True)):
+            mc._linear_stack_kernel(s, ln, min(chunk, n - k * chunk), *ki.args(), *red)
+
+    return run
+
+
 def python_loop(stack: LinearStack, n: int, seed: int) -> np.ndarray:
     """Weak baseline: per sample, one ``Generator.standard_normal()`` for the (all-normal)
     stack, in a Python loop."""
@@ -173,6 +191,7 @@ def main() -> None:
 
     one = RunOptions(progress=False, workers=1)
     variants = {
+        "kernel alone": kernel_alone(st, n, 2024),
         "gearte": lambda: monte_carlo(st, n, seed=2024, options=one),
         "gearte threads": lambda: monte_carlo(st, n, seed=2024, options=opts),
         "twin 1e6": lambda: numpy_grouped(st, n_s, 2024, 1_000_000),
@@ -180,7 +199,7 @@ def main() -> None:
         "twin best": lambda: numpy_grouped(st, n_s, 2024, best_chunk),
         "tuned best": lambda: numpy_tuned(st, n_s, 2024, best_chunk),
     }
-    per = {k: (n if k.startswith("gearte") else n_s) for k in variants}
+    per = {k: (n if k.startswith(("gearte", "kernel")) else n_s) for k in variants}
     runs: dict[str, list[tuple[float, float]]] = {k: [] for k in variants}
     for _ in range(max(1, args.repeats)):  # interleaved, so load changes hit every variant
         for k, f in variants.items():
@@ -216,6 +235,7 @@ def main() -> None:
         + f" -> best {best_chunk:,}"
     )
     labels = {
+        "kernel alone": "gearte kernel alone (same chunks, no Python layer)",
         "gearte": f"gearte kernel ({n:.3g} samples, 1e6-sample chunks, 1 thread)",
         "gearte threads": f"gearte kernel (the same on {threads} threads)",
         "twin 1e6": "numpy one normal, reduce_samples, 1e6 chunks",
@@ -258,6 +278,11 @@ def main() -> None:
             f"gearte's CPU on {threads} threads: {cpu[k] / cpu['gearte threads']:.1f}x; wall, "
             f"gearte on {threads} threads vs numpy on 1: {wall[k] / wall['gearte threads']:.1f}x"
         )
+    outside = cpu["gearte"] - cpu["kernel alone"]
+    print(
+        f"monte_carlo outside its kernel (1 thread): {outside * 1e9:.2f} ns CPU/sample "
+        f"({outside / cpu['gearte']:.0%} of gearte's time; per call and per chunk Python, seeding)"
+    )
     rate = 1 / wall["gearte threads"]
     print(
         f"ratio gearte / numpy per contributor: CPU {c_np / n_np / cpu['gearte']:.1f}x, "

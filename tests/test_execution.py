@@ -178,12 +178,14 @@ def test_worker_lost_mid_study_is_retried_and_result_is_bit_identical(reference,
     killed: list[str] = []
 
     def kill_a_busy_worker(index: int, _result: RunningStats) -> None:
-        if index != 2 or killed:
+        # From the third result on, at the first result where the scheduler reports a worker
+        # with chunks in hand (under load its view can lag one result behind): kill it.
+        if index < 2 or killed:
             return
         busy = [w for w, keys in client.processing().items() if keys and w in pids]
-        victim = busy[0] if busy else sorted(pids)[0]
-        os.kill(pids[victim], signal.SIGKILL)
-        killed.append((victim, bool(busy)))
+        if busy:
+            os.kill(pids[busy[0]], signal.SIGKILL)
+            killed.append((busy[0], True))
 
     stats = map_chunks(
         partial(sample_chunk, delay_s=0.15),
@@ -194,7 +196,7 @@ def test_worker_lost_mid_study_is_retried_and_result_is_bit_identical(reference,
         progress=False,
         description="worker loss",
     )
-    assert killed == [(killed[0][0], True)], "no busy worker was killed"
+    assert len(killed) == 1, "no busy worker was killed"
     assert stats.extra["chunks"] == SAMPLES // CHUNK  # every chunk exactly once
     assert stats.as_tuple() == reference.as_tuple()
     assert stats.extra == reference.extra

@@ -74,7 +74,7 @@ DEFAULT_BINS = 4000
 # DRAWS — the other contributors, in order. Each sample takes exactly one main number, so the
 # kernel draws them in blocks of _BLOCK and the samples do not depend on the block size. Codes:
 # see distributions.KERNEL_CODES.
-_BLOCK = 1024  # a power of two (the pairwise sums) and a multiple of LANES
+_BLOCK = 1024  # a power of two ≥ 512 (the pairwise tree folds 8 and 8) and a multiple of LANES
 
 
 def _group(codes: np.ndarray, params: np.ndarray, sens: np.ndarray) -> tuple[float, float, bool]:
@@ -155,6 +155,27 @@ def _fill_block(
 # in the low bits of the double: the bin loop stays in floating point (vectorised) and the
 # histogram loop reads the index from the bits.
 _BIN_OFFSET = 1.0 + 2.0**52
+
+
+@njit(inline="always")
+def _bin(y, lo, inv_width, top):  # pragma: no cover - compiled
+    """Histogram bin + 1 of ``y`` as the low bits of a double (no branch: vector registers)."""
+    t = (y - lo) * inv_width
+    t = t if t > -1.0 else -1.0
+    t = t if t < top else top
+    return math.floor(t) + _BIN_OFFSET
+
+
+@njit(inline="always")
+def _min(a, b):  # pragma: no cover - compiled
+    return a if a < b else b
+
+
+@njit(inline="always")
+def _max(a, b):  # pragma: no cover - compiled
+    return a if a > b else b
+
+
 _BIN_MASK = uint64(0xFFFFFFFF)
 _FLUSH = 1 << 30  # samples between additions of the int32 counts into the int64 ones
 
@@ -169,10 +190,11 @@ def _linear_stack_kernel(
 
     Per full block of ``_BLOCK`` samples, the sums of ``y − shift`` and of its square and the
     extremes by a fixed pairwise tree (elementwise loops LLVM runs on vector registers; the
-    tree depends on nothing but the block, so neither do the sums); a chunk's last, partial
-    block in order. The histogram bin (the formula of :func:`reduce_samples`) in a vector
-    loop, then the counts; the out-of-spec counts (only with a finite limit) in a vector loop
-    of integer sums."""
+    tree depends on nothing but the block, so neither do the sums) whose first three levels
+    run in registers, eight samples per step, with the histogram bins of those samples (the
+    formula of :func:`reduce_samples`), and the next three levels likewise; a chunk's last,
+    partial block in order. Then the counts; the out-of-spec counts (only with a finite
+    limit) in a vector loop of integer sums."""
     st = states.copy()
     lanes = lanes0.copy()
     counts = np.zeros(nbins + 2, np.int64)
@@ -211,17 +233,43 @@ def _linear_stack_kernel(
         for j in range(min(m, keep - done)):
             kept[done + j] = z[j]
         if m == _BLOCK:  # pairwise (a fixed tree): elementwise loops, vector registers
-            h = _BLOCK // 2
-            for j in range(h):
-                u = z[j]
-                v = z[j + h]
-                d0 = u - shift
-                d1 = v - shift
-                e1[j] = d0 + d1
-                e2[j] = d0 * d0 + d1 * d1
-                emn[j] = u if u < v else v
-                emx[j] = u if u > v else v
-            while h > 1:
+            h = _BLOCK // 8
+            for j in range(h):  # the first three levels in registers: samples j + i·h, i < 8
+                y0, y1, y2, y3 = z[j], z[j + h], z[j + 2 * h], z[j + 3 * h]
+                y4, y5, y6, y7 = z[j + 4 * h], z[j + 5 * h], z[j + 6 * h], z[j + 7 * h]
+                d0, d1, d2, d3 = y0 - shift, y1 - shift, y2 - shift, y3 - shift
+                d4, d5, d6, d7 = y4 - shift, y5 - shift, y6 - shift, y7 - shift
+                e1[j] = ((d0 + d4) + (d2 + d6)) + ((d1 + d5) + (d3 + d7))
+                e2[j] = ((d0 * d0 + d4 * d4) + (d2 * d2 + d6 * d6)) + (
+                    (d1 * d1 + d5 * d5) + (d3 * d3 + d7 * d7)
+                )
+                emn[j] = _min(_min(_min(y0, y4), _min(y2, y6)), _min(_min(y1, y5), _min(y3, y7)))
+                emx[j] = _max(_max(_max(y0, y4), _max(y2, y6)), _max(_max(y1, y5), _max(y3, y7)))
+                fbin[j] = _bin(y0, lo, inv_width, top)
+                fbin[j + h] = _bin(y1, lo, inv_width, top)
+                fbin[j + 2 * h] = _bin(y2, lo, inv_width, top)
+                fbin[j + 3 * h] = _bin(y3, lo, inv_width, top)
+                fbin[j + 4 * h] = _bin(y4, lo, inv_width, top)
+                fbin[j + 5 * h] = _bin(y5, lo, inv_width, top)
+                fbin[j + 6 * h] = _bin(y6, lo, inv_width, top)
+                fbin[j + 7 * h] = _bin(y7, lo, inv_width, top)
+            h = h // 8
+            for j in range(h):  # the next three levels: entries j + i·h, i < 8
+                e1[j] = ((e1[j] + e1[j + 4 * h]) + (e1[j + 2 * h] + e1[j + 6 * h])) + (
+                    (e1[j + h] + e1[j + 5 * h]) + (e1[j + 3 * h] + e1[j + 7 * h])
+                )
+                e2[j] = ((e2[j] + e2[j + 4 * h]) + (e2[j + 2 * h] + e2[j + 6 * h])) + (
+                    (e2[j + h] + e2[j + 5 * h]) + (e2[j + 3 * h] + e2[j + 7 * h])
+                )
+                emn[j] = _min(
+                    _min(_min(emn[j], emn[j + 4 * h]), _min(emn[j + 2 * h], emn[j + 6 * h])),
+                    _min(_min(emn[j + h], emn[j + 5 * h]), _min(emn[j + 3 * h], emn[j + 7 * h])),
+                )
+                emx[j] = _max(
+                    _max(_max(emx[j], emx[j + 4 * h]), _max(emx[j + 2 * h], emx[j + 6 * h])),
+                    _max(_max(emx[j + h], emx[j + 5 * h]), _max(emx[j + 3 * h], emx[j + 7 * h])),
+                )
+            while h > 1:  # the last four levels
                 h //= 2
                 for j in range(h):
                     e1[j] += e1[j + h]
@@ -240,11 +288,7 @@ def _linear_stack_kernel(
                 s2 += d0 * d0
                 mn = y if y < mn else mn
                 mx = y if y > mx else mx
-        for j in range(m):  # bin + 1 as the low bits of a double (no branch: vector registers)
-            t = (z[j] - lo) * inv_width
-            t = t if t > -1.0 else -1.0
-            t = t if t < top else top
-            fbin[j] = math.floor(t) + _BIN_OFFSET
+                fbin[j] = _bin(y, lo, inv_width, top)
         for j in range(m):
             c32[ibin[j] & _BIN_MASK] += 1  # 0 underflow, nbins + 1 overflow
         if specs:  # integer sums of comparisons: vector registers
@@ -506,22 +550,28 @@ class MCResult:
         return self.below_fraction + self.above_fraction
 
 
-def _percentile_from_hist(
-    q: float, counts: np.ndarray, lo: float, hi: float, mn: float, mx: float
-) -> float:
+def _percentiles_from_hist(
+    qs: Sequence[float], counts: np.ndarray, lo: float, hi: float, mn: float, mx: float
+) -> dict[float, float]:
+    """The values at the percent levels ``qs``, interpolated in the histogram (edges and
+    cumulative counts built once for all levels)."""
     nbins = counts.size - 2
     n = counts.sum()
-    target = q / 100.0 * n
     edges = np.concatenate([[min(mn, lo)], np.linspace(lo, hi, nbins + 1), [max(mx, hi)]])
     cum = np.concatenate([[0], np.cumsum(counts)])
-    k = int(np.searchsorted(cum, target, side="left"))
-    k = min(max(k, 1), counts.size)
-    c0, c1 = cum[k - 1], cum[k]
-    left, right = edges[k - 1], edges[k]
-    if c1 == c0:
-        return float(left)
-    val = left + (target - c0) / (c1 - c0) * (right - left)
-    return float(min(max(val, mn), mx))
+    out = {}
+    for q in qs:
+        target = q / 100.0 * n
+        k = int(np.searchsorted(cum, target, side="left"))
+        k = min(max(k, 1), counts.size)
+        c0, c1 = cum[k - 1], cum[k]
+        left, right = edges[k - 1], edges[k]
+        if c1 == c0:
+            out[float(q)] = float(left)
+            continue
+        val = left + (target - c0) / (c1 - c0) * (right - left)
+        out[float(q)] = float(min(max(val, mn), mx))
+    return out
 
 
 def _map_chunks(func, tasks: Sequence[Any], *, options: Any, progress: bool, description: str):
@@ -667,10 +717,7 @@ def monte_carlo(
     mean = centre + total.s1 / total.n
     var = max(total.s2 - total.s1**2 / total.n, 0.0) / (total.n - 1)
     sd = math.sqrt(var)
-    pct = {
-        float(q): _percentile_from_hist(q, total.counts, lo, hi, total.min, total.max)
-        for q in percentiles
-    }
+    pct = _percentiles_from_hist(percentiles, total.counts, lo, hi, total.min, total.max)
     cp, cpk = process_capability(mean, sd, lower_spec, upper_spec)
     return MCResult(
         n=total.n,
