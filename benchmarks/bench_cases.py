@@ -14,8 +14,10 @@ included) and prints, per case:
   render (PNG, forked workers), the slowest figure, html, csv, write, and *startup/exit* (the
   wall time outside gearte's own timing: interpreter start, exit); then, in the report process,
   its warm-up (importing matplotlib, drawing a first figure; it runs beside the case load and
-  the analyses) and how long it then waited for the result (*rp idle*: ~0 means the warm-up, not
-  the analyses, held the report back);
+  the analyses), how long it waited for the parent in all (*rp idle*: ~0 means the warm-up, not
+  the analyses, held the report back) and how long it built and drew the figures of analyses
+  streamed to it while the next ones ran (*rp early*, off the critical path; *figures* and
+  *render* are what was left after the final result came);
 * *other* = wall − analyses: everything the user did not ask for, and its ratio to the analyses.
 
 Then one summary line per goal of issue 12: a warm run of a case whose analyses take < 1 s
@@ -41,9 +43,10 @@ import time
 from pathlib import Path
 
 STAGES = ["imports", "numba", "analyses", "figures", "render", "fig max", "html", "csv", "write",
-          "startup", "rp warm", "rp idle"]  # fmt: skip
+          "startup", "rp warm", "rp idle", "rp early"]  # fmt: skip
 REPORT_PROCESS = {"report process: warm-up": "rp warm",
-                  "report process: waited for the result": "rp idle"}  # fmt: skip
+                  "report process: waited for the result": "rp idle",
+                  "report process: figures during the analyses": "rp early"}  # fmt: skip
 WANG_GOAL_S = 2.5
 FAST_GOAL_S = 1.5
 FIGURE_GOAL_S = 1.0

@@ -151,3 +151,75 @@ def test_fixed_grid_leaves_the_asked_room_around_each_panel() -> None:
     assert boxes[3].y0 * h == pytest.approx(0.5) and (1 - boxes[0].y1) * h == pytest.approx(0.3)
     with pytest.raises(ValueError, match="no room"):
         new_figure(1, 4, figsize=(3.0, 3.0), margins_in=(0.9, 0.5, 0.3, 0.1))
+
+
+# Streaming (issue 12): each analysis's figures are drawn as soon as the analysis is done; the
+# report of the final result must be the one drawn from the whole result.
+
+
+@pytest.fixture(scope="module")
+def cycloid_result() -> object:
+    from gearte.studies import RunOptions, run_case
+
+    return run_case("hu2020_rv80e_initial", RunOptions(progress=False))
+
+
+def _pngs(figs: list) -> list[tuple[str, str, str]]:
+    from gearte.report.html import render_all
+
+    return [(r.analysis, r.title, r.png) for r in render_all(figs, workers=1)]
+
+
+def test_figures_of_one_analysis_are_those_of_the_whole_result(cycloid_result) -> None:
+    from gearte.plotting import figures_for, figures_of, self_contained
+
+    names = [a.name for a in cycloid_result.analyses]
+    drawn = [n for n in names if n in self_contained(cycloid_result.kind)]
+    assert {"geometry", "geometric_te", "tooth_contact"} <= set(drawn)
+    whole = _pngs(figures_for(cycloid_result))
+    alone = [p for n in drawn for p in _pngs(figures_of(cycloid_result, {n}))]
+    assert alone == [p for p in whole if p[0] in drawn]  # same pixels, same order per analysis
+
+
+def _page(html: str) -> str:
+    import re
+
+    return re.sub(r"\d{4}-\d\d-\d\d \d\d:\d\d UTC", "DATE", html)
+
+
+@pytest.mark.parametrize(("early_steps", "changed"), [(0, False), (2, True), (99, True)])
+def test_streamed_report_is_the_report_of_the_final_result(
+    cycloid_result, early_steps: int, changed: bool
+) -> None:
+    """The report process's side fed as ``gearte run`` feeds it: the case, each analysis as it
+    is made, some figures drawn before the final result (none, some, all), and an analysis
+    changed after it was streamed (drawn again from the final result)."""
+    import copy
+    import pickle
+
+    from gearte.report.background import _analysis_bytes, _final_frame, _Report
+    from gearte.report.html import render_report
+
+    result = copy.deepcopy(cycloid_result)
+    rep = _Report()
+    rep.take(("preload", [], pickle.dumps(result.case)))
+    sent = {}
+    for i, a in enumerate(result.analyses):
+        data = _analysis_bytes(a)
+        sent[id(a)] = (a, i, data)
+        rep.take(("analysis", i, data))
+    for _ in range(early_steps):
+        if not (rep.todo or any(rep.built.values())):
+            break
+        rep.step()
+    if early_steps >= 99:
+        assert sum(len(d) for d in rep.drawn.values()) == 6  # every figure drawn early
+    if changed:  # the study changes a result after making it
+        v = result["tooth_contact"].values
+        v["contact_force [N]"] = 2.0 * v["contact_force [N]"]
+    frame = _final_frame(result, sent)
+    parts = pickle.loads(frame[8:])[2]
+    assert [how for how, _ in parts].count("new") == int(changed)
+    html, timings = rep.finish(pickle.loads(frame[8:]))
+    assert _page(html) == _page(render_report(result))
+    assert timings["report process: figures during the analyses"] >= 0.0

@@ -285,7 +285,13 @@ def run(
             t2 = time.perf_counter()
             default = os.path.join("out", safe_label(c.case.name or c.case.kind))
             target = check_output_dir(out_dir if out_dir is not None else default)
-            with _executor(scheduler, workers) as executor:
+            listening: Any = contextlib.nullcontext()
+            if renderer is not None:  # it imports what we did, then draws each analysis's
+                from gearte.results import analysis_listener  # figures as soon as it is done
+
+                renderer.preload(c)
+                listening = analysis_listener(renderer.stream)
+            with _executor(scheduler, workers) as executor, listening:
                 opts = RunOptions(
                     progress=not no_progress,
                     seed=seed,

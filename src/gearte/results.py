@@ -12,17 +12,20 @@ study kinds), so this module imports nothing above it.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import json
 import math
+import threading
 import time
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from types import ModuleType
 from typing import Any
 
 import numpy as np
 
-__all__ = ["AnalysisResult", "StudyResult", "to_jsonable", "DISPLAY_MODULE"]
+__all__ = ["AnalysisResult", "StudyResult", "to_jsonable", "DISPLAY_MODULE", "analysis_listener"]
 
 DISPLAY_MODULE = "gearte.report.notebook"
 """The module that displays results in notebooks (HTML summary, pandas tables, figures)."""
@@ -30,6 +33,29 @@ DISPLAY_MODULE = "gearte.report.notebook"
 
 def _display() -> ModuleType:
     return importlib.import_module(DISPLAY_MODULE)
+
+
+_LISTENERS: list[Callable[[AnalysisResult], None]] = []
+_LISTENERS_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def analysis_listener(callback: Callable[[AnalysisResult], None]) -> Iterator[None]:
+    """Call ``callback(analysis)`` with every :class:`AnalysisResult` made while the block runs
+    (in the thread that made it), as soon as it is made: studies make an analysis's result when
+    that analysis is done, so ``gearte run`` streams each finished analysis to its report
+    process, which draws its figures while the next analyses run. An error of ``callback`` is
+    ignored (it must not stop an analysis); a study may still change a result after making it,
+    so a listener must not assume it final (the report process checks it against the final
+    result).
+    """
+    with _LISTENERS_LOCK:
+        _LISTENERS.append(callback)
+    try:
+        yield
+    finally:
+        with _LISTENERS_LOCK:
+            _LISTENERS.remove(callback)
 
 
 def to_jsonable(obj: Any) -> Any:
@@ -121,6 +147,11 @@ class AnalysisResult:
     files: dict[str, str] = field(default_factory=dict, repr=False)
     created: float = field(default_factory=time.perf_counter, repr=False, compare=False)
     study: Any = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        for callback in tuple(_LISTENERS):
+            with contextlib.suppress(Exception):
+                callback(self)
 
     def __getitem__(self, key: str) -> Any:
         return self.values[key]

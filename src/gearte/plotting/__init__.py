@@ -10,7 +10,15 @@ import importlib
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Figure", "new_figure", "figures_for", "for_analysis", "PALETTE"]
+__all__ = [
+    "Figure",
+    "new_figure",
+    "figures_for",
+    "figures_of",
+    "self_contained",
+    "for_analysis",
+    "PALETTE",
+]
 
 #: Colours used consistently across gearte's plots (colour-blind safe, Okabe–Ito).
 PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000"]
@@ -75,11 +83,42 @@ def new_figure(
     return fig, fig.subplots(nrows, ncols, **subplot_kw)
 
 
-def figures_for(result: Any) -> list[Figure]:
-    """All figures of a study result, from the plotting module its kind names (``FIGURES``)."""
+def _module(kind: str) -> Any:
     from gearte.studies import get_kind
 
-    module_name = getattr(get_kind(result.kind), "FIGURES", None)
-    if not module_name:
-        return []
-    return list(importlib.import_module(module_name).figures(result))
+    module_name = getattr(get_kind(kind), "FIGURES", None)
+    return importlib.import_module(module_name) if module_name else None
+
+
+def figures_for(result: Any) -> list[Figure]:
+    """All figures of a study result, from the plotting module its kind names (``FIGURES``)."""
+    module = _module(result.kind)
+    return list(module.figures(result)) if module is not None else []
+
+
+def self_contained(kind: str) -> frozenset[str]:
+    """The analyses of study kind ``kind`` whose figures read that analysis alone (and the
+    case): :func:`figures_of` draws them from the analysis as soon as it is done, the same
+    figures as :func:`figures_for` draws from the whole result. A plotting module lists them in
+    ``SELF_CONTAINED``; none where it lists none."""
+    module = _module(kind)
+    return frozenset(getattr(module, "SELF_CONTAINED", ())) if module is not None else frozenset()
+
+
+def figures_of(result: Any, names: Any) -> list[Figure]:
+    """The figures of the analyses ``names`` of ``result`` (a
+    :class:`~gearte.results.StudyResult`), drawn as if the result held only those analyses.
+
+    For analyses of :func:`self_contained` these are the figures :func:`figures_for` draws of
+    them from the whole result, in the same order (the report process draws each finished
+    analysis's figures while the next ones run: docs/report.md)."""
+    import copy
+
+    names = set(names)
+    view = copy.copy(result)
+    view.analyses = [a for a in result.analyses if a.name in names]
+    try:
+        figs = figures_for(view)
+    finally:
+        result._link()  # reading the view pointed its analyses at it
+    return [f for f in figs if f.analysis in names]

@@ -7,9 +7,20 @@ from typing import Any
 import numpy as np
 
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
+from gearte.plotting.yield_figures import SELF_CONTAINED as _YIELD
 from gearte.units import Nmm_to_Nm, rad_to_deg
 
-__all__ = ["figures", "profile_figure", "contact_figures", "sensitivity_figure", "pareto_figure"]
+__all__ = [
+    "figures",
+    "stage_figures",
+    "profile_figure",
+    "contact_figures",
+    "sensitivity_figure",
+    "pareto_figure",
+]
+
+#: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`).
+SELF_CONTAINED = frozenset({"geometry", "geometric_te", "tooth_contact"}) | _YIELD
 
 
 def _exaggeration(max_dev_mm: float, tooth_height_mm: float) -> float:
@@ -202,11 +213,19 @@ def pareto_figure(result: Any) -> Figure:
 
 def figures(result: Any) -> list[Figure]:
     """All figures of a ``cycloid_stage`` result."""
-    out = for_analysis("geometry", [profile_figure(result["geometry"].data["stage"])])
+    from gearte.plotting.yield_figures import yield_figures
+
+    return stage_figures(result) + yield_figures(result)
+
+
+def stage_figures(result: Any) -> list[Figure]:
+    """The figures of the cycloid stage's analyses (geometry, geometric TE, tooth contact) of a
+    ``cycloid_stage`` or ``rv_reducer`` result, each where its analysis ran."""
+    out: list[Figure] = []
+    if "geometry" in result:
+        out += for_analysis("geometry", [profile_figure(result["geometry"].data["stage"])])
     if "geometric_te" in result:
         out += for_analysis("geometric_te", [sensitivity_figure(result), pareto_figure(result)])
     if "tooth_contact" in result:
         out += for_analysis("tooth_contact", contact_figures(result))
-    from gearte.plotting.yield_figures import yield_figures
-
-    return out + yield_figures(result)
+    return out

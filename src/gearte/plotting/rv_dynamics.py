@@ -10,7 +10,10 @@ import numpy as np
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import mm_to_um, rad_to_arcsec
 
-__all__ = ["figures"]
+__all__ = ["figures", "SELF_CONTAINED"]
+
+#: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`).
+SELF_CONTAINED = frozenset({"contact", "dte", "modal", "speed_sweep", "batch"})
 
 
 def _contact_figure(a) -> Figure:

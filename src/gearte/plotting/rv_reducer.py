@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
+from gearte.plotting import PALETTE, Figure, cycloid_stage, for_analysis, new_figure, rv_dynamics
+from gearte.plotting.yield_figures import SELF_CONTAINED as _YIELD
 from gearte.units import (
     Nm_to_Nmm,
     Nmm_per_rad_to_Nm_per_arcmin,
@@ -15,7 +16,16 @@ from gearte.units import (
     rad_to_deg,
 )
 
-__all__ = ["figures"]
+__all__ = ["figures", "SELF_CONTAINED"]
+
+#: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`):
+#: this kind's own, the cycloid stage's, the dynamics' and the yield's.
+SELF_CONTAINED = (
+    frozenset({"load_sharing", "transmission_error", "catalogue", "compensation"})
+    | cycloid_stage.SELF_CONTAINED
+    | rv_dynamics.SELF_CONTAINED
+    | _YIELD
+)
 
 
 def _pin_map(ls, title: str) -> Figure:
@@ -154,12 +164,7 @@ def figures(result) -> list[Figure]:
     if "compensation" in result:
         comp = result["compensation"].data["compensation"]
         out += for_analysis("compensation", [_compensation(comp)])
-    if "geometry" in result:  # the cycloid stage's analyses (run by the cycloid_stage kind)
-        from gearte.plotting import cycloid_stage
-
-        out += cycloid_stage.figures(result)
-    from gearte.plotting import rv_dynamics
-
+    out += cycloid_stage.stage_figures(result)  # its cycloid stage's analyses, where they ran
     out += rv_dynamics.figures(result)
     from gearte.plotting.yield_figures import yield_figures
 

@@ -15,7 +15,10 @@ import numpy as np
 
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 
-__all__ = ["yield_figures"]
+__all__ = ["yield_figures", "SELF_CONTAINED"]
+
+#: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`).
+SELF_CONTAINED = frozenset({"yield"})
 
 
 def _histograms(a: Any) -> Figure | None:

@@ -1193,6 +1193,7 @@ def _transmission_error(red, sec: TESection, law) -> AnalysisResult:
         "output_angle [deg]": rad_to_deg(th),
         "total_te [arcsec]": rad_to_arcsec(te.total),
         "geometric_te [arcsec]": rad_to_arcsec(te.geometric),
+        "contact_law": red.discs.contact_law,
     }
     return AnalysisResult(
         name="transmission_error",
@@ -1281,6 +1282,7 @@ def _catalogue(red, sec: CatalogueSection, law, fs_terms=None) -> AnalysisResult
         "hysteresis_loss [arcmin]": rad_to_arcmin(cat.hysteresis_loss),
         "rated_torque [N*m]": None if red.rated_torque is None else Nmm_to_Nm(red.rated_torque),
         **fs_values,
+        "contact_law": red.discs.contact_law,
     }
     return AnalysisResult(
         name="catalogue",
@@ -1331,6 +1333,7 @@ def _compensation(red, sec: CompensationSection) -> AnalysisResult:
             }
         )
     values["model_evaluations"] = comp.evaluations
+    values["contact_law"] = red.discs.contact_law
     return AnalysisResult(
         name="compensation",
         title="Compensation of the total TE through the model",
@@ -1459,9 +1462,10 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
         got, w = dyn.run_dynamics(case, red, options)
         out += got
         warnings += w
-    for r in out:
+    for r in out:  # each says its law when it is made (a result is streamed to the report then)
         if r.name in ("load_sharing", "transmission_error", "catalogue", "compensation"):
-            r.values["contact_law"] = case.reducer.contact_law
+            if r.values.get("contact_law") != case.reducer.contact_law:
+                r.values["contact_law"] = case.reducer.contact_law
     if not out:
         warnings.append("no analyses requested: add [analyses.load_sharing] etc.")
     allowable = case.reducer.allowable_contact_pressure_MPa
