@@ -297,7 +297,8 @@ def main() -> None:
         f"monte_carlo outside its kernel (1 thread): difference of the two minima above "
         f"{outside * 1e9:.2f} ns CPU/sample ({outside / cpu['gearte']:.0%}); measured directly "
         f"(tiny chunks): {(o1 - per_chunk) * 1e3:.2f} ms per call + {per_chunk * 1e6:.0f} µs per "
-        f"chunk (seeding its streams) = {layer / n * 1e9:.2f} ns/sample at {n:.3g} samples"
+        f"chunk (seeding, the kernel's call and set-up) = {layer / n * 1e9:.2f} ns/sample at "
+        f"{n:.3g} samples"
     )
     rate = 1 / wall["gearte threads"]
     print(
