@@ -29,7 +29,6 @@ to round-off (a test checks 1e-9 on sampled reducers).
 from __future__ import annotations
 
 import threading
-from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
@@ -400,8 +399,8 @@ def _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, F, kt, q, H, grad
 
 @njit(cache=True, nogil=True)
 def _newton(
-    exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, F, d, kt, w, tol,
-    maxit,
+    exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, F, d, kt, wm, wv,
+    wc, tol, maxit,
 ):  # fmt: skip
     """Active-set Newton with a backtracking line search on Π (:func:`_energy`), in place.
 
@@ -411,13 +410,16 @@ def _newton(
     :func:`gearte.solvers.rv_equilibrium._solve_all` is the root of this Π's gradient, and
     Newton reaches it quadratically. On entry ``F``, ``d`` hold warm (force, approach) pairs of
     the law (exact only); on return ``q`` the minimiser and ``F``, ``d``, ``kt`` its forces,
-    approaches and tangents. ``w``: the work arrays (:func:`_work`). Returns (iterations, ok).
+    approaches and tangents. ``wm`` (2, nd, nd), ``wv`` (3, nd), ``wc`` (3, nc): work arrays
+    (three arrays, not a tuple of eight: each array argument is several flattened arguments of
+    the compiled function, docs/numba.md). Returns (iterations, ok).
     """
     nd = q.size
     nc = gc.size
     nm = kn.size
-    H, L, grad, dq, qn = w.H, w.L, w.grad, w.dq, w.qn
-    Fn, dn, ktn = w.Fn, w.dn, w.ktn
+    H, L = wm[0], wm[1]
+    grad, dq, qn = wv[0], wv[1], wv[2]
+    Fn, dn, ktn = wc[0], wc[1], wc[2]
     e0 = _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, F, d, Fn,
                  dn, ktn)  # fmt: skip
     if not np.isfinite(e0):
@@ -470,9 +472,9 @@ def _newton(
     return maxit, False
 
 
-@njit(cache=True, nogil=True)
-def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, F, d, kt, w,
-                  maxit):  # fmt: skip
+@njit(cache=True, nogil=True, inline="always")
+def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, F, d, kt, wm,
+                  wv, wc, maxit):  # fmt: skip
     """Newton on the equilibrium *and* the pin law together, in place: no inner law solves.
 
     Unknowns ``q`` and the force ``F_c`` of every closed contact; equations
@@ -494,7 +496,8 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     """
     nd = q.size
     nc = gc.size
-    H, L, grad, dq, Ft, Bdq, lf = w.H, w.L, w.grad, w.dq, w.Fn, w.dn, w.ktn
+    H, L, grad, dq = wm[0], wm[1], wv[0], wv[1]
+    Ft, Bdq, lf = wc[0], wc[1], wc[2]
     for it in range(maxit):
         changed = False
         if it == 0:
@@ -571,72 +574,67 @@ def _log_update(lf, f, r):
     return np.log(f)
 
 
-_Work = namedtuple("_Work", "H L grad dq qn Fn dn ktn kt q0 F0 d0 f0 force approach k kc")
-
-
-@njit(cache=True, nogil=True)
-def _work(nd, nc, ngroups):
-    """The work arrays of one thread: nothing is allocated inside the solver loops."""
-    return _Work(
-        np.empty((nd, nd)), np.empty((nd, nd)), np.empty(nd), np.empty(nd), np.empty(nd),
-        np.empty(nc), np.empty(nc), np.empty(nc), np.zeros(nc), np.empty(nd), np.empty(nc),
-        np.empty(nc), np.empty(nd), np.zeros(nc), np.zeros(nc), np.empty(ngroups), np.empty(nc),
-    )  # fmt: skip
-
-
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _position(
-    K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, group, ngroups, law, coef, q, w, tol,
-    maxit, exact,
+    K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, group, ngroups, law, coef, q, k, kc,
+    force, approach, kt, q0, fd0, wm, wv, wc, tol, maxit, exact,
 ):  # fmt: skip
     """:func:`gearte.solvers.rv_equilibrium._solve_all` on sparse rows, in place.
 
-    State in ``q`` (displacements) and the work arrays ``w``: ``w.k`` (per disc) and ``w.kc``
-    (per contact) stiffnesses, ``w.force`` and ``w.approach`` (the last solution's contact
-    forces and approaches: warm pairs of the law). Returns (iterations, ok).
+    State in ``q`` (displacements), ``k`` (per disc) and ``kc`` (per contact) stiffnesses,
+    ``force`` and ``approach`` (the last solution's contact forces and approaches: warm pairs of
+    the law) and ``kt`` (tangents); ``q0``, ``fd0`` (2, nc): the start, kept for a retry;
+    ``wm``, ``wv``, ``wc``: :func:`_newton`'s work arrays. Returns (iterations, ok).
+    Inlined into its one caller, :func:`_solve_batch` (each level of compiled calls
+    re-optimises the code below it, docs/numba.md).
 
     ``exact`` (per-contact law only): :func:`_newton_mixed` from the warm forces first; where it
     fails, Newton on Π with the exact law (:func:`_newton`); the secant fixed point only where
     both fail.
     """
     nc = gc.size
-    k, kc, force, approach, kt = w.k, w.kc, w.force, w.approach, w.kt
     qmax = 1.0
     for a in range(q.size):
         qmax = max(qmax, abs(q[a]))
     qtol = 1e-13 * qmax
-    # the law flag of _newton as a run-time bool: a constant True/False argument would make
-    # numba compile _newton (and _energy) once per literal value (docs/numba.md)
-    secant = exact and not exact
-    if law == LAW_SECANT_PER_CONTACT and exact:
-        _copy(q, w.q0)
-        _copy(force, w.F0)
-        _copy(approach, w.d0)
-        its, ok = _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q,
-                                force, approach, kt, w, 30)  # fmt: skip
-        if not ok:
-            _copy(w.q0, q)
-            _copy(w.F0, force)
-            _copy(w.d0, approach)
-            more, ok = _newton(exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef,
-                               kc, q, force, approach, kt, w, qtol, maxit)  # fmt: skip
-            its += more
+    # one call site of _newton (it is inlined): the exact law's attempt after _newton_mixed,
+    # then the secant fixed point; the law flag a run-time bool (a constant True/False would
+    # compile _newton and _energy once per literal value, docs/numba.md)
+    use_exact = law == LAW_SECANT_PER_CONTACT and exact
+    total = 0
+    if use_exact:
+        _copy(q, q0)
+        _copy(force, fd0[0])
+        _copy(approach, fd0[1])
+        total, ok = _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q,
+                                  force, approach, kt, wm, wv, wc, 30)  # fmt: skip
         if ok:
-            return its, True
-        _copy(w.q0, q)
-        _copy(w.F0, force)
-        _copy(w.d0, approach)
-        for c in range(nc):  # the secant stiffness of the start as the fixed point's start
-            if force[c] > 0.0 and approach[c] > 0.0:
-                kc[c] = force[c] / approach[c]
-    if law != LAW_SECANT_PER_CONTACT:
+            return total, True
+        _copy(q0, q)
+        _copy(fd0[0], force)
+        _copy(fd0[1], approach)
+    elif law != LAW_SECANT_PER_CONTACT:
         for c in range(nc):
             kc[c] = k[group[c]]
-    total = 0
-    for _outer in range(200):
-        its, ok = _newton(secant, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc,
-                          q, force, approach, kt, w, qtol, maxit)  # fmt: skip
+    outer = 0
+    while outer < 200:
+        its, ok = _newton(use_exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef,
+                          kc, q, force, approach, kt, wm, wv, wc, qtol, maxit)  # fmt: skip
         total += its
+        if use_exact:
+            # Newton on Π with the exact law, after _newton_mixed failed
+            if ok:
+                return total, True
+            use_exact = False
+            total = 0
+            _copy(q0, q)
+            _copy(fd0[0], force)
+            _copy(fd0[1], approach)
+            for c in range(nc):  # the secant stiffness of the start as the fixed point's start
+                if force[c] > 0.0 and approach[c] > 0.0:
+                    kc[c] = force[c] / approach[c]
+            continue
+        outer += 1
         if not ok:
             return total, False
         # force = kc d on the closed contacts (from the last energy evaluation)
@@ -685,18 +683,20 @@ def _position(
 @njit(cache=True, nogil=True)
 def _solve_batch(
     K0s, us, regs, cidx, cvals, nidx, nvals, kn, cn, group, ngroups, law, coefs, kstart, Hs, ENs,
-    GAPs, step_g, step_T, start, rec, nrec, out_u, out_h, out_q, tol, maxit, exact, given_q,
-    given_f, given_d, given_kg, given_kc, given,
+    GAPs, step_g, step_T, start, rec, nrec, out_u, out_h, out_q, tol, maxit, exact, given_state,
+    given,
 ):  # fmt: skip
     """All samples × steps. The system is the condensed one (:func:`condense`): stiffness
     ``K0s[g]``, load ``T us[g] − Hs[s, g]``; the output rotation is recovered as
     ``T out_u[g] − out_h[s, g] + out_q[g] · q``. ``start[t]``: the step whose solution (of the
     same sample) starts step ``t`` (−1: zero displacements and the law's start stiffness);
-    where ``given[t]``, step ``t`` starts from ``given_q[t]`` (displacements), ``given_f[t]``,
-    ``given_d[t]`` (contact forces and approaches), ``given_kg[t]``, ``given_kc[t]`` (per-disc
-    and per-contact stiffness) instead. Returns the output rotation, the recorded forces and the
-    iterations per step, and the state of every step of the last sample (``Q, F, D, KG, KC``:
-    a one-sample batch's whole solution)."""
+    where ``given[t]``, step ``t`` starts from the state ``given_state[t]`` instead.
+
+    A step's state is one vector (:func:`_state_parts`): displacements ``q`` (nd), contact
+    forces and approaches (nc each), per-disc (ngroups) and per-contact (nc) stiffness — one
+    copy where a step starts from another (each copy site is compiled code of its own).
+    Returns the output rotation, the recorded forces and the iterations per step, and the
+    state of every step of the last sample (a one-sample batch's whole solution)."""
     S = Hs.shape[0]
     K = step_g.size
     nd = us.shape[1]
@@ -704,38 +704,36 @@ def _solve_batch(
     rot = np.zeros((S, K))
     forces = np.zeros((S, nrec, nc))
     iters = np.zeros((S, K), dtype=np.int64)
-    w = _work(nd, nc, ngroups)
-    f0 = w.f0
-    q = np.zeros(nd)
-    # the solution of every step of the current sample (starts of later steps)
-    Q = np.zeros((K, nd))
-    FF = np.zeros((K, nc))
-    DD = np.zeros((K, nc))
-    KG = np.zeros((K, ngroups))
-    KC = np.zeros((K, nc))
+    # the state of the step being solved (views of one vector) and the solver's work arrays:
+    # nothing is allocated inside the loops
+    ns = nd + 3 * nc + ngroups
+    state = np.zeros(ns)
+    q = state[:nd]
+    force = state[nd : nd + nc]
+    approach = state[nd + nc : nd + 2 * nc]
+    k = state[nd + 2 * nc : nd + 2 * nc + ngroups]
+    kc = state[nd + 2 * nc + ngroups :]
+    kt = np.zeros(nc)
+    f0 = np.zeros(nd)
+    q0 = np.zeros(nd)
+    fd0 = np.zeros((2, nc))
+    wm = np.zeros((2, nd, nd))
+    wv = np.zeros((3, nd))
+    wc = np.zeros((3, nc))
+    # the state of every step of the current sample (starts of later steps)
+    ST = np.zeros((K, ns))
     for s in range(S):
         for t in range(K):
             g = step_g[t]
             T = step_T[t]
             u = start[t]
             if given[t]:
-                _copy(given_q[t], q)
-                _copy(given_f[t], w.force)
-                _copy(given_d[t], w.approach)
-                _copy(given_kg[t], w.k)
-                _copy(given_kc[t], w.kc)
+                _copy(given_state[t], state)
             elif u < 0:
-                q[:] = 0.0
-                w.force[:] = 0.0
-                w.approach[:] = 0.0
-                w.k[:] = kstart
-                w.kc[:] = kstart
+                state[: nd + 2 * nc] = 0.0
+                state[nd + 2 * nc :] = kstart
             else:
-                _copy(Q[u], q)
-                _copy(FF[u], w.force)
-                _copy(DD[u], w.approach)
-                _copy(KG[u], w.k)
-                _copy(KC[u], w.kc)
+                _copy(ST[u], state)
             if u >= 0 and not given[t] and step_g[u] == g and step_T[u] == T:
                 its, ok = 0, True  # the same equilibrium (unique): its solution as it is
             else:
@@ -743,24 +741,21 @@ def _solve_batch(
                     f0[a] = T * us[g, a] - Hs[s, g, a]
                 its, ok = _position(
                     K0s[g], regs[g], f0, nidx, nvals[g], ENs[s, g], kn, cn, cidx, cvals[g],
-                    GAPs[s, g], group, ngroups, law, coefs[g], q, w, tol, maxit, exact,
+                    GAPs[s, g], group, ngroups, law, coefs[g], q, k, kc, force, approach, kt, q0,
+                    fd0, wm, wv, wc, tol, maxit, exact,
                 )  # fmt: skip
             if not ok:
                 iters[s, t] = -1
                 break
             iters[s, t] = its
-            _copy(q, Q[t])
-            _copy(w.force, FF[t])
-            _copy(w.approach, DD[t])
-            _copy(w.k, KG[t])
-            _copy(w.kc, KC[t])
+            _copy(state, ST[t])
             r = T * out_u[g] - out_h[s, g]
             for a in range(nd):
                 r += out_q[g, a] * q[a]
             rot[s, t] = r
             if rec[t] >= 0:
-                _copy(w.force, forces[s, rec[t]])
-    return rot, forces, iters, Q, FF, DD, KG, KC
+                _copy(force, forces[s, rec[t]])
+    return rot, forces, iters, ST
 
 
 @dataclass(frozen=True)
@@ -967,11 +962,13 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
     out_h = np.sum(cd.out_hrow[None] * h, axis=2)
     K = np.asarray(step_g).size
     nd, nc, ng = cd.K.shape[1], np.shape(gap)[2], p.ngroups
+    parts = _state_parts(nd, nc, ng)
     given = np.zeros(K, dtype=np.bool_)
-    gq, gkg, gkc = np.zeros((K, nd)), np.zeros((K, ng)), np.zeros((K, nc))
+    given_state = np.zeros((K, parts[-1].stop))
     if first is not None and K:
         given[0] = True
-        gq[0], gkg[0], gkc[0] = first
+        q_, k_, kc_ = first
+        given_state[0, parts[0]], given_state[0, parts[3]], given_state[0, parts[4]] = q_, k_, kc_
     args = (
         cd.K, cd.u, cd.reg, cd.contacts.index, np.ascontiguousarray(cd.contacts.value),
         cd.bearings.index, np.ascontiguousarray(cd.bearings.value),
@@ -981,15 +978,23 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
         np.ascontiguousarray(en, dtype=float), np.ascontiguousarray(gap, dtype=float),
         np.asarray(step_g, dtype=np.int64), np.array(step_T, dtype=float), start, rec,
         int((rec >= 0).sum()), np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
-        np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact), gq,
-        np.zeros((K, nc)), np.zeros((K, nc)), gkg, gkc, given,
+        np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact), given_state, given,
     )  # fmt: skip
     # step_T a fresh C array: solve_system passes a read-only broadcast ('A' layout), the yield
     # a contiguous one; each compiled _solve_batch again (~7 s CPU, gear_chain's first run)
     if compiled:
-        return _solve_batch(*args)
-    with _TWIN_LOCK:
-        return _twin(_solve_batch)(*args)
+        rot, forces, iters, ST = _solve_batch(*args)
+    else:
+        with _TWIN_LOCK:
+            rot, forces, iters, ST = _twin(_solve_batch)(*args)
+    return (rot, forces, iters) + tuple(ST[:, part] for part in parts)
+
+
+def _state_parts(nd: int, nc: int, ngroups: int) -> tuple[slice, ...]:
+    """The parts of :func:`_solve_batch`'s state vector: displacements, contact forces,
+    approaches, per-disc and per-contact stiffness."""
+    ends = np.cumsum([0, nd, nc, nc, ngroups, nc])
+    return tuple(slice(int(a), int(b)) for a, b in zip(ends[:-1], ends[1:], strict=True))
 
 
 def solve_positions(
@@ -1141,7 +1146,7 @@ def solve_system(
 
 _KERNELS = ("_solve_batch", "_position", "_newton", "_newton_mixed", "_energy", "_assemble",
             "_assemble_rows3", "_add_block3", "_rows_times",
-            "_spd_solve", "_copy", "_rows_dot", "_law_force", "_law_force_start", "_work",
+            "_spd_solve", "_copy", "_rows_dot", "_law_force", "_law_force_start",
             "_log_update",
             "_bearing_terms", "_law_delta")  # fmt: skip
 
