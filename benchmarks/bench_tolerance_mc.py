@@ -174,7 +174,7 @@ def main() -> None:
     ap.add_argument("--numpy-samples", type=float, default=4e6)
     ap.add_argument("--loop-samples", type=int, default=50_000)
     ap.add_argument("--workers", type=int, default=None)
-    ap.add_argument("--repeats", type=int, default=5, help="interleaved repeats (best kept)")
+    ap.add_argument("--repeats", type=int, default=12, help="interleaved repeats (best kept)")
     args = ap.parse_args()
     n = int(args.samples)
     n_s = min(n, int(args.numpy_samples))
@@ -262,26 +262,43 @@ def main() -> None:
     )
 
     def strongest(names):
-        """(name, best CPU ratio, range of per-repeat CPU ratios) of the faster baseline."""
+        """(name, best CPU ratio, range and median of per-repeat CPU ratios) of the faster
+        baseline."""
         k = min(names, key=lambda x: cpu[x])
         per_rep = [b[1] / a[1] for a, b in zip(runs["gearte"], runs[k], strict=True)]
-        return k, cpu[k] / cpu["gearte"], min(per_rep), max(per_rep)
+        return k, cpu[k] / cpu["gearte"], min(per_rep), max(per_rep), float(np.median(per_rep))
 
     for names, what in (
         (("twin 1e6", "tuned 1e6"), "numpy chunks 1e6 (gearte's default)"),
         (("twin best", "tuned best"), f"numpy chunks {best_chunk:,} (its best)"),
     ):
-        k, rc, lo_, hi_ = strongest(names)
+        k, rc, lo_, hi_, med = strongest(names)
         print(
             f"goal >= 5x the strongest numpy per core (CPU, 1 thread each), {what}, vs {k}: "
-            f"measured {rc:.1f}x (repeats {lo_:.1f}-{hi_:.1f}x) — {verdict(rc, 5)}; "
+            f"measured {rc:.1f}x (repeats {lo_:.1f}-{hi_:.1f}x, median {med:.1f}x) — "
+            f"{verdict(rc, 5)}; "
             f"gearte's CPU on {threads} threads: {cpu[k] / cpu['gearte threads']:.1f}x; wall, "
             f"gearte on {threads} threads vs numpy on 1: {wall[k] / wall['gearte threads']:.1f}x"
         )
     outside = cpu["gearte"] - cpu["kernel alone"]
+
+    def overhead(chunks: int) -> float:
+        """CPU seconds of a call of ``chunks`` chunks of 1024 samples (the kernel's part ~3 µs
+        per chunk): monte_carlo's Python layer, per call and per chunk."""
+        return min(
+            timed(monte_carlo, st, 1024 * chunks, seed=1, chunk_size=1024, options=one)[1]
+            for _ in range(30)
+        )
+
+    o1, o10 = overhead(1), overhead(10)
+    per_chunk = (o10 - o1) / 9
+    layer = o1 - per_chunk + per_chunk * math.ceil(n / 1e6)
     print(
-        f"monte_carlo outside its kernel (1 thread): {outside * 1e9:.2f} ns CPU/sample "
-        f"({outside / cpu['gearte']:.0%} of gearte's time; per call and per chunk Python, seeding)"
+        f"monte_carlo outside its kernel (1 thread): difference of the two minima above "
+        f"{outside * 1e9:.2f} ns CPU/sample ({outside / cpu['gearte']:.0%}); measured directly "
+        f"(tiny chunks): {(o1 - per_chunk) * 1e3:.2f} ms per call + {per_chunk * 1e6:.0f} µs per "
+        f"chunk (seeding, the kernel's call and set-up) = {layer / n * 1e9:.2f} ns/sample at "
+        f"{n:.3g} samples"
     )
     rate = 1 / wall["gearte threads"]
     print(

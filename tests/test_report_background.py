@@ -223,3 +223,18 @@ def test_streamed_report_is_the_report_of_the_final_result(
     html, timings = rep.finish(pickle.loads(frame[8:]))
     assert _page(html) == _page(render_report(result))
     assert timings["report process: figures during the analyses"] >= 0.0
+
+
+def test_cached_font_heights_draw_the_same_pixels(cycloid_result, monkeypatch) -> None:
+    """matplotlib reads a font's height metrics for every text it lays out; the cache
+    (``display.cache_font_heights``) gives the same numbers, so the same PNG bytes."""
+    from matplotlib.backends.backend_agg import RendererAgg
+
+    from gearte.plotting import display, figures_for
+
+    display.cache_font_heights()
+    cached = _pngs(figures_for(cycloid_result))
+    assert display._FONT_HEIGHTS  # the cache was used
+    monkeypatch.delattr(RendererAgg, "_get_font_height_metrics")
+    monkeypatch.setattr(display, "cache_font_heights", lambda: None)
+    assert _pngs(figures_for(cycloid_result)) == cached

@@ -554,24 +554,18 @@ def _percentiles_from_hist(
     qs: Sequence[float], counts: np.ndarray, lo: float, hi: float, mn: float, mx: float
 ) -> dict[float, float]:
     """The values at the percent levels ``qs``, interpolated in the histogram (edges and
-    cumulative counts built once for all levels)."""
+    cumulative counts built once, every level located by one ``searchsorted``)."""
     nbins = counts.size - 2
-    n = counts.sum()
     edges = np.concatenate([[min(mn, lo)], np.linspace(lo, hi, nbins + 1), [max(mx, hi)]])
     cum = np.concatenate([[0], np.cumsum(counts)])
-    out = {}
-    for q in qs:
-        target = q / 100.0 * n
-        k = int(np.searchsorted(cum, target, side="left"))
-        k = min(max(k, 1), counts.size)
-        c0, c1 = cum[k - 1], cum[k]
-        left, right = edges[k - 1], edges[k]
-        if c1 == c0:
-            out[float(q)] = float(left)
-            continue
-        val = left + (target - c0) / (c1 - c0) * (right - left)
-        out[float(q)] = float(min(max(val, mn), mx))
-    return out
+    target = np.asarray(qs, dtype=float) / 100.0 * cum[-1]
+    k = np.clip(np.searchsorted(cum, target, side="left"), 1, counts.size)
+    c0, c1 = cum[k - 1], cum[k]
+    left, right = edges[k - 1], edges[k]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        val = np.clip(left + (target - c0) / (c1 - c0) * (right - left), mn, mx)
+    val = np.where(c1 == c0, left, val)
+    return {float(q): float(v) for q, v in zip(qs, val, strict=True)}
 
 
 def _map_chunks(func, tasks: Sequence[Any], *, options: Any, progress: bool, description: str):
@@ -593,6 +587,7 @@ class _Task:
     seed: np.random.SeedSequence
     n: int
     keep: int
+    states: np.ndarray | None = None  # the kernel's stream states of this chunk's seed
 
 
 class _ChunkRunner:
@@ -609,7 +604,7 @@ class _ChunkRunner:
         kw = dict(shift=self.shift, lo=self.lo, hi=self.hi, nbins=self.nbins)
         if self.kernel is not None:
             reduction = (self.shift, self.lo, self.hi, self.nbins, self.lsl, self.usl, task.keep)
-            st = stream_states(task.seed)
+            st = stream_states(task.seed) if task.states is None else task.states
             args = (st, lane_states(st), task.n, *self.kernel.args(), *reduction)
             out = _linear_stack_kernel(*args)
             return ChunkStats(task.n, *out)
@@ -704,7 +699,11 @@ def monte_carlo(
     remaining_keep = keep
     for k in range(n_chunks):
         m = min(chunk_size, n - k * chunk_size)
-        tasks.append(_Task(seeds[k], m, max(0, min(remaining_keep, m))))
+        # The kernel's stream states, seeded here for every chunk in a row: seeding in the
+        # chunk, right after the previous chunk's kernel, found the caches cold and took ~4×
+        # as long (0.2 ns per sample at 10⁶-sample chunks). Same states, same results.
+        states = stream_states(seeds[k]) if kernel is not None else None
+        tasks.append(_Task(seeds[k], m, max(0, min(remaining_keep, m)), states))
         remaining_keep -= m
     runner = _ChunkRunner(stack, kernel, centre, lo, hi, nbins, lsl, usl, min(chunk_size, 250_000))
     parts = _map_chunks(
