@@ -446,7 +446,9 @@ class ReportWorker:
         """Send the loaded case (a validated ``Case``) and the names of the gearte modules this
         process has imported (the worker imports them while the analyses run: unpickling the
         analyses needs them, and some import numba)."""
-        modules = sorted(m for m in sys.modules if m.startswith("gearte."))
+        modules = sorted(
+            m for m in sys.modules if m.startswith("gearte.") and m != "gearte.__main__"
+        )  # (importing gearte.__main__ runs the command)
         with contextlib.suppress(Exception):
             case_data = pickle.dumps(case, protocol=pickle.HIGHEST_PROTOCOL)
             self._send(_frame(("preload", modules, case_data)))
