@@ -170,15 +170,28 @@ def _pngs(figs: list) -> list[tuple[str, str, str]]:
     return [(r.analysis, r.title, r.png) for r in render_all(figs, workers=1)]
 
 
-def test_figures_of_one_analysis_are_those_of_the_whole_result(cycloid_result) -> None:
+@pytest.mark.parametrize(
+    ("case", "expected"),
+    [("hu2020_rv80e_initial", {"geometry", "geometric_te", "tooth_contact"}),
+     ("synthetic_rv_bench", {"te_orders"})],
+)  # fmt: skip
+def test_figures_of_one_analysis_are_those_of_the_whole_result(
+    cycloid_result, case: str, expected: set[str]
+) -> None:
     from gearte.plotting import figures_for, figures_of, self_contained
+    from gearte.studies import RunOptions, run_case
 
-    names = [a.name for a in cycloid_result.analyses]
-    drawn = [n for n in names if n in self_contained(cycloid_result.kind)]
-    assert {"geometry", "geometric_te", "tooth_contact"} <= set(drawn)
-    whole = _pngs(figures_for(cycloid_result))
-    alone = [p for n in drawn for p in _pngs(figures_of(cycloid_result, {n}))]
-    assert alone == [p for p in whole if p[0] in drawn]  # same pixels, same order per analysis
+    result = (
+        cycloid_result
+        if case == "hu2020_rv80e_initial"
+        else run_case(case, RunOptions(progress=False))
+    )
+    names = [a.name for a in result.analyses]
+    drawn = [n for n in names if n in self_contained(result.kind)]
+    assert set(drawn) == expected
+    whole = _pngs(figures_for(result))
+    alone = [p for n in drawn for p in _pngs(figures_of(result, {n}))]
+    assert alone and alone == [p for p in whole if p[0] in drawn]  # same pixels and order
 
 
 def _page(html: str) -> str:
@@ -223,3 +236,18 @@ def test_streamed_report_is_the_report_of_the_final_result(
     html, timings = rep.finish(pickle.loads(frame[8:]))
     assert _page(html) == _page(render_report(result))
     assert timings["report process: figures during the analyses"] >= 0.0
+
+
+def test_cached_font_heights_draw_the_same_pixels(cycloid_result, monkeypatch) -> None:
+    """matplotlib reads a font's height metrics for every text it lays out; the cache
+    (``display.cache_font_heights``) gives the same numbers, so the same PNG bytes."""
+    from matplotlib.backends.backend_agg import RendererAgg
+
+    from gearte.plotting import display, figures_for
+
+    display.cache_font_heights()
+    cached = _pngs(figures_for(cycloid_result))
+    assert display._FONT_HEIGHTS  # the cache was used
+    monkeypatch.delattr(RendererAgg, "_get_font_height_metrics")
+    monkeypatch.setattr(display, "cache_font_heights", lambda: None)
+    assert _pngs(figures_for(cycloid_result)) == cached

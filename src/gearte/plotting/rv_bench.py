@@ -9,7 +9,11 @@ import numpy as np
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 
-__all__ = ["figures"]
+__all__ = ["figures", "SELF_CONTAINED"]
+
+#: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`);
+#: not the catalogue (its hysteresis figure draws the calibrated model beside the bench curve).
+SELF_CONTAINED = frozenset({"te_orders"})
 
 
 def _analysis(result, name):

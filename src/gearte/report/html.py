@@ -62,6 +62,9 @@ def figure_to_png_base64(fig: Any, dpi: int = DPI) -> str:
     str
         Base64 text of the PNG.
     """
+    from gearte.plotting.display import cache_font_heights
+
+    cache_font_heights()  # the same pixels, ~15-20 % less drawing time
     buf = io.BytesIO()
     # zlib level 3, not Pillow's 6: half the encoding time (~15 of ~30 ms for a 700 x 400 px
     # figure) for ~18 % more bytes

@@ -574,112 +574,6 @@ def _log_update(lf, f, r):
     return np.log(f)
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _position(
-    K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, group, ngroups, law, coef, q, k, kc,
-    force, approach, kt, q0, fd0, wm, wv, wc, tol, maxit, exact,
-):  # fmt: skip
-    """:func:`gearte.solvers.rv_equilibrium._solve_all` on sparse rows, in place.
-
-    State in ``q`` (displacements), ``k`` (per disc) and ``kc`` (per contact) stiffnesses,
-    ``force`` and ``approach`` (the last solution's contact forces and approaches: warm pairs of
-    the law) and ``kt`` (tangents); ``q0``, ``fd0`` (2, nc): the start, kept for a retry;
-    ``wm``, ``wv``, ``wc``: :func:`_newton`'s work arrays. Returns (iterations, ok).
-    Inlined into its one caller, :func:`_solve_batch` (each level of compiled calls
-    re-optimises the code below it, docs/numba.md).
-
-    ``exact`` (per-contact law only): :func:`_newton_mixed` from the warm forces first; where it
-    fails, Newton on Π with the exact law (:func:`_newton`); the secant fixed point only where
-    both fail.
-    """
-    nc = gc.size
-    qmax = 1.0
-    for a in range(q.size):
-        qmax = max(qmax, abs(q[a]))
-    qtol = 1e-13 * qmax
-    # one call site of _newton (it is inlined): the exact law's attempt after _newton_mixed,
-    # then the secant fixed point; the law flag a run-time bool (a constant True/False would
-    # compile _newton and _energy once per literal value, docs/numba.md)
-    use_exact = law == LAW_SECANT_PER_CONTACT and exact
-    total = 0
-    if use_exact:
-        _copy(q, q0)
-        _copy(force, fd0[0])
-        _copy(approach, fd0[1])
-        total, ok = _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q,
-                                  force, approach, kt, wm, wv, wc, 30)  # fmt: skip
-        if ok:
-            return total, True
-        _copy(q0, q)
-        _copy(fd0[0], force)
-        _copy(fd0[1], approach)
-    elif law != LAW_SECANT_PER_CONTACT:
-        for c in range(nc):
-            kc[c] = k[group[c]]
-    outer = 0
-    while outer < 200:
-        its, ok = _newton(use_exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef,
-                          kc, q, force, approach, kt, wm, wv, wc, qtol, maxit)  # fmt: skip
-        total += its
-        if use_exact:
-            # Newton on Π with the exact law, after _newton_mixed failed
-            if ok:
-                return total, True
-            use_exact = False
-            total = 0
-            _copy(q0, q)
-            _copy(fd0[0], force)
-            _copy(fd0[1], approach)
-            for c in range(nc):  # the secant stiffness of the start as the fixed point's start
-                if force[c] > 0.0 and approach[c] > 0.0:
-                    kc[c] = force[c] / approach[c]
-            continue
-        outer += 1
-        if not ok:
-            return total, False
-        # force = kc d on the closed contacts (from the last energy evaluation)
-        if law == LAW_LINEAR:
-            return total, True
-        change = 0.0
-        if law == LAW_SECANT_PER_DISC:
-            for g in range(ngroups):
-                fmax = 0.0
-                cm = -1
-                for c in range(nc):
-                    if group[c] == g and force[c] > fmax:
-                        fmax = force[c]
-                        cm = c
-                if fmax > 0.0:
-                    if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
-                        return total, False
-                    knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
-                    change = max(change, abs(knew / k[g] - 1.0))
-                    k[g] = knew
-            for c in range(nc):
-                kc[c] = k[group[c]]
-        else:
-            for c in range(nc):
-                if force[c] > 0.0:
-                    if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
-                        return total, False
-                    knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
-                    change = max(change, abs(knew / kc[c] - 1.0))
-                    kc[c] = knew
-            for g in range(ngroups):
-                kg = 0.0
-                for c in range(nc):
-                    if group[c] == g and force[c] > 0.0 and kc[c] > kg:
-                        kg = kc[c]
-                if kg > 0.0:
-                    k[g] = kg
-        if change < tol:
-            for c in range(nc):
-                dc = approach[c]
-                force[c] = kc[c] * dc if dc > 0.0 else 0.0
-            return total, True
-    return total, False
-
-
 @njit(cache=True, nogil=True)
 def _solve_batch(
     K0s, us, regs, cidx, cvals, nidx, nvals, kn, cn, group, ngroups, law, coefs, kstart, Hs, ENs,
@@ -690,7 +584,9 @@ def _solve_batch(
     ``K0s[g]``, load ``T us[g] − Hs[s, g]``; the output rotation is recovered as
     ``T out_u[g] − out_h[s, g] + out_q[g] · q``. ``start[t]``: the step whose solution (of the
     same sample) starts step ``t`` (−1: zero displacements and the law's start stiffness);
-    where ``given[t]``, step ``t`` starts from the state ``given_state[t]`` instead.
+    where ``given[t]``, step ``t`` starts from the state ``given_state[t]`` instead. Each
+    step's equilibrium is :func:`gearte.solvers.rv_equilibrium._solve_all` on sparse rows
+    (:func:`_newton_mixed`, :func:`_newton` and the stiffness fixed point), written out here.
 
     A step's state is one vector (:func:`_state_parts`): displacements ``q`` (nd), contact
     forces and approaches (nc each), per-disc (ngroups) and per-contact (nc) stiffness — one
@@ -737,13 +633,107 @@ def _solve_batch(
             if u >= 0 and not given[t] and step_g[u] == g and step_T[u] == T:
                 its, ok = 0, True  # the same equilibrium (unique): its solution as it is
             else:
+                # the equilibrium of this step: rv_equilibrium._solve_all on sparse rows, in
+                # place (written here, not as a kernel of its own: each level of compiled calls
+                # re-optimises the code below it, and numba's inlining copies the callee's IR
+                # block by block, docs/numba.md)
+                K0, reg, nval, cval = K0s[g], regs[g], nvals[g], cvals[g]
+                en, gc, coef = ENs[s, g], GAPs[s, g], coefs[g]
                 for a in range(nd):
                     f0[a] = T * us[g, a] - Hs[s, g, a]
-                its, ok = _position(
-                    K0s[g], regs[g], f0, nidx, nvals[g], ENs[s, g], kn, cn, cidx, cvals[g],
-                    GAPs[s, g], group, ngroups, law, coefs[g], q, k, kc, force, approach, kt, q0,
-                    fd0, wm, wv, wc, tol, maxit, exact,
-                )  # fmt: skip
+                qmax = 1.0
+                for a in range(nd):
+                    qmax = max(qmax, abs(q[a]))
+                qtol = 1e-13 * qmax
+                # exact (per-contact law only): _newton_mixed from the warm forces first; where
+                # it fails, Newton on Π with the exact law (_newton); the secant fixed point only
+                # where both fail. One call site of _newton for the exact-law retry and the fixed
+                # point; its law flag a run-time bool (a constant True/False would compile
+                # _newton and _energy once per literal value, docs/numba.md)
+                use_exact = law == LAW_SECANT_PER_CONTACT and exact
+                its, ok = 0, False
+                if use_exact:
+                    _copy(q, q0)
+                    _copy(force, fd0[0])
+                    _copy(approach, fd0[1])
+                    its, ok = _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval,
+                                            gc, coef, q, force, approach, kt, wm, wv, wc,
+                                            30)  # fmt: skip
+                    if not ok:
+                        _copy(q0, q)
+                        _copy(fd0[0], force)
+                        _copy(fd0[1], approach)
+                elif law != LAW_SECANT_PER_CONTACT:
+                    for c in range(nc):
+                        kc[c] = k[group[c]]
+                outer = 0
+                while not ok and outer < 200:
+                    more, ok = _newton(use_exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval,
+                                       gc, coef, kc, q, force, approach, kt, wm, wv, wc, qtol,
+                                       maxit)  # fmt: skip
+                    its += more
+                    if use_exact:
+                        # Newton on Π with the exact law, after _newton_mixed failed
+                        if ok:
+                            break
+                        use_exact = False
+                        its = 0
+                        _copy(q0, q)
+                        _copy(fd0[0], force)
+                        _copy(fd0[1], approach)
+                        for c in range(nc):  # the start's secant stiffness: the fixed point's start
+                            if force[c] > 0.0 and approach[c] > 0.0:
+                                kc[c] = force[c] / approach[c]
+                        continue
+                    outer += 1
+                    # force = kc d on the closed contacts (from the last energy evaluation)
+                    if not ok or law == LAW_LINEAR:
+                        break
+                    ok = False  # until the stiffness fixed point has converged
+                    change = 0.0
+                    beyond = False  # a force beyond the law's range
+                    if law == LAW_SECANT_PER_DISC:
+                        for gr in range(ngroups):
+                            fmax = 0.0
+                            cm = -1
+                            for c in range(nc):
+                                if group[c] == gr and force[c] > fmax:
+                                    fmax = force[c]
+                                    cm = c
+                            if fmax > 0.0:
+                                if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
+                                    beyond = True
+                                    break
+                                knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
+                                change = max(change, abs(knew / k[gr] - 1.0))
+                                k[gr] = knew
+                        if beyond:
+                            break
+                        for c in range(nc):
+                            kc[c] = k[group[c]]
+                    else:
+                        for c in range(nc):
+                            if force[c] > 0.0:
+                                if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
+                                    beyond = True
+                                    break
+                                knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
+                                change = max(change, abs(knew / kc[c] - 1.0))
+                                kc[c] = knew
+                        if beyond:
+                            break
+                        for gr in range(ngroups):
+                            kg = 0.0
+                            for c in range(nc):
+                                if group[c] == gr and force[c] > 0.0 and kc[c] > kg:
+                                    kg = kc[c]
+                            if kg > 0.0:
+                                k[gr] = kg
+                    if change < tol:
+                        for c in range(nc):
+                            dc = approach[c]
+                            force[c] = kc[c] * dc if dc > 0.0 else 0.0
+                        ok = True
             if not ok:
                 iters[s, t] = -1
                 break
@@ -1144,7 +1134,7 @@ def solve_system(
     return EquilibriumSolution(q, F, KG, iters, KC)
 
 
-_KERNELS = ("_solve_batch", "_position", "_newton", "_newton_mixed", "_energy", "_assemble",
+_KERNELS = ("_solve_batch", "_newton", "_newton_mixed", "_energy", "_assemble",
             "_assemble_rows3", "_add_block3", "_rows_times",
             "_spd_solve", "_copy", "_rows_dot", "_law_force", "_law_force_start",
             "_log_update",
