@@ -561,10 +561,14 @@ def _rotation_batch(arm, clr, a0, a1, T, rot0, rtol, frtol, max_iter):  # pragma
 def _rotation_inputs(arm, clearance, a0, a1, torque):
     if not (math.isfinite(torque) and torque > 0.0):
         raise ParameterError("torque", torque, "must be finite and > 0 [N·mm]")
-    arm = np.ascontiguousarray(np.atleast_2d(np.asarray(arm, dtype=float)))
+    # fresh writeable C arrays: a read-only one (np.broadcast_to of an array of that shape is
+    # a read-only view, which ascontiguousarray keeps) compiles _rotation_batch, _rotation_one
+    # and _torque_at a second time beside the cycloid line-contact kernel's writeable arrays
+    # (~1 s CPU on the first run of a case with both, docs/numba.md)
+    arm = np.require(np.atleast_2d(np.asarray(arm, dtype=float)), float, ["C", "W"])
     shape = arm.shape
     clearance, a0, a1 = (
-        np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float), shape))
+        np.require(np.broadcast_to(np.asarray(x, dtype=float), shape), float, ["C", "W"])
         for x in (clearance, a0, a1)
     )
     return arm, clearance, a0, a1
@@ -659,7 +663,7 @@ def solve_rotation(
         a0,
         a1,
         float(torque),
-        np.ascontiguousarray(rot0, dtype=float),
+        np.require(rot0, float, ["C", "W"]),
         float(rtol),
         float(force_rtol),
         int(max_iter),

@@ -43,7 +43,7 @@ from gearte.tolerance.rng import (
     ZigguratTables,
     lane_states,
     next_u64,
-    normals_block,
+    normals_block_hist,
     reference_normal,
     stream_states,
     u64_to_unit,
@@ -122,8 +122,9 @@ def _draw_other(code, p0, p1, d0, d1, d2, d3, pool):  # pragma: no cover - compi
 
 @njit(inline="always")
 def _fill_block(
-    z, m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
-):  # pragma: no cover - compiled
+    z, m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool,
+    counts, bins, nb,
+):  # pragma: no cover - compiled  # fmt: skip
     """``z[:m]`` <- the next ``m`` samples of the stack; the stream states advance.
 
     Per sample: the Gaussian group's normal (:func:`gearte.tolerance.rng.normals_block`: one
@@ -131,7 +132,7 @@ def _fill_block(
     then each other contributor in order from the draws stream (the order of
     :func:`linear_stack_reference`)."""
     if group:
-        normals_block(z, m, raw, rej, lanes, st, tk, tw, tf)
+        normals_block_hist(z, m, raw, rej, lanes, st, tk, tw, tf, counts, bins, nb)
         for j in range(m):
             z[j] = base + gsd * z[j]
     else:
@@ -203,8 +204,9 @@ def _linear_stack_kernel(
     z = np.empty(_BLOCK)
     raw = np.empty(_BLOCK, np.uint64)
     rej = np.empty(_BLOCK, np.int64)
-    fbin = raw.view(np.float64)  # raw is free once the block's normals are drawn
-    ibin = raw
+    ibin = np.empty(_BLOCK, np.uint64)
+    fbin = ibin.view(np.float64)
+    pm = 0
     inv_width = nbins / (hi - lo)
     top = float(nbins)
     specs = lsl > -np.inf or usl < np.inf
@@ -228,8 +230,11 @@ def _linear_stack_kernel(
         m = min(_BLOCK, n - done)
         _fill_block(
             z, m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params, codes,
-            sens, pool,
+            sens, pool, c32, ibin, pm if group else 0,
         )  # fmt: skip
+        if not group:
+            for j in range(pm):
+                c32[ibin[j] & _BIN_MASK] += 1
         for j in range(min(m, keep - done)):
             kept[done + j] = z[j]
         if m == _BLOCK:  # pairwise (a fixed tree): elementwise loops, vector registers
@@ -289,13 +294,14 @@ def _linear_stack_kernel(
                 mn = y if y < mn else mn
                 mx = y if y > mx else mx
                 fbin[j] = _bin(y, lo, inv_width, top)
-        for j in range(m):
-            c32[ibin[j] & _BIN_MASK] += 1  # 0 underflow, nbins + 1 overflow
+        pm = m
         if specs:  # integer sums of comparisons: vector registers
             for j in range(m):
                 below += z[j] < lsl
                 above += z[j] > usl
         done += m
+    for j in range(pm):  # the last block's counts
+        c32[ibin[j] & _BIN_MASK] += 1
     counts += c32
     return s1, s2, mn, mx, below, above, counts, kept
 
@@ -313,7 +319,7 @@ def _linear_stack_samples(
         m = min(_BLOCK, n - done)
         _fill_block(
             out[done:], m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params,
-            codes, sens, pool,
+            codes, sens, pool, rej, raw, 0,
         )  # fmt: skip
     return out
 
