@@ -251,3 +251,22 @@ def test_cached_font_heights_draw_the_same_pixels(cycloid_result, monkeypatch) -
     monkeypatch.delattr(RendererAgg, "_get_font_height_metrics")
     monkeypatch.setattr(display, "cache_font_heights", lambda: None)
     assert _pngs(figures_for(cycloid_result)) == cached
+
+
+def test_plotting_modules_with_a_log_axis_say_so() -> None:
+    """The report process builds matplotlib's mathtext parser (log tick labels) while it warms
+    up only for kinds whose plotting module says ``LOG_AXES``; a module drawing a log axis
+    without saying so pays it after the result (slower, same pixels)."""
+    import importlib
+    import pkgutil
+    import re
+
+    import gearte.plotting
+
+    log = re.compile(r"set_[xy]scale\(\s*[\"']log|semilog[xy]\(|loglog\(")
+    for info in pkgutil.iter_modules(gearte.plotting.__path__):
+        module = importlib.import_module(f"gearte.plotting.{info.name}")
+        with open(module.__file__, encoding="utf-8") as fh:
+            draws_log = bool(log.search(fh.read()))
+        if draws_log:
+            assert getattr(module, "LOG_AXES", False), f"{info.name} draws a log axis"

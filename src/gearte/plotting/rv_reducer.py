@@ -26,6 +26,8 @@ SELF_CONTAINED = (
     | rv_dynamics.SELF_CONTAINED
     | _YIELD
 )
+#: Some figure has a log axis (the dynamics' DTE spectrum).
+LOG_AXES = rv_dynamics.LOG_AXES
 
 
 def _pin_map(ls, title: str) -> Figure:
