@@ -253,6 +253,19 @@ def test_cached_font_heights_draw_the_same_pixels(cycloid_result, monkeypatch) -
     assert _pngs(figures_for(cycloid_result)) == cached
 
 
+def test_font_height_cache_falls_back_to_matplotlib_when_its_internals_change() -> None:
+    """The hook is private matplotlib API: where what it reads is missing (a renderer without
+    ``dpi``, a font property object of another shape) or it is called with other arguments, it
+    answers ``(None, None, None)`` and matplotlib measures the font itself."""
+    from gearte.plotting import display
+
+    class Renderer:  # no dpi
+        pass
+
+    assert display._font_height_metrics(Renderer(), object()) == (None, None, None)
+    assert display._font_height_metrics(Renderer(), object(), 72.0, extra=1) == (None, None, None)
+
+
 def test_plotting_modules_with_a_log_axis_say_so() -> None:
     """The report process builds matplotlib's mathtext parser (log tick labels) while it warms
     up only for kinds whose plotting module says ``LOG_AXES``; a module drawing a log axis

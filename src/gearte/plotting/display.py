@@ -154,12 +154,23 @@ def _legends_outside(fig: Any) -> None:
 _FONT_HEIGHTS: dict[tuple[Any, ...], tuple[Any, Any, Any]] = {}
 
 
-def _font_height_metrics(renderer: Any, prop: Any) -> tuple[Any, Any, Any]:
+def _font_height_metrics(
+    renderer: Any, prop: Any, *_more: Any, **_named: Any
+) -> tuple[Any, Any, Any]:
     """``(ascent, descent, line gap)`` [px] of the font ``prop`` at the renderer's resolution,
     read from the font's tables as ``matplotlib.text.Text._get_layout`` reads them (its own
     path looks the font file up and reads three tables for every text it lays out: ~15-25 % of
     drawing a figure), once per font, size and resolution; ``(None, None, None)`` (matplotlib
-    then measures the font itself) where the font has neither table."""
+    then measures the font itself) where the font has neither table, or where matplotlib's
+    internals it reads have changed (the hook is private: a newer matplotlib loses only the
+    speed, never the figure)."""
+    try:
+        return _font_height_metrics_cached(renderer, prop)
+    except (AttributeError, KeyError, TypeError, ValueError, RuntimeError):
+        return (None, None, None)
+
+
+def _font_height_metrics_cached(renderer: Any, prop: Any) -> tuple[Any, Any, Any]:
     key = (
         tuple(prop.get_family()),
         prop.get_slant(),
