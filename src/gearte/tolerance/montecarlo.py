@@ -158,7 +158,7 @@ def _fill_block(
 _BIN_OFFSET = 1.0 + 2.0**52
 
 
-@njit(inline="always")
+@njit(cache=True, nogil=True)
 def _bin(y, lo, inv_width, top):  # pragma: no cover - compiled
     """Histogram bin + 1 of ``y`` as the low bits of a double (no branch: vector registers)."""
     t = (y - lo) * inv_width
@@ -167,12 +167,12 @@ def _bin(y, lo, inv_width, top):  # pragma: no cover - compiled
     return math.floor(t) + _BIN_OFFSET
 
 
-@njit(inline="always")
+@njit(cache=True, nogil=True)
 def _min(a, b):  # pragma: no cover - compiled
     return a if a < b else b
 
 
-@njit(inline="always")
+@njit(cache=True, nogil=True)
 def _max(a, b):  # pragma: no cover - compiled
     return a if a > b else b
 

@@ -146,34 +146,37 @@ def stream_states(seed: int | np.random.SeedSequence, streams: int = STREAMS) ->
 
 
 # ------------------------------------------------------------------------------------------------
-# compiled draws (inlined into the kernels; state as four uint64 locals)
+# compiled draws (state as four uint64 locals). The small ones are plain kernels, which LLVM
+# inlines into their callers; numba's inline="always" typed a copy at each of their ~40 call
+# sites and cost the Monte-Carlo kernel ~4 s of its first compile (docs/numba.md).
 # ------------------------------------------------------------------------------------------------
-@njit(inline="always")
+@njit(cache=True, nogil=True)
 def _rotl(x, k):  # pragma: no cover - compiled
-    return (x << uint64(k)) | (x >> uint64(64 - k))
+    """``x`` rotated left by ``k`` bits (both uint64: one signature, no literal ints)."""
+    return (x << k) | (x >> (uint64(64) - k))
 
 
-@njit(inline="always")
+@njit(cache=True, nogil=True)
 def next_u64(s0, s1, s2, s3):  # pragma: no cover - compiled
     """xoshiro256++: ``(output, s0, s1, s2, s3)``."""
-    r = _rotl(s0 + s3, 23) + s0
+    r = _rotl(s0 + s3, uint64(23)) + s0
     t = s1 << uint64(17)
     s2 ^= s0
     s3 ^= s1
     s1 ^= s2
     s0 ^= s3
     s2 ^= t
-    s3 = _rotl(s3, 45)
+    s3 = _rotl(s3, uint64(45))
     return r, s0, s1, s2, s3
 
 
-@njit(inline="always")
+@njit(cache=True, nogil=True)
 def u64_to_unit(r):  # pragma: no cover - compiled
     """Uniform ``[0, 1)`` from the top 53 bits."""
     return float(r >> uint64(11)) * _INV_2_53
 
 
-@njit(inline="always")
+@njit(cache=True, nogil=True)
 def zig_fast(r, k, w):  # pragma: no cover - compiled
     """Fast path of the ziggurat: ``(x, accepted, layer, v)`` from one 64-bit output."""
     idx = int(r & uint64(0xFF))
