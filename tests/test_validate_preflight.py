@@ -288,3 +288,39 @@ def test_rv_tooth_contact_deformation_beyond_the_elastic_range_is_refused_by_val
     assert v == r
     assert v.startswith("analyses.tooth_contact.torque_Nm = ")
     assert "beyond the elastic contact model's range" in v
+
+
+def test_reducer_case_that_is_a_folder_is_refused_by_validate(tmp_path):
+    """Issue 13 fuzz (seed 13, final main): ``reducer.case`` naming an existing *folder* passed
+    the schema's exists-check and crashed the design load (FileNotFoundError, counted as an
+    internal error); it is a schema error naming the key."""
+    folder = tmp_path / "a_folder"
+    folder.mkdir()
+    p = _mutant(
+        tmp_path,
+        "synthetic_rv110e_serial",
+        'case = "han2023_rv110e_no_errors"',
+        f'case = "{folder.as_posix()}"',
+    )
+    line = _validate_and_run_schema(p, tmp_path)
+    assert line.startswith("reducer.case: ") and "is a folder, not a case file" in line
+
+
+def test_design_case_removed_after_validation_names_the_key(tmp_path):
+    """The design file checked at validation and gone before the design is loaded: a
+    ParameterError naming ``reducer.case``, not a FileNotFoundError."""
+    from gearte.errors import ParameterError
+    from gearte.io.case_file import load_case
+
+    design = tmp_path / "design.toml"
+    design.write_text(case_path("han2023_rv110e_no_errors").read_text(encoding="utf-8"))
+    p = _mutant(
+        tmp_path,
+        "synthetic_rv110e_serial",
+        'case = "han2023_rv110e_no_errors"',
+        f'case = "{design.as_posix()}"',
+    )
+    case = load_case(p)
+    design.unlink()
+    with pytest.raises(ParameterError, match="reducer.case"):
+        case.design()

@@ -31,7 +31,11 @@ class MeasuredPartsCase(CaseBase):
         from gearte.io.case_file import load_case
         from gearte.studies import rv_reducer as rv
 
-        design = load_case(self.reducer.case)
+        try:
+            design = load_case(self.reducer.case)
+        except (FileNotFoundError, IsADirectoryError, PermissionError) as exc:
+            # checked at validation; the file went away (or became unreadable) since
+            raise ParameterError("reducer.case", self.reducer.case, str(exc)) from None
         if design.case.kind != "rv_reducer":
             raise ParameterError(
                 "reducer.case",

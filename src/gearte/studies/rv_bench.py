@@ -89,7 +89,10 @@ class ReducerRef(StrictModel):
 
         if v in list_cases() or v.removesuffix(".toml") in list_cases():
             return v
-        return _resolve(v, info)
+        path = _resolve(v, info)
+        if not Path(path).is_file():  # a folder: not a case file
+            raise ValueError(f"{path!r} is a folder, not a case file")
+        return path
 
 
 class DataSection(StrictModel):
