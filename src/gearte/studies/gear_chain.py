@@ -673,6 +673,13 @@ def _yield_setup(case: Case, sec: YieldSection, pairs: dict, defaults: dict):
         if not key.endswith("_gear_eccentricity") or key not in drawn:
             return None
         pair, which = drawn[key]
+        if isinstance(pair, BevelPair):
+            from gearte.errors import ParameterError
+            from gearte.tolerance.iso1328 import BEVEL_GRADE_REASON
+
+            raise ParameterError(
+                f"analyses.yield.tolerances.{key}.grade", grade, BEVEL_GRADE_REASON
+            )
         if not isinstance(pair, SpurPair):
             return None
         teeth = getattr(pair, which).teeth
