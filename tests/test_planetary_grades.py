@@ -232,3 +232,18 @@ def test_unknown_key_hint_never_suggests_the_key_itself():
 
     assert did_you_mean("grade", {"grade", "teeth"}) == ""
     assert did_you_mean("grad", {"grade", "teeth"}) == "did you mean 'grade'?"
+
+
+def test_rv_first_stage_sun_eccentricity_takes_its_grade_too_by_hand():
+    """han2023_rv110e_yield's first stage, m 1.5: sun z 20 → d 30 mm, class 6: F_pT =
+    (0.06 + 0.55·√30 + 1.05 + 12)·√2 = 16.1225·√2 = 22.80 µm, F_rT = 20.52 → 21 µm,
+    tolerance 10.5 µm; the planets (z 40, d 60) keep 11 µm (tests/test_yield_rv.py). Both
+    are reported as derived."""
+    from gearte.studies.rv_reducer import _grade_um
+
+    assert 0.9 * _f_pt(30, 1.5, 6) == pytest.approx(20.52, abs=0.005)
+    read = _grade_um(gearte.load_case("han2023_rv110e_yield"))
+    sun, planet = read("sun_eccentricity", 6), read("planet_base_circle", 6)
+    assert (sun.tolerance_um, planet.tolerance_um) == (10.5, 11.0)
+    assert "sun: z = 20, m_n = 1.5 mm, d = m_n z = 30 mm" in sun.derivation
+    assert read("sun_assembly", 6) is None  # a bearing seat: "not a gear's eccentricity"

@@ -637,7 +637,7 @@ def _yield_setup(case: Case, sec: YieldSection, pairs: dict, defaults: dict):
     """
     from gearte.models.backlash import SpurPair
     from gearte.runners.chain_yield import ChainStage, GearChainYield, stack_terms
-    from gearte.studies._yield import ToleranceEntry
+    from gearte.studies._yield import GradeTolerance, ToleranceEntry
     from gearte.tolerance.iso1328 import radial_composite_tolerances
 
     units = {s.name: "arcmin" for s in case.chain.stages}
@@ -668,7 +668,7 @@ def _yield_setup(case: Case, sec: YieldSection, pairs: dict, defaults: dict):
             )
             drawn[key] = (pair, "driving" if ".driving_gear" in key else "driven")
 
-    def grade_um(key: str, grade: int) -> float | None:
+    def grade_um(key: str, grade: int) -> GradeTolerance | None:
         """A spur gear's eccentricity: its ISO 1328-2 total radial composite tolerance F_i″."""
         if not key.endswith("_gear_eccentricity") or key not in drawn:
             return None
@@ -683,7 +683,12 @@ def _yield_setup(case: Case, sec: YieldSection, pairs: dict, defaults: dict):
         if not isinstance(pair, SpurPair):
             return None
         teeth = getattr(pair, which).teeth
-        return radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
+        f_i2 = radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
+        return GradeTolerance(
+            f_i2,
+            f"ISO 1328-2:1997 radial composite, grade {grade}, {which} gear: z = {teeth}, "
+            f"m = {pair.module:g} mm, d = {pair.module * teeth:g} mm: F_i″ = {f_i2:g} µm",
+        )
 
     model = GearChainYield(chain, nominal, case.chain.lever_length_mm)
     return model, chain, units, nominal, defaults, grade_um
