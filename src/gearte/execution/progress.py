@@ -18,6 +18,13 @@ __all__ = ["ChunkProgress", "format_rate"]
 def format_rate(speed: float | None, unit: str) -> str:
     """The rate shown beside the bar: ``"12,345 samples/s"`` (``"?"`` before two updates).
 
+    Parameters
+    ----------
+    speed : float or None
+        Units per second [1/s] (rich's estimate); ``None`` while unknown.
+    unit : str
+        What is counted (``"samples"``, ``"points"`` …).
+
     >>> format_rate(12345.6, "samples"), format_rate(0.25, "points"), format_rate(None, "samples")
     ('12,346 samples/s', '0.25 points/s', '? samples/s')
     """
