@@ -247,3 +247,18 @@ def test_rv_first_stage_sun_eccentricity_takes_its_grade_too_by_hand():
     assert (sun.tolerance_um, planet.tolerance_um) == (10.5, 11.0)
     assert "sun: z = 20, m_n = 1.5 mm, d = m_n z = 30 mm" in sun.derivation
     assert read("sun_assembly", 6) is None  # a bearing seat: "not a gear's eccentricity"
+
+
+def test_one_grade_on_E_p_covers_every_planet_each_drawn_on_its_own():
+    """``E_p`` (as ``[errors]`` accepts it for every planet) is the family of E_p1 … E_p3
+    (planet_model = "mean"): one grade → 10 µm for each planet (z 36, above), reported once
+    under E_p as derived; the worst sample holds three different draws."""
+    d = _derived({"E_p": {"grade": 6}}, samples=300)
+    d["errors"]["planet_model"] = "mean"
+    d["analyses"]["yield"]["keep_worst"] = 1
+    v = _run(d)
+    t = v["tolerances"]
+    assert list(t) == ["E_p"] and t["E_p"]["tolerance"] == 10.0
+    assert "each planet: z = 36" in t["E_p"]["derived_from"]
+    drawn = v["worst_samples"][0]["errors"]
+    assert len({drawn["E_p1"], drawn["E_p2"], drawn["E_p3"]}) == 3

@@ -472,10 +472,12 @@ def preflight(case: Case) -> None:
         from gearte.studies._yield import yield_inputs
 
         units, nominal = _yield_keys(terms, mags, angs)
+        families = _planet_families(case, units)
         yield_inputs(
             case.analyses.yield_,
             units,
             nominal,
+            families=families,
             grade_um=_grade_um(case),
             quantities=PlanetaryCoupledTE.quantities,
         )
@@ -730,6 +732,25 @@ def _yield_keys(terms: TermSet, mags: dict, angs: dict) -> tuple[dict, dict]:
     return units, nominal
 
 
+def _planet_families(case: Case, units: dict[str, str]) -> dict[str, list[str]]:
+    """With ``errors.source = "derived"``: ``E_p``, ``A_p``, ``beta_p``, ``gamma_p`` as families
+    of the planets' keys (``E_p`` → ``E_p1`` … as the model has them), so one tolerance — or one
+    grade — covers every planet, each drawn on its own, as ``[errors]`` accepts ``E_p`` for
+    every planet. ``units`` gains the family keys."""
+    if case.errors.source != "derived":
+        return {}
+    families: dict[str, list[str]] = {}
+    for base in ("E_p", "A_p", "beta_p", "gamma_p"):
+        inst = sorted(
+            (k for k in units if k.rstrip("0123456789") == base and k != base),
+            key=lambda k: int(k[len(base) :]),
+        )
+        if inst:
+            families[base] = inst
+            units[base] = units[inst[0]]
+    return families
+
+
 def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> AnalysisResult:
     """``[analyses.yield]``: magnitudes [µm] and directions [deg] as tolerances (e.g. Wang's
     random assembly: each direction ``uniform``, ``nominal_deg = 180``, ``tolerance_deg =
@@ -738,6 +759,7 @@ def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> Analy
     from gearte.studies._yield import yield_analysis
 
     units, nominal = _yield_keys(terms, mags, angs)
+    families = _planet_families(case, units)
     mag_um = {k: float(mm_to_um(v)) for k, v in mags.items()}
     ang_deg = {k: float(rad_to_deg(v)) for k, v in angs.items()}
 
@@ -763,6 +785,7 @@ def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> Analy
         options=options,
         worst_case=worst_case,
         references=["wang2013"],
+        families=families,
         grade_um=_grade_um(case),
     )
 
@@ -780,7 +803,8 @@ _ASSEMBLY_KEYS = {
 def _grade_um(case: Case):
     """The ``grade_um(key, grade)`` of the planetary yield
     (:func:`~gearte.studies._yield.yield_analysis`): a gear's manufacturing eccentricity —
-    ``E_s`` (sun), ``E_p<i>`` (planet ``i``), ``E_r`` (ring, an internal gear) — takes the
+    ``E_s`` (sun), ``E_p<i>`` (planet ``i``; ``E_p``: every planet), ``E_r`` (ring, an internal
+    gear) — takes the
     eccentricity tolerance ``F_rT / 2`` of its ISO 1328-1:2013 class, from the gear's module
     and teeth of ``[gearset]`` (``d = m z``; run-out needs no face width). Any other key is an
     error naming it and saying why.
@@ -803,7 +827,8 @@ def _grade_um(case: Case):
             )
         base = key.rstrip("0123456789")
         if base == "E_p":
-            name, z = f"planet {key[len(base) :]}", gs.z_planet
+            i = key[len(base) :]
+            name, z = (f"planet {i}" if i else "each planet"), gs.z_planet
         elif key in gears:
             name, z = gears[key]
         elif base in _ASSEMBLY_KEYS:
