@@ -57,16 +57,7 @@ def warm_up_plotting(case: Any = None) -> None:
 
     log_axes = case is None
     if case is not None:
-        with contextlib.suppress(Exception):
-            kind = _kind_of(case)
-            if kind:
-                import importlib
-
-                from gearte.io.kinds import get_kind
-
-                figures = getattr(get_kind(kind), "FIGURES", None)
-                if figures:  # its plotting module (the analyses' figures are drawn with it)
-                    log_axes = bool(getattr(importlib.import_module(figures), "LOG_AXES", False))
+        log_axes = bool(getattr(_plotting_module(case), "LOG_AXES", False))
     fig, ax = new_figure(figsize=(2.0, 1.5))
     ax.plot([1.0, 2.0], [1.0, 100.0], label="x")
     if log_axes:
@@ -76,6 +67,23 @@ def warm_up_plotting(case: Any = None) -> None:
     ax.set_title("Warm-up")
     ax.legend()
     fig.savefig(io.BytesIO(), format="png", dpi=50)
+
+
+def _plotting_module(case: Any) -> Any:
+    """The plotting module of the case's study kind (imported with the kind: the analyses'
+    figures are drawn with it), read without validating the case; ``None`` where the kind
+    cannot be read or draws no figures."""
+    with contextlib.suppress(Exception):
+        kind = _kind_of(case)
+        if kind:
+            import importlib
+
+            from gearte.io.kinds import get_kind
+
+            figures = getattr(get_kind(kind), "FIGURES", None)
+            if figures:
+                return importlib.import_module(figures)
+    return None
 
 
 def _kind_of(case: Any) -> str | None:
@@ -180,7 +188,8 @@ class _Report:
     drawn yet are drawn in parallel (:func:`gearte.report.html.render_all`).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, preload: bool = True) -> None:
+        self.preload = preload  # import the parent's modules (False: unpickling imports them)
         self.case: Any = None
         self.streamed: dict[int, Any] = {}
         self.todo: list[int] = []  # streamed analyses whose figures are not built yet
@@ -212,7 +221,7 @@ class _Report:
         import importlib
 
         if msg[0] == "preload":
-            for name in msg[1]:
+            for name in msg[1] if self.preload else ():
                 with contextlib.suppress(Exception):
                     importlib.import_module(name)
             self.case = pickle.loads(msg[2])
@@ -338,7 +347,9 @@ def _serve(req: int, resp: int, parent: int, case: Any) -> None:
         _no_setter_docstrings()
         warm_up_plotting(case)
         warm = time.perf_counter() - t0
-        got = _Report().serve(req)
+        # a kind whose results unpickle without numba: not the parent's numba-using modules
+        numba_free = bool(getattr(_plotting_module(case), "NUMBA_FREE_RESULTS", False))
+        got = _Report(preload=not numba_free).serve(req)
         if got is None:
             return
         html, timings = got

@@ -28,14 +28,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from gearte.errors import ParameterError
-from gearte.models.planetary_errors import (
-    TermSet,
-    coupled_te,
-    frequency_basis,
-    keyed_vector,
-    minimize_amplitude,
-    sample_extremes,
-)
+from gearte.models.planetary_terms import TermSet
+
+# The models (numba kernels) are imported where they are used: the report process unpickles an
+# AssemblyPlan without importing numba (docs/report.md).
 
 __all__ = [
     "AssemblyPlan",
@@ -106,6 +102,8 @@ def _unit_phasor(terms: TermSet, mags: Mapping[str, float], idx: list[int], var:
 
 
 def _plan(terms: TermSet, mags: Mapping[str, float], angles: dict[str, float], rule: tuple):
+    from gearte.models.planetary_errors import coupled_te
+
     r = coupled_te(terms, mags, angles)
     return AssemblyPlan(
         angles={k: float(np.mod(v, 2 * np.pi)) for k, v in angles.items()},
@@ -165,6 +163,8 @@ def paper_rule_angles(
     ParameterError
         ``terms``: an angle enters one frequency group with both signs; a missing magnitude.
     """
+    from gearte.models.planetary_errors import frequency_basis, keyed_vector
+
     mags = dict(magnitudes)
     keyed_vector(terms.magnitudes, mags, "magnitudes", required=True)
     ang = {a: float((given_angles or {}).get(a, 0.0)) for a in terms.angles}
@@ -263,6 +263,8 @@ def _polish_compiled(
     """Compiled Nelder–Mead (:func:`gearte.models.planetary_errors.minimize_amplitude`) from
     each start in ``cand`` [rad], restarted once from its result (a minimax can stall a simplex
     on a kink): (x per start, amplitude [mm] per start)."""
+    from gearte.models.planetary_errors import minimize_amplitude
+
     return minimize_amplitude(
         terms, mvec, base, pos, cand, xatol=1e-10, fatol=1e-14, maxiter=4000 * len(pos)
     )
@@ -320,6 +322,8 @@ def optimal_assembly(
     AssemblyPlan
         Angles of the relevant free angles (others 0) and the exact amplitude there.
     """
+    from gearte.models.planetary_errors import keyed_vector, sample_extremes
+
     mags = dict(magnitudes)
     mvec = keyed_vector(terms.magnitudes, mags, "magnitudes", required=True)
     free = relevant_angles(terms, mags)
