@@ -258,16 +258,36 @@ def halton_starts(n: int, d: int, seed: int) -> np.ndarray:
 
 
 def _polish_compiled(
-    cand: list[np.ndarray], base: np.ndarray, pos: list[int], mvec: np.ndarray, terms: TermSet
+    cand: list[np.ndarray],
+    base: np.ndarray,
+    pos: list[int],
+    mvec: np.ndarray,
+    terms: TermSet,
+    workers: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Compiled Nelder–Mead (:func:`gearte.models.planetary_errors.minimize_amplitude`) from
     each start in ``cand`` [rad], restarted once from its result (a minimax can stall a simplex
-    on a kink): (x per start, amplitude [mm] per start)."""
+    on a kink): (x per start, amplitude [mm] per start).
+
+    The starts are independent: they run on ``workers`` threads (default: the cores this process
+    may use; the kernel releases the GIL), each start's steps and result the same as in one
+    thread."""
+    from gearte.execution.streams import default_workers
     from gearte.models.planetary_errors import minimize_amplitude
 
-    return minimize_amplitude(
-        terms, mvec, base, pos, cand, xatol=1e-10, fatol=1e-14, maxiter=4000 * len(pos)
-    )
+    def polish(starts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        return minimize_amplitude(
+            terms, mvec, base, pos, starts, xatol=1e-10, fatol=1e-14, maxiter=4000 * len(pos)
+        )
+
+    n = min(default_workers() if workers is None else workers, len(cand))
+    if n <= 1:
+        return polish(cand)
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(n, thread_name_prefix="gearte-polish") as pool:
+        parts = list(pool.map(polish, [[x] for x in cand]))
+    return np.concatenate([x for x, _ in parts]), np.concatenate([f for _, f in parts])
 
 
 def _polish_scipy(amp, cand: list[np.ndarray], d: int) -> tuple[np.ndarray, np.ndarray]:
@@ -295,6 +315,7 @@ def optimal_assembly(
     seed: int = 20130808,
     extra_starts: list[Mapping[str, float]] | None = None,
     compiled: bool = True,
+    workers: int | None = None,
 ) -> AssemblyPlan:
     """Global minimum over all free angles of the exact coupled amplitude max_t |Σe(t)|.
 
@@ -316,6 +337,9 @@ def optimal_assembly(
     compiled : bool
         Run the Nelder–Mead polish compiled (default) or with SciPy on the Python objective
         (the plain twin: same steps, ~100× slower).
+    workers : int, optional
+        Threads of the compiled polish (default: the cores this process may use; the result does
+        not depend on it).
 
     Returns
     -------
@@ -351,7 +375,7 @@ def optimal_assembly(
     for st in extra_starts or []:
         cand.append(np.array([float(st.get(a, 0.0)) for a in free]))
     if compiled:
-        xs, fs = _polish_compiled(cand, base, pos, mvec, terms)
+        xs, fs = _polish_compiled(cand, base, pos, mvec, terms, workers)
     else:
         xs, fs = _polish_scipy(amp, cand, d)
     best_x, best_v = None, np.inf

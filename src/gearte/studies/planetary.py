@@ -564,6 +564,7 @@ def run(case: Case, options) -> StudyResult:
             polish=sample_cap(ao, "polish", options),
             seed=ao.seed,
             extra_starts=[paper.angles],
+            workers=options.workers,
         )
 
     # ---- coupled TE at the chosen assembly
