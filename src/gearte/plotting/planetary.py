@@ -23,6 +23,7 @@ __all__ = [
     "mc_histograms_figure",
     "SELF_CONTAINED",
     "NUMBA_FREE_RESULTS",
+    "OTHERS_READ_ALONE",
 ]
 
 #: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`): the
@@ -35,6 +36,11 @@ SELF_CONTAINED = frozenset({"terms", "coupled_te", "assembly"}) | _YIELD
 #: where they use them): the report process does not import the parent's numba-using modules
 #: (~0.5 s CPU on the core beside the analyses; tests/test_report_background.py checks it).
 NUMBA_FREE_RESULTS = True
+
+#: The Monte-Carlo histogram reads the Monte-Carlo analyses alone (none of SELF_CONTAINED): once
+#: the final result comes, the report process builds only it
+#: (:func:`gearte.plotting.others_read_alone`).
+OTHERS_READ_ALONE = True
 
 
 def phasor_figure(result: Any) -> Figure | None:

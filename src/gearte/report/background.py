@@ -256,7 +256,7 @@ class _Report:
     def finish(self, final: tuple[Any, ...]) -> tuple[Any, ...]:
         import time
 
-        from gearte.plotting import figures_for, figures_of, self_contained
+        from gearte.plotting import figures_for, figures_of, others_read_alone, self_contained
         from gearte.report.html import render_all, render_report
 
         result = pickle.loads(final[1])
@@ -277,7 +277,7 @@ class _Report:
         rest = [n for n in names if n not in early]
         if not early:
             figs = figures_for(result)
-        elif set(rest) <= self_contained(result.kind):
+        elif set(rest) <= self_contained(result.kind) or others_read_alone(result.kind):
             figs = figures_of(result, rest)
         else:  # a figure of another analysis may read those built already: build all, skip them
             figs = [f for f in figures_for(result) if f.analysis not in early]
