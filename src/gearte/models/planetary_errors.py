@@ -249,6 +249,9 @@ def frequency_basis(terms: TermSet) -> tuple[Fraction, tuple[int, ...], np.ndarr
     group : ndarray of int
         Per term, the index into ``harmonics`` (-1 for q = 0).
     """
+    if terms._basis is not None:  # computed once per term set
+        q0, harm, group = terms._basis
+        return q0, harm, group.copy()
     qs = [abs(t.frequency) for t in terms.terms if t.frequency != 0]
     if not qs:
         return Fraction(1), (), np.full(len(terms.terms), -1, dtype=np.int64)
@@ -264,6 +267,7 @@ def frequency_basis(terms: TermSet) -> tuple[Fraction, tuple[int, ...], np.ndarr
         [idx[int(abs(t.frequency) / q0)] if t.frequency != 0 else -1 for t in terms.terms],
         dtype=np.int64,
     )
+    object.__setattr__(terms, "_basis", (q0, tuple(harm), group.copy()))
     return q0, tuple(harm), group
 
 

@@ -69,6 +69,9 @@ class TermSet:
     _arrays: dict[str, np.ndarray] | None = field(
         default=None, init=False, repr=False, compare=False
     )
+    _basis: tuple[Fraction, tuple[int, ...], np.ndarray] | None = field(
+        default=None, init=False, repr=False, compare=False
+    )  # frequency_basis's answer, kept (its fraction arithmetic is slow)
 
     def __post_init__(self) -> None:
         if not self.terms:
