@@ -355,3 +355,33 @@ def test_local_cluster_workers_run_without_profiler_and_with_a_slow_tick(referen
         assert settings == {(False, "1s")}
         assert _stats(scheduler=ex).as_tuple() == reference.as_tuple()
     assert _worker_dask_settings() == before
+
+
+def test_progress_on_dask_counts_samples_with_the_uneven_last_chunk(client, monkeypatch):
+    """Issue 14: on a Dask cluster too the bar's total is the samples (10 500) and each finished
+    chunk advances it by its own size (4000, 4000, 2500); the result equals the sequential one.
+    (Threads and processes: tests/test_progress_samples.py.)"""
+    import gearte.execution.mapping as mapping
+
+    seen: list = []
+
+    class Recorder:
+        def __init__(self, total, description, enabled, unit="chunks"):
+            seen.append([total, unit])
+
+        def advance(self, n=1):
+            seen[-1].append(n)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return None
+
+    monkeypatch.setattr(mapping, "ChunkProgress", Recorder)
+    kw = dict(reduce=RunningStats.merge, progress=True)
+    on_dask = map_chunks(sample_chunk, seeded_chunks(10_500, 4_000, 3), scheduler=client, **kw)
+    here = map_chunks(sample_chunk, seeded_chunks(10_500, 4_000, 3), workers=1, **kw)
+    assert on_dask.as_tuple() == here.as_tuple()
+    for total, unit, *advances in seen:
+        assert (total, unit, sorted(advances)) == (10_500, "samples", [2500, 4000, 4000])

@@ -60,6 +60,8 @@ def test_chain_yield_grade_of_a_spur_gear_eccentricity_is_its_iso1328_2_radial_c
     res = gearte.run_case(load_case_dict(data, name="chain_grade"), OPTS)
     tol = res["yield"].values["tolerances"]["spur_pair.driven_gear_eccentricity"]
     assert tol["tolerance"] == 31.0
+    assert tol["grade"] == 5  # reported as derived, naming the standard
+    assert tol["derived_from"].startswith("ISO 1328-2:1997 radial composite, grade 5, driven gear")
     data["analyses"]["yield"]["tolerances"]["spur_pair.driven_gear_eccentricity"]["grade"] = 7
     res = gearte.run_case(load_case_dict(data, name="chain_grade7"), OPTS)
     assert (

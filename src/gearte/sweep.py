@@ -660,6 +660,7 @@ def run_sweep(
                     scheduler=ex,
                     progress=progress,
                     description=f"sweep {name}",
+                    unit="points",
                     on_result=done.__setitem__,
                 )
             else:  # few points: one after another, each spreading its samples over the workers

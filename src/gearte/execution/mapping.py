@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any, TypeVar
 
 from gearte.errors import ClusterLostError, ParameterError
 from gearte.execution.backends import ChunkExecutor, SequentialExecutor, open_executor
 from gearte.execution.progress import ChunkProgress
 from gearte.execution.stop import current_stop_scope
+from gearte.execution.streams import Chunk
 
 __all__ = ["map_chunks"]
 
@@ -35,6 +36,8 @@ def map_chunks(
     options: Any = None,
     max_in_flight: int | None = None,
     shared: Any = _NOTHING,
+    sizes: Sequence[int] | None = None,
+    unit: str | None = None,
 ) -> Any:
     """Run ``func(task)`` for every task; hand the results back in task order.
 
@@ -55,7 +58,10 @@ def map_chunks(
         address, ``"processes"``, ``"local-cluster"``) is shut down before returning, also on
         errors and Ctrl-C.
     progress : bool, optional
-        Progress bar over chunks (terminal only); default ``options.progress`` or ``True``.
+        Progress bar (terminal only; :class:`~gearte.execution.progress.ChunkProgress`): in
+        samples when the sample count of every task is known (``sizes``, or tasks that are
+        :class:`~gearte.execution.Chunk`), else one unit per task. Default
+        ``options.progress`` or ``True``.
     description : str
         Label of the progress bar and of the Dask task keys.
     retries : int
@@ -78,6 +84,14 @@ def map_chunks(
         Data every chunk needs (a model, a compiled system, tables): each chunk then runs as
         ``func(task, shared)``. On Dask it is sent to every worker once (scattered, broadcast)
         instead of with each task; locally it is passed as is.
+    sizes : sequence of int, optional
+        Samples of each task, in task order (one per task): the progress bar then counts
+        samples — total ``sum(sizes)``, each finished chunk advancing it by its own size. Default:
+        the tasks' ``size`` when every task is a :class:`~gearte.execution.Chunk`
+        (:func:`~gearte.execution.seeded_chunks`), else none (the bar counts tasks). Progress
+        only: results do not depend on it.
+    unit : str, optional
+        What the bar counts: default ``"samples"`` with sizes, ``"chunks"`` without.
 
     Returns
     -------
@@ -106,6 +120,19 @@ def map_chunks(
     if max_in_flight is not None and max_in_flight < 1:
         raise ParameterError("max_in_flight", max_in_flight, "must be ≥ 1")
     total = len(tasks) if hasattr(tasks, "__len__") else None  # type: ignore[arg-type]
+    if sizes is None and total and isinstance(tasks, Sequence):
+        if all(isinstance(t, Chunk) for t in tasks):
+            sizes = [t.size for t in tasks]
+    if sizes is not None:
+        sizes = [int(n) for n in sizes]
+        if total is not None and len(sizes) != total:
+            raise ParameterError(
+                "sizes", len(sizes), f"must give one sample count per task ({total})"
+            )
+        if any(n < 0 for n in sizes):
+            raise ParameterError("sizes", min(sizes), "sample counts must be >= 0")
+    bar_total = total if sizes is None else sum(sizes)
+    unit = unit or ("chunks" if sizes is None else "samples")
     keep = reduce is None and on_result is None
     label = re.sub(r"[^A-Za-z0-9_.]+", "_", description).strip("_") or "chunk"
     scope = current_stop_scope()
@@ -153,7 +180,7 @@ def map_chunks(
 
         it = iter(tasks)
         exhausted = False
-        with ChunkProgress(total, description, bool(progress)) as bar:
+        with ChunkProgress(bar_total, description, bool(progress), unit) as bar:
             try:
                 while True:
                     w = window()
@@ -163,13 +190,17 @@ def map_chunks(
                         except StopIteration:
                             exhausted = True
                             break
+                        if sizes is not None and submitted >= len(sizes):
+                            raise ParameterError(
+                                "sizes", len(sizes), "gives fewer sample counts than tasks"
+                            )
                         batch.submit(func, task, submitted, label)
                         submitted += 1
                     if not len(batch):
                         break
                     for index, result in batch.next_done():
                         buffer[index] = result
-                        bar.advance()
+                        bar.advance(1 if sizes is None else sizes[index])
                     hand_back()
             except BaseException as caught:
                 exc = _signal_in_kernel(caught)
@@ -188,9 +219,10 @@ def map_chunks(
                         raise
                     raise exc from None
                 scope.cause = exc
-                scope.cut.append(
-                    f"{description}: {frontier} of {total or '?'} chunks finished and kept"
-                )
+                kept = f"{description}: {frontier} of {total or '?'} chunks finished and kept"
+                if sizes is not None:
+                    kept += f" ({sum(sizes[:frontier])} of {bar_total} samples)"
+                scope.cut.append(kept)
     finally:
         if owned:
             executor.close()

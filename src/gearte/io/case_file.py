@@ -165,6 +165,7 @@ def did_you_mean(key: str, known: set[str], value: Any = None) -> str:
     converted to that unit), or a close spelling."""
     import difflib
 
+    known = known - {key}  # (a union's other branch may have the key: no "did you mean" itself)
     stem, _, unit = key.rpartition("_")
     if stem:
         same_stem = sorted(k for k in known if k.rpartition("_")[0] == stem and k != key)

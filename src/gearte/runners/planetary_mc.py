@@ -203,6 +203,7 @@ def run_scenario(
         scheduler=scheduler,
         progress=progress,
         description=f"Monte-Carlo {scenario}",
+        sizes=sizes,
     )
     st, sp = RunningStats(), RunningStats()
     hist = np.zeros(bins, dtype=np.int64)

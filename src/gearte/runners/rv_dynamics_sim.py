@@ -455,6 +455,7 @@ def dte_batch(
             progress=progress,
             description="DTE realisations",
             shared=shared,
+            sizes=sizes,
         )
     )
     wall = time.perf_counter() - t0

@@ -41,9 +41,8 @@ from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
     LAW_LINEAR,
     LAW_SECANT_PER_CONTACT,
-    LAW_SECANT_PER_DISC,
     _bearing_terms,
-    _law_delta,
+    _secant_update,
 )
 
 __all__ = [
@@ -690,45 +689,9 @@ def _solve_batch(
                     if not ok or law == LAW_LINEAR:
                         break
                     ok = False  # until the stiffness fixed point has converged
-                    change = 0.0
-                    beyond = False  # a force beyond the law's range
-                    if law == LAW_SECANT_PER_DISC:
-                        for gr in range(ngroups):
-                            fmax = 0.0
-                            cm = -1
-                            for c in range(nc):
-                                if group[c] == gr and force[c] > fmax:
-                                    fmax = force[c]
-                                    cm = c
-                            if fmax > 0.0:
-                                if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
-                                    beyond = True
-                                    break
-                                knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
-                                change = max(change, abs(knew / k[gr] - 1.0))
-                                k[gr] = knew
-                        if beyond:
-                            break
-                        for c in range(nc):
-                            kc[c] = k[group[c]]
-                    else:
-                        for c in range(nc):
-                            if force[c] > 0.0:
-                                if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
-                                    beyond = True
-                                    break
-                                knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
-                                change = max(change, abs(knew / kc[c] - 1.0))
-                                kc[c] = knew
-                        if beyond:
-                            break
-                        for gr in range(ngroups):
-                            kg = 0.0
-                            for c in range(nc):
-                                if group[c] == gr and force[c] > 0.0 and kc[c] > kg:
-                                    kg = kc[c]
-                            if kg > 0.0:
-                                k[gr] = kg
+                    change, in_range = _secant_update(law, force, coef, group, ngroups, k, kc)
+                    if not in_range:  # a force beyond the law's range
+                        break
                     if change < tol:
                         for c in range(nc):
                             dc = approach[c]
@@ -1138,7 +1101,7 @@ _KERNELS = ("_solve_batch", "_newton", "_newton_mixed", "_energy", "_assemble",
             "_assemble_rows3", "_add_block3", "_rows_times",
             "_spd_solve", "_copy", "_rows_dot", "_law_force", "_law_force_start",
             "_log_update",
-            "_bearing_terms", "_law_delta")  # fmt: skip
+            "_bearing_terms", "_secant_update")  # fmt: skip
 
 
 def _twin(kernel):

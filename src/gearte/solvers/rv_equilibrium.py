@@ -122,6 +122,53 @@ def _law_delta(f, a0, a1):
 
 
 @njit(cache=True, nogil=True)
+def _secant_update(law, force, coef, group, ngroups, k, kc):
+    """One step of the secant fixed point of the log law: the new stiffnesses from ``force``.
+
+    ``LAW_SECANT_PER_DISC``: each disc (``group``) its secant ``F/δ(F)`` at its largest pin
+    force (that contact's coefficients), copied to its contacts' ``kc``; otherwise
+    (``LAW_SECANT_PER_CONTACT``) each loaded contact its own secant, and ``k`` per disc the
+    stiffest loaded contact's (reported). Updates ``k`` and ``kc`` in place; returns the
+    largest relative change of a stiffness and ``False`` (leaving them part-updated) where a
+    force lies beyond the law's range (``a0 − a1 ln F ≤ a1``: δ(F) no longer increasing).
+    Shared by :func:`_solve_all` and the batched solver (:mod:`gearte.solvers.rv_batch`)."""
+    change = 0.0
+    nc = force.size
+    if law == LAW_SECANT_PER_DISC:
+        for g in range(ngroups):
+            fmax = 0.0
+            cm = -1
+            for c in range(nc):
+                if group[c] == g and force[c] > fmax:
+                    fmax = force[c]
+                    cm = c
+            if fmax > 0.0:
+                if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
+                    return change, False
+                knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
+                change = max(change, abs(knew / k[g] - 1.0))
+                k[g] = knew
+        for c in range(nc):
+            kc[c] = k[group[c]]
+    else:
+        for c in range(nc):
+            if force[c] > 0.0:
+                if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
+                    return change, False
+                knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
+                change = max(change, abs(knew / kc[c] - 1.0))
+                kc[c] = knew
+        for g in range(ngroups):
+            kg = 0.0
+            for c in range(nc):
+                if group[c] == g and force[c] > 0.0 and kc[c] > kg:
+                    kg = kc[c]
+            if kg > 0.0:
+                k[g] = kg
+    return change, True
+
+
+@njit(cache=True, nogil=True)
 def _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q):
     """Π(q) (scalar loops: no array expressions, cheap to compile; ``docs/numba.md``)."""
     nd = q.size
@@ -309,41 +356,7 @@ def _solve_all(
             if law == LAW_LINEAR:
                 ok = True
                 break
-            change = 0.0
-            in_range = True
-            if law == LAW_SECANT_PER_DISC:
-                for g in range(ngroups):
-                    fmax = 0.0
-                    cm = -1
-                    for c in range(nc):
-                        if group[c] == g and force[c] > fmax:
-                            fmax = force[c]
-                            cm = c
-                    if fmax > 0.0:
-                        if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
-                            in_range = False  # beyond the law's range
-                            break
-                        knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
-                        change = max(change, abs(knew / k[g] - 1.0))
-                        k[g] = knew
-                for c in range(nc):
-                    kc[c] = k[group[c]]
-            else:
-                for c in range(nc):
-                    if force[c] > 0.0:
-                        if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
-                            in_range = False  # beyond the law's range
-                            break
-                        knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
-                        change = max(change, abs(knew / kc[c] - 1.0))
-                        kc[c] = knew
-                for g in range(ngroups):  # reported per disc: the stiffest loaded contact's secant
-                    kg = 0.0
-                    for c in range(nc):
-                        if group[c] == g and force[c] > 0.0 and kc[c] > kg:
-                            kg = kc[c]
-                    if kg > 0.0:
-                        k[g] = kg
+            change, in_range = _secant_update(law, force, coef, group, ngroups, k, kc)
             if not in_range:
                 break
             if change < tol:
@@ -460,7 +473,7 @@ def solve_positions(
         # lock for the duration of the call; compiled callers do not look these names up)
         g = _solve_all.py_func.__globals__
         _TWIN_LOCK.acquire()
-        saved = {n: g[n] for n in ("_newton", "_energy", "_law_delta")}
+        saved = {n: g[n] for n in ("_newton", "_energy", "_law_delta", "_secant_update")}
         for n in saved:
             g[n] = saved[n].py_func
         try:

@@ -490,6 +490,7 @@ def _speed_sweep(case, model, options) -> AnalysisResult:
             scheduler=options.scheduler,
             progress=options.progress,
             description="speed sweep",
+            unit="speeds",
         )
     )
     per_rpm = {

@@ -40,14 +40,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, Literal
+from typing import Any, Literal, NamedTuple
 
 from pydantic import Field, model_validator
 
 from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult
 
-__all__ = ["YieldSection", "ToleranceEntry", "yield_analysis", "to_toml"]
+__all__ = ["YieldSection", "ToleranceEntry", "GradeTolerance", "yield_analysis", "to_toml"]
+
+
+class GradeTolerance(NamedTuple):
+    """What ``grade = N`` gives one error: the tolerance [µm] and how it was derived (the
+    standard, the class and the gear's size), reported beside the tolerance in the result."""
+
+    tolerance_um: float
+    derivation: str
+
+
+#: ``grade_um(key, grade)``: the tolerance a grade gives an error (``None``: no grade applies;
+#: it may raise a ParameterError naming ``analyses.yield.tolerances.<key>.grade`` with why).
+GradeReader = Callable[[str, int], "float | GradeTolerance | None"]
 
 
 class ToleranceEntry(StrictModel):
@@ -305,8 +318,11 @@ def _tolerances(
     nominal: Mapping[str, float],
     defaults: Mapping[str, ToleranceEntry],
     families: Mapping[str, list[str]],
-    grade_um: Callable[[str, int], float | None] | None = None,
+    grade_um: GradeReader | None = None,
+    derived: dict[str, dict[str, Any]] | None = None,
 ):
+    """The :class:`~gearte.tolerance.yield_mc.ToleranceSet` of a section; a tolerance read from
+    a grade is recorded in ``derived`` (``{key: {"grade", "derived_from"}}``) when given."""
     from gearte.errors import ParameterError
     from gearte.tolerance.yield_mc import CorrelatedGroup, Tolerance, ToleranceSet
 
@@ -337,13 +353,17 @@ def _tolerances(
             )
         tol = {"um": t.tolerance_um, "deg": t.tolerance_deg, "arcmin": t.tolerance_arcmin}[t.unit]
         if t.grade is not None:
-            tol = None if grade_um is None else grade_um(ukey, t.grade)
-            if tol is None:
+            read = None if grade_um is None else grade_um(ukey, t.grade)
+            if read is None:
                 raise ParameterError(
                     f"analyses.yield.tolerances.{ukey}.grade",
                     t.grade,
                     "this error is not a gear's eccentricity: give tolerance_um",
                 )
+            tol = float(read[0] if isinstance(read, GradeTolerance) else read)
+            if derived is not None:
+                how = read.derivation if isinstance(read, GradeTolerance) else None
+                derived[ukey] = {"grade": t.grade, "derived_from": how or f"grade {t.grade}"}
         nom = {"um": t.nominal_um, "deg": t.nominal_deg, "arcmin": t.nominal_arcmin}[t.unit]
         tols.append(
             Tolerance(
@@ -420,14 +440,16 @@ def yield_inputs(
     nominal: Mapping[str, float],
     defaults: Mapping[str, ToleranceEntry] | None = None,
     families: Mapping[str, list[str]] | None = None,
-    grade_um: Callable[[str, int], float | None] | None = None,
+    grade_um: GradeReader | None = None,
     quantities: Sequence[str] | None = None,
+    derived: dict[str, dict[str, Any]] | None = None,
 ) -> tuple[Any, dict[str, Any]]:
     """The tolerance set and allocation cost models of a yield section, checked against the
     drive's error keys (arguments as :func:`yield_analysis`), and its spec against the yield
     model's ``quantities`` (its output names; not checked when ``None``). :func:`yield_analysis`
     calls it before any sample and the kinds' pre-flight (``gearte validate``) calls it without
-    running.
+    running. ``derived``, when given, receives the tolerances read from a grade (key → its
+    ``grade`` and ``derived_from``).
 
     Returns
     -------
@@ -454,7 +476,9 @@ def yield_inputs(
                     f"is not a quantity of the model {sorted(quantities)}",
                 )
 
-    ts = _tolerances(section, units, nominal, dict(defaults or {}), dict(families or {}), grade_um)
+    ts = _tolerances(
+        section, units, nominal, dict(defaults or {}), dict(families or {}), grade_um, derived
+    )
     costs: dict[str, CostModel | PriceTable] = {}
     for key, c in (section.allocation.costs if section.allocation else {}).items():
         if key not in ts.families:
@@ -479,7 +503,7 @@ def yield_analysis(
     references: list[str] | None = None,
     defaults: Mapping[str, ToleranceEntry] | None = None,
     families: Mapping[str, list[str]] | None = None,
-    grade_um: Callable[[str, int], float | None] | None = None,
+    grade_um: GradeReader | None = None,
 ) -> AnalysisResult:
     """Run the yield analysis of a drive.
 
@@ -506,8 +530,10 @@ def yield_analysis(
         Family key → its instance keys (e.g. ``cam`` → ``cam.c1.d1`` …): a tolerance on a
         family applies to each instance, drawn independently (a correlated group may name it).
     grade_um : callable, optional
-        ``(key, grade) -> tolerance [µm]`` for errors that are a gear's eccentricity (``None``
-        for the others): how ``grade = N`` reads for this drive.
+        ``(key, grade) -> tolerance [µm]`` (a number or a :class:`GradeTolerance` naming its
+        derivation) for errors that are a gear's eccentricity (``None`` for the others): how
+        ``grade = N`` reads for this drive. A tolerance read from a grade is reported with its
+        ``grade`` and ``derived_from`` under ``tolerances`` in the result.
     """
     from gearte.studies import sample_cap
     from gearte.tolerance.allocation import allocate
@@ -520,8 +546,16 @@ def yield_analysis(
 
     seed = section.seed if getattr(options, "seed", None) is None else int(options.seed)
     n = section.samples if getattr(options, "samples", None) is None else int(options.samples)
+    derived: dict[str, dict[str, Any]] = {}
     ts, costs = yield_inputs(
-        section, units, nominal, defaults, families, grade_um, getattr(model, "quantities", None)
+        section,
+        units,
+        nominal,
+        defaults,
+        families,
+        grade_um,
+        getattr(model, "quantities", None),
+        derived,
     )
     spec = [SpecLimit(q, s.lower, s.upper) for q, s in section.spec.items()]
     progress = getattr(options, "progress", False)
@@ -560,6 +594,7 @@ def yield_analysis(
         "quantities": quantities,
         "tolerances": {
             t.family_name: {"kind": t.kind, "tolerance": t.tolerance, "nominal": t.nominal}
+            | derived.get(t.family_name, {})
             for t in ts.tolerances
         },
     }
@@ -569,6 +604,8 @@ def yield_analysis(
         "Tolerance meaning: normal ±t with σ = t/3 unless sigmas is given; rayleigh: 99.73 % of "
         "magnitudes ≤ t; uniform on ±t around the nominal.",
     ]
+    for key, d in derived.items():
+        notes.append(f"{key}: tolerance derived from its accuracy grade — {d['derived_from']}.")
     data: dict[str, Any] = {"yield": res}
     files: dict[str, str] = {}
     sobol_q = spec[0].quantity if spec else next(iter(res.quantities), None)

@@ -637,7 +637,7 @@ def _yield_setup(case: Case, sec: YieldSection, pairs: dict, defaults: dict):
     """
     from gearte.models.backlash import SpurPair
     from gearte.runners.chain_yield import ChainStage, GearChainYield, stack_terms
-    from gearte.studies._yield import ToleranceEntry
+    from gearte.studies._yield import GradeTolerance, ToleranceEntry
     from gearte.tolerance.iso1328 import radial_composite_tolerances
 
     units = {s.name: "arcmin" for s in case.chain.stages}
@@ -668,15 +668,27 @@ def _yield_setup(case: Case, sec: YieldSection, pairs: dict, defaults: dict):
             )
             drawn[key] = (pair, "driving" if ".driving_gear" in key else "driven")
 
-    def grade_um(key: str, grade: int) -> float | None:
+    def grade_um(key: str, grade: int) -> GradeTolerance | None:
         """A spur gear's eccentricity: its ISO 1328-2 total radial composite tolerance F_i″."""
         if not key.endswith("_gear_eccentricity") or key not in drawn:
             return None
         pair, which = drawn[key]
+        if isinstance(pair, BevelPair):
+            from gearte.errors import ParameterError
+            from gearte.tolerance.iso1328 import BEVEL_GRADE_REASON
+
+            raise ParameterError(
+                f"analyses.yield.tolerances.{key}.grade", grade, BEVEL_GRADE_REASON
+            )
         if not isinstance(pair, SpurPair):
             return None
         teeth = getattr(pair, which).teeth
-        return radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
+        f_i2 = radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
+        return GradeTolerance(
+            f_i2,
+            f"ISO 1328-2:1997 radial composite, grade {grade}, {which} gear: z = {teeth}, "
+            f"m = {pair.module:g} mm, d = {pair.module * teeth:g} mm: F_i″ = {f_i2:g} µm",
+        )
 
     model = GearChainYield(chain, nominal, case.chain.lever_length_mm)
     return model, chain, units, nominal, defaults, grade_um

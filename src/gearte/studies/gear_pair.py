@@ -463,7 +463,28 @@ class SpurPairSpec(_Clearance, _Distributions):
         )
 
 
-class BevelGearSpec(_ThicknessLimits, _Clearance):
+class _NoBevelGrade(StrictModel):
+    """``grade`` on a bevel gear or pair: an error naming the key and saying why (not the
+    unknown-key error, whose "did you mean" pointed at the spur gear's field)."""
+
+    grade: None = Field(
+        default=None,
+        description="Not accepted: bevel gears take no accuracy grade (ISO 1328-1 is for "
+        "cylindrical gears; ISO 17485, the bevel standard, is not implemented). Give the "
+        "tolerances in µm.",
+    )
+
+    @field_validator("grade", mode="before")
+    @classmethod
+    def _no_grade(cls, v):
+        if v is None:  # the default (TOML has no null: a file never gives None)
+            return v
+        from gearte.tolerance.iso1328 import BEVEL_GRADE_REASON
+
+        raise ValueError(BEVEL_GRADE_REASON)
+
+
+class BevelGearSpec(_NoBevelGrade, _ThicknessLimits, _Clearance):
     """One bevel gear with its bearing and locating faces."""
 
     teeth: int = Field(ge=5, le=10_000, description="Number of teeth z.")
@@ -477,7 +498,7 @@ class BevelGearSpec(_ThicknessLimits, _Clearance):
     )
 
 
-class BevelPairSpec(_Distributions):
+class BevelPairSpec(_NoBevelGrade, _Distributions):
     """A straight bevel pair and its mounting (Jiang et al. 2024, Tables 5–6)."""
 
     type: Literal["bevel"] = Field("bevel", description="Pair type: a bevel pair.")

@@ -242,7 +242,10 @@ class Analyses(StrictModel):
     assembly: AssemblyOptions | None = Field(default_factory=AssemblyOptions)
     monte_carlo: MonteCarloOptions | None = None
     yield_: YieldSection | None = Field(
-        default=None, alias="yield", description="production yield (gearte.studies._yield)"
+        default=None,
+        alias="yield",
+        description="production yield (gearte.studies._yield); a gear's eccentricity E_s, "
+        "E_p<i>, E_r takes grade = N: F_rT/2 of its ISO 1328-1:2013 class",
     )
 
 
@@ -469,7 +472,15 @@ def preflight(case: Case) -> None:
         from gearte.studies._yield import yield_inputs
 
         units, nominal = _yield_keys(terms, mags, angs)
-        yield_inputs(case.analyses.yield_, units, nominal, quantities=PlanetaryCoupledTE.quantities)
+        families = _planet_families(case, units)
+        yield_inputs(
+            case.analyses.yield_,
+            units,
+            nominal,
+            families=families,
+            grade_um=_grade_um(case),
+            quantities=PlanetaryCoupledTE.quantities,
+        )
 
 
 def run(case: Case, options) -> StudyResult:
@@ -720,6 +731,25 @@ def _yield_keys(terms: TermSet, mags: dict, angs: dict) -> tuple[dict, dict]:
     return units, nominal
 
 
+def _planet_families(case: Case, units: dict[str, str]) -> dict[str, list[str]]:
+    """With ``errors.source = "derived"``: ``E_p``, ``A_p``, ``beta_p``, ``gamma_p`` as families
+    of the planets' keys (``E_p`` → ``E_p1`` … as the model has them), so one tolerance — or one
+    grade — covers every planet, each drawn on its own, as ``[errors]`` accepts ``E_p`` for
+    every planet. ``units`` gains the family keys."""
+    if case.errors.source != "derived":
+        return {}
+    families: dict[str, list[str]] = {}
+    for base in ("E_p", "A_p", "beta_p", "gamma_p"):
+        inst = sorted(
+            (k for k in units if k.rstrip("0123456789") == base and k != base),
+            key=lambda k: int(k[len(base) :]),
+        )
+        if inst:
+            families[base] = inst
+            units[base] = units[inst[0]]
+    return families
+
+
 def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> AnalysisResult:
     """``[analyses.yield]``: magnitudes [µm] and directions [deg] as tolerances (e.g. Wang's
     random assembly: each direction ``uniform``, ``nominal_deg = 180``, ``tolerance_deg =
@@ -728,6 +758,7 @@ def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> Analy
     from gearte.studies._yield import yield_analysis
 
     units, nominal = _yield_keys(terms, mags, angs)
+    families = _planet_families(case, units)
     mag_um = {k: float(mm_to_um(v)) for k, v in mags.items()}
     ang_deg = {k: float(rad_to_deg(v)) for k, v in angs.items()}
 
@@ -753,4 +784,76 @@ def _yield(case: Case, terms: TermSet, mags: dict, angs: dict, options) -> Analy
         options=options,
         worst_case=worst_case,
         references=["wang2013"],
+        families=families,
+        grade_um=_grade_um(case),
     )
+
+
+#: The assembly eccentricities of the derived model: what each one is (no accuracy grade
+#: bounds them — they are seats and bores, not teeth).
+_ASSEMBLY_KEYS = {
+    "A_s": "the sun's assembly eccentricity (its bearing seat)",
+    "A_r": "the ring's assembly eccentricity (its seat in the housing)",
+    "A_c": "the carrier's assembly eccentricity (its bearing seat)",
+    "A_p": "a planet's assembly eccentricity (its pin-hole position in the carrier)",
+}
+
+
+def _grade_um(case: Case):
+    """The ``grade_um(key, grade)`` of the planetary yield
+    (:func:`~gearte.studies._yield.yield_analysis`): a gear's manufacturing eccentricity —
+    ``E_s`` (sun), ``E_p<i>`` (planet ``i``; ``E_p``: every planet), ``E_r`` (ring, an internal
+    gear) — takes the
+    eccentricity tolerance ``F_rT / 2`` of its ISO 1328-1:2013 class, from the gear's module
+    and teeth of ``[gearset]`` (``d = m z``; run-out needs no face width). Any other key is an
+    error naming it and saying why.
+    """
+    from gearte.studies._yield import GradeTolerance
+    from gearte.tolerance.iso1328 import runout_tolerance
+
+    gs = case.gearset
+    gears = {"E_s": ("sun", gs.z_sun), "E_r": ("ring (internal gear)", gs.z_ring)}
+
+    def grade_um(key: str, grade: int) -> GradeTolerance | None:
+        field = f"analyses.yield.tolerances.{key}.grade"
+        if case.errors.source != "derived":
+            raise ParameterError(
+                field,
+                grade,
+                "with errors.source = 'terms' the magnitudes are the terms' own keys and name "
+                "no gear, so no gear's size is known to read a grade with: give tolerance_um "
+                "(or describe the stage with errors.source = 'derived')",
+            )
+        base = key.rstrip("0123456789")
+        if base == "E_p":
+            i = key[len(base) :]
+            name, z = (f"planet {i}" if i else "each planet"), gs.z_planet
+        elif key in gears:
+            name, z = gears[key]
+        elif base in _ASSEMBLY_KEYS:
+            raise ParameterError(
+                field,
+                grade,
+                f"{key} is {_ASSEMBLY_KEYS[base]}, not a gear's tooth run-out, so no ISO "
+                "1328-1 class bounds it: give tolerance_um",
+            )
+        else:
+            return None
+        m, d = gs.module_mm, gs.module_mm * z
+        where = f"{name}: z = {z}, m_n = {m:g} mm, d = m_n z = {d:g} mm"
+        try:
+            f_rt = runout_tolerance(grade, m, d, teeth=z)
+        except ParameterError as exc:
+            raise ParameterError(
+                field,
+                grade,
+                f"the {where} is outside ISO 1328-1:2013's range of application "
+                f"({exc.field} = {exc.value:g}: {exc.reason}): give tolerance_um",
+            ) from None
+        return GradeTolerance(
+            0.5 * f_rt,
+            f"ISO 1328-1:2013 class {grade}, {where}: run-out F_rT = 0.9 F_pT = {f_rt:g} µm "
+            f"(rounded as §5.2.3), eccentricity tolerance F_rT/2 = {0.5 * f_rt:g} µm",
+        )
+
+    return grade_um

@@ -331,7 +331,9 @@ def run(case: Case, options=None) -> StudyResult:
         )
     # the full-model check and the pin grading of every reducer, on the local cores (or the
     # scheduler of the run options)
-    checked = map_chunks(sa.check_reducer, tasks, options=options, description="reducers")
+    checked = map_chunks(
+        sa.check_reducer, tasks, options=options, description="reducers", unit="reducers"
+    )
     full = np.array([c[0] for c in checked])
     values: dict = {
         "reducers": n_red,

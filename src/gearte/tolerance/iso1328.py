@@ -23,7 +23,10 @@ standard)::
 to the nearest 1 µm, from 5 to 10 µm to the nearest 0.5 µm, below 5 µm to the nearest
 0.1 µm; halves round away from zero. Range of application: ``5 ≤ z ≤ 1000``,
 ``5 ≤ d ≤ 15 000 mm``, ``0.5 ≤ m_n ≤ 70 mm``, ``4 ≤ b ≤ 1200 mm``, ``β ≤ 45°``; the standard
-forbids extrapolation, so values outside are errors.
+forbids extrapolation, so values outside are errors (``z`` is checked where the caller gives
+``teeth``). The standard's scope is "individual cylindrical involute gears", internal gears not
+excluded: an internal gear (a planetary ring) is read with ``z`` its tooth count and
+``d = m_n z`` its (positive) reference diameter.
 
 Radial composite (double-flank) tolerances, grade ``Q = 4 … 12`` of ISO 1328-2:1997 (the
 edition whose formulas gearte's reference corpus holds; ISO 1328-2:2020 replaced them with the
@@ -59,6 +62,7 @@ from dataclasses import asdict, dataclass
 from gearte.errors import ParameterError
 
 __all__ = [
+    "BEVEL_GRADE_REASON",
     "FlankTolerances",
     "RadialTolerances",
     "iso1328_round",
@@ -68,11 +72,22 @@ __all__ = [
     "runout_tolerance",
 ]
 
+#: Why a bevel gear takes no ``grade``: ISO 1328 is for cylindrical gears; the bevel accuracy
+#: standard, ISO 17485, is not implemented (its formulas are in no source gearte could read), and
+#: ISO 1328-1 is not substituted for it.
+BEVEL_GRADE_REASON = (
+    "bevel gears take no accuracy grade in gearte: ISO 1328-1 is for cylindrical gears only, "
+    "and the bevel gear accuracy standard (ISO 17485) is not implemented — its formulas are in "
+    "no source gearte could read, and ISO 1328-1 is not substituted for it; give the "
+    "tolerances in µm"
+)
+
 _SQ2 = math.sqrt(2.0)
 _RANGES = {
     "reference_diameter_mm": (5.0, 15_000.0),
     "module_mm": (0.5, 70.0),
     "face_width_mm": (4.0, 1200.0),
+    "teeth": (5.0, 1000.0),
 }
 
 
@@ -213,12 +228,15 @@ def flank_tolerances(
     return FlankTolerances(grade=a, unrounded=raw, **r)
 
 
-def runout_tolerance(grade: int, module_mm: float, reference_diameter_mm: float) -> float:
+def runout_tolerance(
+    grade: int, module_mm: float, reference_diameter_mm: float, *, teeth: int | None = None
+) -> float:
     """Run-out tolerance ``F_rT = 0.9 F_pT`` [µm], rounded (ISO 1328-1:2013; no face width needed).
 
     An eccentricity ``e`` of the gear's teeth about its axis gives a run-out of ``2e``, so the
     eccentricity tolerance a grade implies is ``F_rT / 2``. Parameters: ``grade`` (class
-    1 … 11), ``module_mm`` [mm], ``reference_diameter_mm`` [mm].
+    1 … 11), ``module_mm`` [mm], ``reference_diameter_mm`` [mm]; ``teeth`` (optional): the tooth
+    count, checked against the range of application ``5 ≤ z ≤ 1000``.
 
     Examples
     --------
@@ -228,6 +246,8 @@ def runout_tolerance(grade: int, module_mm: float, reference_diameter_mm: float)
     a = _check_grade("grade", grade, 1, 11)
     mn = _check_range("module_mm", module_mm)
     d = _check_range("reference_diameter_mm", reference_diameter_mm)
+    if teeth is not None:
+        _check_range("teeth", teeth)
     f_pt = (0.002 * d + 0.55 * math.sqrt(d) + 0.7 * mn + 12.0) * _SQ2 ** (a - 5)
     return iso1328_round(0.9 * f_pt)
 

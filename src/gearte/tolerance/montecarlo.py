@@ -585,6 +585,7 @@ def _map_chunks(func, tasks: Sequence[Any], *, options: Any, progress: bool, des
         scheduler=getattr(options, "scheduler", None),
         progress=progress,
         description=description,
+        sizes=[t.n for t in tasks],
     )
 
 

@@ -156,6 +156,7 @@ def sobol_tolerances(
         options=options,
         progress=progress,
         description=f"Sobol indices ({n} base samples)",
+        unit="base samples",
     )
     keys = list(tolerances.families)
     # bootstrap stream: its own child of the seed, so the intervals are reproducible too
