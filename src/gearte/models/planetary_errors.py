@@ -250,8 +250,7 @@ def frequency_basis(terms: TermSet) -> tuple[Fraction, tuple[int, ...], np.ndarr
         Per term, the index into ``harmonics`` (-1 for q = 0).
     """
     if terms._basis is not None:  # computed once per term set
-        q0, harm, group = terms._basis
-        return q0, harm, group.copy()
+        return terms._basis[0], terms._basis[1], terms._basis[2].copy()
     qs = [abs(t.frequency) for t in terms.terms if t.frequency != 0]
     if not qs:
         return Fraction(1), (), np.full(len(terms.terms), -1, dtype=np.int64)
