@@ -196,6 +196,24 @@ def test_batch_independent_of_workers(model):
     assert np.all(a["rows"][:, 0] > 0)
 
 
+def test_batch_row_equals_the_same_draw_run_alone(model):
+    """A batch run packs its kernel arguments once, for the static equilibrium and the
+    integration: its row equals the same realisation run alone on the model's own arguments."""
+    from gearte.execution import spawn_generators
+    from gearte.runners.rv_dynamics_sim import draw_errors
+    from gearte.units import ARCSEC_PER_RAD
+
+    tol = table3_tolerances()
+    rows = dte_batch(model, 2, seed=5, duration_s=0.01, settle_s=0.005, tolerances=tol)["rows"]
+    err = draw_errors(spawn_generators(5, 2)[1], tol, model.params.crank_count, 2)
+    m = model.with_errors(err)
+    q0 = m.static_equilibrium(0.0)
+    y0 = np.concatenate([q0, 0 * q0])
+    r = integrate(ode_system(m), y0, (0.0, 0.015), method="rk4", dt=default_step(m), t_settle=0.005)
+    assert rows[1, 0] == r.stats["peak_to_peak"] * ARCSEC_PER_RAD
+    np.testing.assert_array_equal(m.static_equilibrium(0.0, args=m.kernel_args()), q0)
+
+
 def test_bad_parameters():
     with pytest.raises(ParameterError, match="damping_ratio"):
         li2023_parameters(damping_ratio=1.5)

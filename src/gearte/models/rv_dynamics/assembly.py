@@ -449,13 +449,20 @@ class RVDynamicModel:
 
     # --- statics and modes ---------------------------------------------------------------------
     def static_equilibrium(
-        self, t: float = 0.0, *, tol: float = 1e-10, compiled: bool = True
+        self,
+        t: float = 0.0,
+        *,
+        tol: float = 1e-10,
+        compiled: bool = True,
+        args: tuple | None = None,
     ) -> np.ndarray:
         """Deviation q of static equilibrium at time t (modified Newton with the linear K).
 
         The residual (all element forces + loads at zero velocity) comes from the compiled
-        :func:`rv_rhs` (``compiled=True``) or the plain element model. Raises ConvergenceError
-        when the clearances prevent convergence in 100 iterations.
+        :func:`rv_rhs` (``compiled=True``) or the plain element model. ``args``: this model's
+        :meth:`kernel_args` when the caller holds them already (a batch run packs them once for
+        the equilibrium and the integration). Raises ConvergenceError when the clearances
+        prevent convergence in 100 iterations.
         """
         from scipy.linalg import lu_factor, lu_solve
 
@@ -468,7 +475,8 @@ class RVDynamicModel:
         q = np.zeros(nd)
         f_ext = self.external_force(t)
         scale = np.max(np.abs(f_ext))
-        args = self.kernel_args() if compiled else None
+        if compiled and args is None:
+            args = self.kernel_args()
         y = np.zeros(2 * nd)
         dydt = np.empty(2 * nd)
         for it in range(100):  # noqa: B007 - reported on failure
