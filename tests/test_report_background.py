@@ -173,7 +173,8 @@ def _pngs(figs: list) -> list[tuple[str, str, str]]:
 @pytest.mark.parametrize(
     ("case", "expected"),
     [("hu2020_rv80e_initial", {"geometry", "geometric_te", "tooth_contact"}),
-     ("synthetic_rv_bench", {"te_orders"})],
+     ("synthetic_rv_bench", {"te_orders"}),
+     ("wang2013_2kh_eq9", {"terms", "coupled_te", "assembly"})],
 )  # fmt: skip
 def test_figures_of_one_analysis_are_those_of_the_whole_result(
     cycloid_result, case: str, expected: set[str]
@@ -184,7 +185,7 @@ def test_figures_of_one_analysis_are_those_of_the_whole_result(
     result = (
         cycloid_result
         if case == "hu2020_rv80e_initial"
-        else run_case(case, RunOptions(progress=False))
+        else run_case(case, RunOptions(progress=False, samples=2000))
     )
     names = [a.name for a in result.analyses]
     drawn = [n for n in names if n in self_contained(result.kind)]
@@ -192,6 +193,55 @@ def test_figures_of_one_analysis_are_those_of_the_whole_result(
     whole = _pngs(figures_for(result))
     alone = [p for n in drawn for p in _pngs(figures_of(result, {n}))]
     assert alone and alone == [p for p in whole if p[0] in drawn]  # same pixels and order
+
+
+_NUMBA_FREE = r"""
+import pickle, sys
+from gearte.report.background import _Report, _plotting_module, warm_up_plotting
+case, case_bytes, analyses, final = pickle.loads(sys.stdin.buffer.read())
+warm_up_plotting(case)
+assert _plotting_module(case).NUMBA_FREE_RESULTS
+rep = _Report(preload=False)
+rep.take(("preload", [], case_bytes))
+for i, data in enumerate(analyses):
+    rep.take(("analysis", i, data))
+while rep.todo or any(rep.built.values()):
+    rep.step()
+html, _ = rep.finish(final)
+print("numba" in sys.modules)
+print(html)
+"""
+
+
+@pytest.mark.parametrize("case", ["wang2013_2kh_eq9", "wang2013_2kh_eq9_yield"])
+def test_planetary_report_is_drawn_without_importing_numba(case: str) -> None:
+    """The report process of a kind whose plotting module says ``NUMBA_FREE_RESULTS``
+    imports none of the parent's modules: unpickling the case and every analysis, drawing the
+    figures early and rendering the page import no numba (~0.5 s CPU beside the analyses); the
+    page (the histogram built alone after the result: ``OTHERS_READ_ALONE``) is the page drawn
+    in one process from the whole result."""
+    import pickle
+
+    from gearte.report.background import _analysis_bytes, _final_frame
+    from gearte.report.html import render_report
+    from gearte.studies import RunOptions, run_case
+
+    result = run_case(case, RunOptions(progress=False, samples=2000))
+    sent = {id(a): (a, i, _analysis_bytes(a)) for i, a in enumerate(result.analyses)}
+    final = pickle.loads(_final_frame(result, sent)[8:])
+    data = [case, pickle.dumps(result.case), [v[2] for v in sent.values()], final]
+    p = subprocess.run(
+        [sys.executable, "-c", _NUMBA_FREE],
+        input=pickle.dumps(data),
+        capture_output=True,
+        timeout=300,
+        check=False,
+    )
+    assert p.returncode == 0, p.stderr.decode()[-3000:]
+    numba, html = p.stdout.decode().split("\n", 1)
+    assert numba == "False"
+    assert html.count("data:image/png;base64,") >= 3
+    assert _page(html.removesuffix("\n")) == _page(render_report(result))
 
 
 def _page(html: str) -> str:

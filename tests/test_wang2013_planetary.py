@@ -309,6 +309,17 @@ def test_compiled_nelder_mead_polish_matches_scipy_twin(eq9):
     assert rad_to_arcsec(fast.amplitude) == pytest.approx(107.55, abs=0.01)
 
 
+def test_optimal_assembly_on_threads_is_the_one_thread_result(eq9):
+    """The polish's starts run on threads (issue 12: Wang's warm run); each start takes the
+    same steps, so the plan is bit-identical for any number of threads."""
+    terms, mags, _ = eq9
+    rule = paper_rule_assembly(terms, mags, {"beta_l": 0.0})
+    kw = dict(starts=512, polish=5, extra_starts=[rule.angles])
+    one = optimal_assembly(terms, mags, workers=1, **kw)
+    for workers in (2, 3):
+        assert optimal_assembly(terms, mags, workers=workers, **kw) == one
+
+
 def test_halton_starts_fill_each_axis_evenly():
     """Shifted Halton points: in [0, 1), deterministic per seed, and every 1-D projection of
     n points in base b leaves no gap wider than ~b/2n (a pseudo-random set leaves gaps

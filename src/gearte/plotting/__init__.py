@@ -15,6 +15,7 @@ __all__ = [
     "new_figure",
     "figures_for",
     "figures_of",
+    "others_read_alone",
     "self_contained",
     "for_analysis",
     "PALETTE",
@@ -103,6 +104,14 @@ def self_contained(kind: str) -> frozenset[str]:
     ``SELF_CONTAINED``; none where it lists none."""
     module = _module(kind)
     return frozenset(getattr(module, "SELF_CONTAINED", ())) if module is not None else frozenset()
+
+
+def others_read_alone(kind: str) -> bool:
+    """Whether no figure of an analysis outside :func:`self_contained` of study kind ``kind``
+    reads a self-contained analysis (a plotting module says so with ``OTHERS_READ_ALONE``):
+    then the figures of the analyses not drawn early are those :func:`figures_of` draws from
+    them alone, and the report process builds only those once the final result comes."""
+    return bool(getattr(_module(kind), "OTHERS_READ_ALONE", False))
 
 
 def figures_of(result: Any, names: Any) -> list[Figure]:

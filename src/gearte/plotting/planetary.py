@@ -11,11 +11,36 @@ import numpy as np
 
 from gearte.labels import label
 from gearte.plotting import PALETTE, Figure, new_figure
+from gearte.plotting.yield_figures import SELF_CONTAINED as _YIELD
 from gearte.units import rad_to_arcsec
 
 _OPT = "optimal_assembly_te [arcsec]"
 
-__all__ = ["figures", "phasor_figure", "te_period_figure", "mc_histograms_figure"]
+__all__ = [
+    "figures",
+    "phasor_figure",
+    "te_period_figure",
+    "mc_histograms_figure",
+    "SELF_CONTAINED",
+    "NUMBA_FREE_RESULTS",
+    "OTHERS_READ_ALONE",
+]
+
+#: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`): the
+#: coupled TE's figures are drawn while the Monte-Carlo runs (its analysis carries the optimal
+#: assembly's curve where the case asks for the assembly analysis); terms and assembly have none.
+SELF_CONTAINED = frozenset({"terms", "coupled_te", "assembly"}) | _YIELD
+
+#: A result of this kind unpickles and its figures draw without numba (its records live in
+#: numba-free modules: :mod:`gearte.models.planetary_terms`, the runners import their kernels
+#: where they use them): the report process does not import the parent's numba-using modules
+#: (~0.5 s CPU on the core beside the analyses; tests/test_report_background.py checks it).
+NUMBA_FREE_RESULTS = True
+
+#: The Monte-Carlo histogram reads the Monte-Carlo analyses alone (none of SELF_CONTAINED): once
+#: the final result comes, the report process builds only it
+#: (:func:`gearte.plotting.others_read_alone`).
+OTHERS_READ_ALONE = True
 
 
 def phasor_figure(result: Any) -> Figure | None:
@@ -98,19 +123,22 @@ def te_period_figure(result: Any) -> Figure | None:
     ax.axhline(-amp, color=PALETTE[1], ls="--", lw=1)
     s = a["coupled_te_amplitude_sum [arcsec]"]
     ax.axhline(s, color=PALETTE[2], ls=":", lw=1, label=f"Σ group amplitudes {s:.1f}″")
-    if "assembly" in result:
+    opt, opt_amp = a.data.get("optimal_te"), a.data.get(_OPT)  # where the case asks for it
+    if opt is None and "assembly" in result:  # a result from before coupled_te kept it
+        from gearte.models.planetary_errors import coupled_te
+
         d = result["assembly"].data
         opt = d.get("optimal_te")
-        if opt is None:  # a result from before the analysis kept it
-            from gearte.models.planetary_errors import coupled_te
-
+        if opt is None:
             opt = coupled_te(d["terms"], d["mags"], d["optimal"].angles)
+        opt_amp = result["assembly"][_OPT]
+    if opt is not None:
         ax.plot(
             revs,
             _output_te_arcsec(opt, u),
             color=PALETTE[3],
             lw=1.0,
-            label=f"optimal assembly (amplitude {result['assembly'][_OPT]:.1f}″)",
+            label=f"optimal assembly (amplitude {opt_amp:.1f}″)",
         )
     ax.set_xlabel("input revolutions")
     ax.set_ylabel("output TE [arcsec]")

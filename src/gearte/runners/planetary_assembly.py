@@ -28,14 +28,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from gearte.errors import ParameterError
-from gearte.models.planetary_errors import (
-    TermSet,
-    coupled_te,
-    frequency_basis,
-    keyed_vector,
-    minimize_amplitude,
-    sample_extremes,
-)
+from gearte.models.planetary_terms import TermSet
+
+# The models (numba kernels) are imported where they are used: the report process unpickles an
+# AssemblyPlan without importing numba (docs/report.md).
 
 __all__ = [
     "AssemblyPlan",
@@ -106,6 +102,8 @@ def _unit_phasor(terms: TermSet, mags: Mapping[str, float], idx: list[int], var:
 
 
 def _plan(terms: TermSet, mags: Mapping[str, float], angles: dict[str, float], rule: tuple):
+    from gearte.models.planetary_errors import coupled_te
+
     r = coupled_te(terms, mags, angles)
     return AssemblyPlan(
         angles={k: float(np.mod(v, 2 * np.pi)) for k, v in angles.items()},
@@ -165,6 +163,8 @@ def paper_rule_angles(
     ParameterError
         ``terms``: an angle enters one frequency group with both signs; a missing magnitude.
     """
+    from gearte.models.planetary_errors import frequency_basis, keyed_vector
+
     mags = dict(magnitudes)
     keyed_vector(terms.magnitudes, mags, "magnitudes", required=True)
     ang = {a: float((given_angles or {}).get(a, 0.0)) for a in terms.angles}
@@ -258,14 +258,36 @@ def halton_starts(n: int, d: int, seed: int) -> np.ndarray:
 
 
 def _polish_compiled(
-    cand: list[np.ndarray], base: np.ndarray, pos: list[int], mvec: np.ndarray, terms: TermSet
+    cand: list[np.ndarray],
+    base: np.ndarray,
+    pos: list[int],
+    mvec: np.ndarray,
+    terms: TermSet,
+    workers: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Compiled Nelder–Mead (:func:`gearte.models.planetary_errors.minimize_amplitude`) from
     each start in ``cand`` [rad], restarted once from its result (a minimax can stall a simplex
-    on a kink): (x per start, amplitude [mm] per start)."""
-    return minimize_amplitude(
-        terms, mvec, base, pos, cand, xatol=1e-10, fatol=1e-14, maxiter=4000 * len(pos)
-    )
+    on a kink): (x per start, amplitude [mm] per start).
+
+    The starts are independent: they run on ``workers`` threads (default: the cores this process
+    may use; the kernel releases the GIL), each start's steps and result the same as in one
+    thread."""
+    from gearte.execution.streams import default_workers
+    from gearte.models.planetary_errors import minimize_amplitude
+
+    def polish(starts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        return minimize_amplitude(
+            terms, mvec, base, pos, starts, xatol=1e-10, fatol=1e-14, maxiter=4000 * len(pos)
+        )
+
+    n = min(default_workers() if workers is None else workers, len(cand))
+    if n <= 1:
+        return polish(cand)
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(n, thread_name_prefix="gearte-polish") as pool:
+        parts = list(pool.map(polish, [[x] for x in cand]))
+    return np.concatenate([x for x, _ in parts]), np.concatenate([f for _, f in parts])
 
 
 def _polish_scipy(amp, cand: list[np.ndarray], d: int) -> tuple[np.ndarray, np.ndarray]:
@@ -293,6 +315,7 @@ def optimal_assembly(
     seed: int = 20130808,
     extra_starts: list[Mapping[str, float]] | None = None,
     compiled: bool = True,
+    workers: int | None = None,
 ) -> AssemblyPlan:
     """Global minimum over all free angles of the exact coupled amplitude max_t |Σe(t)|.
 
@@ -314,12 +337,17 @@ def optimal_assembly(
     compiled : bool
         Run the Nelder–Mead polish compiled (default) or with SciPy on the Python objective
         (the plain twin: same steps, ~100× slower).
+    workers : int, optional
+        Threads of the compiled polish (default: the cores this process may use; the result does
+        not depend on it).
 
     Returns
     -------
     AssemblyPlan
         Angles of the relevant free angles (others 0) and the exact amplitude there.
     """
+    from gearte.models.planetary_errors import keyed_vector, sample_extremes
+
     mags = dict(magnitudes)
     mvec = keyed_vector(terms.magnitudes, mags, "magnitudes", required=True)
     free = relevant_angles(terms, mags)
@@ -347,7 +375,7 @@ def optimal_assembly(
     for st in extra_starts or []:
         cand.append(np.array([float(st.get(a, 0.0)) for a in free]))
     if compiled:
-        xs, fs = _polish_compiled(cand, base, pos, mvec, terms)
+        xs, fs = _polish_compiled(cand, base, pos, mvec, terms, workers)
     else:
         xs, fs = _polish_scipy(amp, cand, d)
     best_x, best_v = None, np.inf

@@ -575,6 +575,7 @@ def run(case: Case, options) -> StudyResult:
             polish=sample_cap(ao, "polish", options),
             seed=ao.seed,
             extra_starts=[paper.angles],
+            workers=options.workers,
         )
 
     # ---- coupled TE at the chosen assembly
@@ -588,6 +589,11 @@ def run(case: Case, options) -> StudyResult:
         assert at is not None
         r = coupled_te(terms, mags, at)
         u = np.linspace(0, 2 * np.pi, 2001)
+        figure_data: dict = {"te": r, "u": u, "signal_um": mm_to_um(r.signal(u))}
+        if a_opts is not None:  # its figure draws the optimum too: it reads this analysis alone
+            assert optimal is not None
+            figure_data["optimal_te"] = coupled_te(terms, mags, optimal.angles)
+            figure_data["optimal_assembly_te [arcsec]"] = _arcsec(optimal.amplitude)
         analyses.append(
             AnalysisResult(
                 name="coupled_te",
@@ -615,7 +621,7 @@ def run(case: Case, options) -> StudyResult:
                     "coupled_te_amplitude_sum = |constant| + Σ |group phasor| (Wang 2013's "
                     "lambda = 1 rule across frequencies; an upper bound).",
                 ],
-                data={"te": r, "u": u, "signal_um": mm_to_um(r.signal(u))},
+                data=figure_data,
             )
         )
 
@@ -651,14 +657,7 @@ def run(case: Case, options) -> StudyResult:
                     "±1 rule (eq 6, Table 3); paper_rule_assembly_te_exact: exact amplitude at "
                     "those angles with the rule's 'arbitrary' angles at their given values.",
                 ],
-                data={
-                    "optimal": optimal,
-                    "paper": paper,
-                    "terms": terms,
-                    "mags": mags,
-                    # the figure draws it: computed here, not again in the report process
-                    "optimal_te": coupled_te(terms, mags, optimal.angles),
-                },
+                data={"optimal": optimal, "paper": paper, "terms": terms, "mags": mags},
             )
         )
 

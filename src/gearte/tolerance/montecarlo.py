@@ -43,10 +43,11 @@ from gearte.tolerance.rng import (
     ZigguratTables,
     lane_states,
     next_u64,
-    normals_block_hist,
     reference_normal,
     stream_states,
     u64_to_unit,
+    zig_fast,
+    zig_slow,
     ziggurat_tables,
 )
 from gearte.tolerance.stackup import FunctionStack, LinearStack
@@ -96,61 +97,6 @@ def _group(codes: np.ndarray, params: np.ndarray, sens: np.ndarray) -> tuple[flo
     return gmu, math.sqrt(gv), nn > 0
 
 
-@njit(inline="always")
-def _draw_other(code, p0, p1, d0, d1, d2, d3, pool):  # pragma: no cover - compiled
-    """One draw of a contributor outside the Gaussian group from the draws stream."""
-    if code == 1:  # uniform
-        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
-        return p0 + (p1 - p0) * u64_to_unit(r), d0, d1, d2, d3
-    if code == 2:  # rayleigh
-        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
-        return p0 * math.sqrt(-2.0 * math.log1p(-u64_to_unit(r))), d0, d1, d2, d3
-    if code == 6:  # rayleigh magnitude x sin(uniform phase), drawn as magnitude and phase
-        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
-        mag = p0 * math.sqrt(-2.0 * math.log1p(-u64_to_unit(r)))
-        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
-        return mag * math.sin(_TWO_PI * u64_to_unit(r)), d0, d1, d2, d3
-    if code == 4:  # empirical: pool[offset + uniform integer below count] (exact rejection)
-        c = uint64(int(p1))
-        thr = (uint64(0) - c) % c
-        while True:
-            r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
-            if r >= thr:
-                return pool[int(p0) + int(r % c)], d0, d1, d2, d3
-    return p0, d0, d1, d2, d3  # constant
-
-
-@njit(inline="always")
-def _fill_block(
-    z, m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool,
-    counts, bins, nb,
-):  # pragma: no cover - compiled  # fmt: skip
-    """``z[:m]`` <- the next ``m`` samples of the stack; the stream states advance.
-
-    Per sample: the Gaussian group's normal (:func:`gearte.tolerance.rng.normals_block`: one
-    number of main stream ``j % LANES``, rejections from the tail stream), ``y = base + gsd·z``,
-    then each other contributor in order from the draws stream (the order of
-    :func:`linear_stack_reference`)."""
-    if group:
-        normals_block_hist(z, m, raw, rej, lanes, st, tk, tw, tf, counts, bins, nb)
-        for j in range(m):
-            z[j] = base + gsd * z[j]
-    else:
-        for j in range(m):
-            z[j] = base
-    if others.shape[0]:
-        d0, d1, d2, d3 = st[DRAWS, 0], st[DRAWS, 1], st[DRAWS, 2], st[DRAWS, 3]
-        for j in range(m):
-            y = z[j]
-            for i in others:
-                v, d0, d1, d2, d3 = _draw_other(
-                    codes[i], params[i, 0], params[i, 1], d0, d1, d2, d3, pool
-                )
-                y += sens[i] * v
-            z[j] = y
-        st[DRAWS, 0], st[DRAWS, 1], st[DRAWS, 2], st[DRAWS, 3] = d0, d1, d2, d3
-
-
 # The histogram bin of y is floor(clamp((y − lo)/width, −1, nbins)) + 1 (0 the underflow, nbins + 1
 # the overflow), the formula of reduce_samples. Adding 2⁵² to that small integer puts it, exactly,
 # in the low bits of the double: the bin loop stays in floating point (vectorised) and the
@@ -189,6 +135,19 @@ def _linear_stack_kernel(
     """Draw ``n`` samples block by block and reduce each block on the spot; the first ``keep``
     samples kept. No sample array beyond one block.
 
+    Per block: the Gaussian group's normals — one number of main stream ``j % LANES`` per
+    sample, the ``LANES`` generators stepped side by side (vector registers), the ziggurat's
+    fast path over the whole block (branch-free: it lists the ≈ 1.2 % rejected draws, and
+    counts the previous block's histogram bins in the same loop: the two scalar chains
+    overlap), then the rejected ones redrawn in sample order from the tail stream
+    (:func:`gearte.tolerance.rng.zig_slow`) — ``y = base + gsd·z``; then each other
+    contributor in order from the draws stream (the order of :func:`linear_stack_reference`).
+    ``others`` is None for a stack without other contributors: numba prunes that branch, so
+    the common all-normal stack compiles without it (``docs/numba.md``). The block's code is
+    written out here, not in ``inline="always"`` helpers: numba types an inlined helper again
+    at its call site after deep-copying it with the caller's variable scope, which cost ~1.5 s
+    of this kernel's first compile.
+
     Per full block of ``_BLOCK`` samples, the sums of ``y − shift`` and of its square and the
     extremes by a fixed pairwise tree (elementwise loops LLVM runs on vector registers; the
     tree depends on nothing but the block, so neither do the sums) whose first three levels
@@ -198,9 +157,13 @@ def _linear_stack_kernel(
     limit) in a vector loop of integer sums."""
     st = states.copy()
     lanes = lanes0.copy()
-    counts = np.zeros(nbins + 2, np.int64)
-    c32 = np.zeros(nbins + 2, np.int32)  # half the cache lines of int64; added in every 2³⁰
-    kept = np.empty(min(keep, n))
+    # np.empty and a fill, not np.zeros: each np.zeros dtype compiles an allocation and a
+    # zero fill of its own in a cold process (~0.3 s); min() is a conditional for the same reason
+    counts = np.empty(nbins + 2, np.int64)
+    counts[:] = 0
+    c32 = np.empty(nbins + 2, np.int32)  # half the cache lines of int64; added in every 2³⁰
+    c32[:] = 0
+    kept = np.empty(keep if keep < n else n)
     z = np.empty(_BLOCK)
     raw = np.empty(_BLOCK, np.uint64)
     rej = np.empty(_BLOCK, np.int64)
@@ -227,15 +190,79 @@ def _linear_stack_kernel(
             counts += c32
             c32[:] = 0
             added = done
-        m = min(_BLOCK, n - done)
-        _fill_block(
-            z, m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params, codes,
-            sens, pool, c32, ibin, pm if group else 0,
-        )  # fmt: skip
-        if not group:
+        m = _BLOCK if n - done > _BLOCK else n - done
+        if group:  # the Gaussian group's normals; the previous block's bins counted on the way
+            la = lanes[0]
+            lb = lanes[1]
+            lc = lanes[2]
+            ld = lanes[3]
+            for g in range((m + LANES - 1) // LANES):  # the main numbers, LANES streams at once
+                jj = g * LANES
+                for i in range(LANES):
+                    r, la[i], lb[i], lc[i], ld[i] = next_u64(la[i], lb[i], lc[i], ld[i])
+                    raw[jj + i] = r
+            nr = 0  # fast path; rej lists the rejected draws
+            if pm == m:
+                for j in range(m):
+                    x, ok, idx, v = zig_fast(raw[j], tk, tw)
+                    z[j] = x
+                    rej[nr] = j
+                    nr += not ok
+                    c32[ibin[j] & _BIN_MASK] += 1
+            else:
+                for j in range(pm):
+                    c32[ibin[j] & _BIN_MASK] += 1
+                for j in range(m):
+                    x, ok, idx, v = zig_fast(raw[j], tk, tw)
+                    z[j] = x
+                    rej[nr] = j
+                    nr += not ok
+            for i in range(nr):  # the rejected draws in sample order, from the tail stream
+                j = rej[i]
+                x, ok, idx, v = zig_fast(raw[j], tk, tw)
+                t = st[TAIL]
+                z[j], t[0], t[1], t[2], t[3] = zig_slow(
+                    x, idx, v, t[0], t[1], t[2], t[3], tk, tw, tf
+                )
+            for j in range(m):
+                z[j] = base + gsd * z[j]
+        else:
             for j in range(pm):
                 c32[ibin[j] & _BIN_MASK] += 1
-        for j in range(min(m, keep - done)):
+            for j in range(m):
+                z[j] = base
+        if others is not None:  # pruned at compile time where others is None (all normal)
+            d0, d1, d2, d3 = st[DRAWS, 0], st[DRAWS, 1], st[DRAWS, 2], st[DRAWS, 3]
+            for j in range(m):
+                y = z[j]
+                for i in others:
+                    code = codes[i]
+                    p0 = params[i, 0]
+                    p1 = params[i, 1]
+                    if code == 1:  # uniform
+                        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+                        v = p0 + (p1 - p0) * u64_to_unit(r)
+                    elif code == 2:  # rayleigh
+                        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+                        v = p0 * math.sqrt(-2.0 * math.log1p(-u64_to_unit(r)))
+                    elif code == 6:  # rayleigh magnitude x sin(uniform phase), drawn so
+                        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+                        mag = p0 * math.sqrt(-2.0 * math.log1p(-u64_to_unit(r)))
+                        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+                        v = mag * math.sin(_TWO_PI * u64_to_unit(r))
+                    elif code == 4:  # empirical: pool[offset + uniform integer < count]
+                        c = uint64(int(p1))
+                        thr = (uint64(0) - c) % c
+                        r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+                        while r < thr:
+                            r, d0, d1, d2, d3 = next_u64(d0, d1, d2, d3)
+                        v = pool[int(p0) + int(r % c)]
+                    else:  # constant
+                        v = p0
+                    y += sens[i] * v
+                z[j] = y
+            st[DRAWS, 0], st[DRAWS, 1], st[DRAWS, 2], st[DRAWS, 3] = d0, d1, d2, d3
+        for j in range(m if keep - done > m else keep - done):
             kept[done + j] = z[j]
         if m == _BLOCK:  # pairwise (a fixed tree): elementwise loops, vector registers
             h = _BLOCK // 8
@@ -306,24 +333,6 @@ def _linear_stack_kernel(
     return s1, s2, mn, mx, below, above, counts, kept
 
 
-@njit(cache=True, nogil=True)
-def _linear_stack_samples(
-    states, lanes0, n, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool
-):  # pragma: no cover - compiled
-    st = states.copy()
-    lanes = lanes0.copy()
-    out = np.empty(n)
-    raw = np.empty(_BLOCK, np.uint64)
-    rej = np.empty(_BLOCK, np.int64)
-    for done in range(0, n, _BLOCK):
-        m = min(_BLOCK, n - done)
-        _fill_block(
-            out[done:], m, raw, rej, lanes, st, tk, tw, tf, group, base, gsd, others, params,
-            codes, sens, pool, rej, raw, 0,
-        )  # fmt: skip
-    return out
-
-
 @dataclass(frozen=True)
 class _KernelInput:
     """What the kernel needs of a stack, computed once in the caller (and shipped to workers
@@ -352,15 +361,19 @@ class _KernelInput:
         )
 
     def args(self) -> tuple:
+        """The kernel's stack arguments; ``others`` None where there is none (a specialisation
+        compiled without the other contributors' draws)."""
         t = self.tables
         return (
             t.k, t.w, t.f, self.group, self.base, self.gsd,
-            self.others, self.params, self.codes, self.sens, self.pool,
+            self.others if self.others.size else None, self.params, self.codes, self.sens,
+            self.pool,
         )  # fmt: skip
 
 
 def _draw_other_ref(code: int, p: np.ndarray, d: Xoshiro256pp, pool: np.ndarray) -> float:
-    """Plain twin of ``_draw_other``."""
+    """Plain twin of one draw of a contributor outside the Gaussian group (the ``others`` loop
+    of ``_linear_stack_kernel``)."""
     if code == 1:
         return float(p[0]) + (float(p[1]) - float(p[0])) * d.unit()
     if code == 2:
@@ -422,8 +435,45 @@ def kernel_samples(stack: LinearStack, seed: int | np.random.SeedSequence, n: in
     ki = _KernelInput.of(stack)
     if ki is None:
         raise ParameterError("stack", stack.name, "has contributors the kernel cannot draw")
-    st = stream_states(seed)
-    return _linear_stack_samples(st, lane_states(st), int(n), *ki.args())
+    return _kept_samples(stream_states(seed), int(n), ki.args())
+
+
+def _kept_samples(states: np.ndarray, n: int, args: tuple) -> np.ndarray:
+    """The ``n`` samples of the kernel run with stack ``args``, all kept (a dummy reduction)."""
+    red = (0.0, -1.0, 1.0, 1, -np.inf, np.inf, n)
+    return _linear_stack_kernel(*(states, lane_states(states), n, *args, *red))[7]
+
+
+def compile_general_kernel() -> None:
+    """Compile (or load from numba's cache) the kernel for stacks with a contributor outside the
+    Gaussian group (uniform, Rayleigh, polar, empirical, constant).
+
+    A stack of normal contributors only runs a specialisation without their draws
+    (``others=None``), and every bundled case's stacks are such; ``gearte warm-cache`` calls
+    this so that a case with a ``[distributions]`` override finds the other one compiled too.
+    """
+    from gearte.tolerance.distributions import Uniform
+    from gearte.tolerance.stackup import Contributor
+
+    kernel_samples(LinearStack([Contributor("u", Uniform(0.0, 1.0), 1.0)]), 0, 2)
+
+
+def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
+    """``n`` standard normal numbers [-] from the chunk streams of ``seed`` (compiled): the
+    Gaussian group of the kernel for a stack of one standard normal contributor
+    (:func:`gearte.tolerance.rng.standard_normals`).
+
+    Parameters
+    ----------
+    seed : int or SeedSequence
+        Seed of the streams (:func:`gearte.tolerance.rng.stream_states`).
+    n : int
+        How many numbers [-].
+    """
+    t = ziggurat_tables()
+    none = np.zeros(0, np.int64)
+    args = (t.k, t.w, t.f, True, 0.0, 1.0, None, np.zeros((0, 2)), none, np.zeros(0), np.zeros(0))
+    return _kept_samples(stream_states(seed), int(n), args)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -57,8 +57,10 @@ __all__ = [
     "TAIL",
     "DRAWS",
     "lane_states",
-    "normals_block",
-    "normals_block_hist",
+    "next_u64",
+    "u64_to_unit",
+    "zig_fast",
+    "zig_slow",
     "reference_normals",
 ]
 
@@ -146,9 +148,11 @@ def stream_states(seed: int | np.random.SeedSequence, streams: int = STREAMS) ->
 
 
 # ------------------------------------------------------------------------------------------------
-# compiled draws (state as four uint64 locals). The small ones are plain kernels, which LLVM
-# inlines into their callers; numba's inline="always" typed a copy at each of their ~40 call
-# sites and cost the Monte-Carlo kernel ~4 s of its first compile (docs/numba.md).
+# compiled draws (state as four uint64 locals), called by the Monte-Carlo kernel
+# (gearte.tolerance.montecarlo), which steps the interleaved main streams block by block. The
+# small ones are plain kernels, which LLVM inlines into their callers; numba's inline="always"
+# typed a copy at each of their ~40 call sites and cost the Monte-Carlo kernel ~4 s of its first
+# compile (docs/numba.md). zig_slow, with one call site, stays inlined.
 # ------------------------------------------------------------------------------------------------
 @njit(cache=True, nogil=True)
 def _rotl(x, k):  # pragma: no cover - compiled
@@ -179,7 +183,7 @@ def u64_to_unit(r):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def zig_fast(r, k, w):  # pragma: no cover - compiled
     """Fast path of the ziggurat: ``(x, accepted, layer, v)`` from one 64-bit output."""
-    idx = int(r & uint64(0xFF))
+    idx = int64(r & uint64(0xFF))  # int64, as the layer index zig_slow is also called with
     v = int64(r) >> 11
     x = float(v) * w[idx]
     return x, abs(v) < k[idx], idx, v
@@ -222,123 +226,11 @@ def lane_states(states: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(states[:LANES].T)
 
 
-@njit(inline="always")
-def fill_u64(raw, m, lanes):  # pragma: no cover - compiled
-    """``raw[:m]`` <- the next numbers of the ``LANES`` main streams, interleaved (``raw[j]``
-    from stream ``j % LANES``); ``m`` is rounded up to a multiple of ``LANES`` (``raw`` must
-    hold it). ``lanes`` (4, LANES) advances. The inner loop over the lanes has a fixed trip
-    count and no dependency between lanes: LLVM runs it on vector registers."""
-    a = lanes[0]
-    b = lanes[1]
-    c = lanes[2]
-    d = lanes[3]
-    for g in range((m + LANES - 1) // LANES):
-        j = g * LANES
-        for i in range(LANES):
-            r, a[i], b[i], c[i], d[i] = next_u64(a[i], b[i], c[i], d[i])
-            raw[j + i] = r
-
-
-@njit(inline="always")
-def normals_block(z, m, raw, rej, lanes, st, k, w, f):  # pragma: no cover - compiled
-    """``z[:m]`` <- the next ``m`` standard normals of a chunk (:func:`normals_block_hist`
-    without the counts).
-
-    Parameters
-    ----------
-    z : np.ndarray
-        Output, at least ``m`` long [-].
-    m : int
-        Number of normals [-].
-    raw, rej : np.ndarray
-        Work arrays (uint64, int64) of at least ``m`` rounded up to ``LANES`` [-].
-    lanes : np.ndarray
-        The main streams' states, ``(4, LANES)`` uint64 (:func:`lane_states`) [-].
-    st : np.ndarray
-        The chunk's stream states (:func:`stream_states`); row ``TAIL`` advances [-].
-    k, w, f : np.ndarray
-        The ziggurat tables (:class:`ZigguratTables`) [-].
-    """
-    normals_block_hist(z, m, raw, rej, lanes, st, k, w, f, rej, raw, 0)
-
-
-@njit(inline="always")
-def normals_block_hist(
-    z, m, raw, rej, lanes, st, k, w, f, counts, bins, nb
-):  # pragma: no cover - compiled
-    """``z[:m]`` <- the next ``m`` standard normals of a chunk.
-
-    Main numbers from the interleaved main streams (``lanes``, advanced), the ziggurat's fast
-    path over the whole block (branch-free: it lists the ≈ 1.2 % rejected draws), then the
-    rejected ones redrawn in sample order from the tail stream ``st[TAIL]`` (advanced), so the
-    tail stream is read as it would be one sample at a time.
-
-    Parameters
-    ----------
-    z : np.ndarray
-        Output, at least ``m`` long [-].
-    m : int
-        Number of normals [-].
-    raw, rej : np.ndarray
-        Work arrays (uint64, int64) of at least ``m`` rounded up to ``LANES`` [-].
-    lanes : np.ndarray
-        The main streams' states, ``(4, LANES)`` uint64 (:func:`lane_states`) [-].
-    st : np.ndarray
-        The chunk's stream states (:func:`stream_states`); row ``TAIL`` advances [-].
-    k, w, f : np.ndarray
-        The ziggurat tables (:class:`ZigguratTables`) [-].
-    counts, bins, nb : np.ndarray, np.ndarray, int
-        ``counts[bins[i] & 0xFFFFFFFF] += 1`` for ``i < nb`` (a caller's histogram, e.g. of
-        the previous block), done in the same loop as the fast path when ``nb == m``: the two
-        scalar chains overlap in the CPU (~3 % of the Monte-Carlo kernel) [-].
-    """
-    fill_u64(raw, m, lanes)
-    nr = 0
-    if nb == m:
-        for j in range(m):
-            x, ok, idx, v = zig_fast(raw[j], k, w)
-            z[j] = x
-            rej[nr] = j
-            nr += not ok
-            counts[bins[j] & uint64(0xFFFFFFFF)] += 1
-    else:
-        for j in range(nb):
-            counts[bins[j] & uint64(0xFFFFFFFF)] += 1
-        for j in range(m):
-            x, ok, idx, v = zig_fast(raw[j], k, w)
-            z[j] = x
-            rej[nr] = j
-            nr += not ok
-    if nr:
-        t0, t1, t2, t3 = st[TAIL, 0], st[TAIL, 1], st[TAIL, 2], st[TAIL, 3]
-        for i in range(nr):
-            j = rej[i]
-            x, ok, idx, v = zig_fast(raw[j], k, w)
-            z[j], t0, t1, t2, t3 = zig_slow(x, idx, v, t0, t1, t2, t3, k, w, f)
-        st[TAIL, 0], st[TAIL, 1], st[TAIL, 2], st[TAIL, 3] = t0, t1, t2, t3
-
-
-_NBLOCK = 1024  # a multiple of LANES
-
-
-@njit(cache=True, nogil=True)
-def _standard_normals(states, lanes0, n, k, w, f):  # pragma: no cover - compiled
-    st = states.copy()
-    lanes = lanes0.copy()
-    out = np.empty(n)
-    raw = np.empty(_NBLOCK, np.uint64)
-    rej = np.empty(_NBLOCK, np.int64)
-    for s in range(0, n, _NBLOCK):
-        m = min(_NBLOCK, n - s)
-        normals_block(out[s:], m, raw, rej, lanes, st, k, w, f)
-    return out
-
-
 def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
     """``n`` standard normal numbers [-] from the chunk streams of ``seed`` (compiled).
 
-    The same numbers as the Gaussian group of :mod:`gearte.tolerance.montecarlo`'s kernel for
-    a stack of one standard normal contributor.
+    Drawn by :mod:`gearte.tolerance.montecarlo`'s kernel for a stack of one standard normal
+    contributor (the block loop is written once, there).
 
     Parameters
     ----------
@@ -347,9 +239,9 @@ def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
     n : int
         How many numbers [-].
     """
-    t = ziggurat_tables()
-    st = stream_states(seed)
-    return _standard_normals(st, lane_states(st), int(n), t.k, t.w, t.f)
+    from gearte.tolerance.montecarlo import standard_normals as kernel_normals
+
+    return kernel_normals(seed, n)
 
 
 # ------------------------------------------------------------------------------------------------
