@@ -438,3 +438,21 @@ def test_kernel_moments_of_a_mixed_stack_match_the_closed_form():
     r = monte_carlo(st, n, seed=17, chunk_size=500_000)
     assert abs(r.mean - st.mean) < 5 * r.std_error
     assert abs(r.sd**2 - st.sd**2) < 5 * math.sqrt((m4 - var**2) / n)
+
+
+def test_kernel_specialisation_without_other_draws_only_for_all_normal_stacks():
+    """An all-normal stack (the Jiang 2024 spur pair) passes ``others=None`` to the kernel — a
+    specialisation compiled without the other laws' draws (docs/numba.md) — and gives the same
+    samples as the same stack with a zero constant contributor added, which runs the general
+    specialisation (a constant adds ``0.0`` to each sample, exactly); ``compile_general_kernel``
+    (run by ``gearte warm-cache``) compiles the general one for a stack with a uniform term."""
+    import gearte.tolerance.montecarlo as mc
+
+    st = spur_pair().backlash_stack()
+    assert mc._KernelInput.of(st).args()[6] is None
+    with_zero = LinearStack([*st.contributors, Contributor("zero", Constant(0.0), 1.0)])
+    assert mc._KernelInput.of(with_zero).args()[6].tolist() == [len(st.contributors)]
+    np.testing.assert_array_equal(kernel_samples(st, 8, 3000), kernel_samples(with_zero, 8, 3000))
+    mc.compile_general_kernel()
+    general = [s for s in mc._linear_stack_kernel.signatures if "none" not in str(s[9]).lower()]
+    assert general and all(s == general[0] for s in general)

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 from gearte.cases import list_cases
 from gearte.cli import main
-from gearte.warm import BENCH_CASES, WARM_CASES, WARM_CHAINS, WARM_USES, _chains
+from gearte.warm import BENCH_CASES, WARM_ALSO, WARM_CASES, WARM_CHAINS, WARM_USES, _chains
 
 
 def _kind_of(path) -> str:
@@ -45,6 +45,17 @@ def test_warm_chains_hold_every_warm_up_case_once_and_bench_cases_one_per_kind()
     assert chain_cases == set(WARM_CASES["gear_pair"]) | set(WARM_CASES["rv_reducer"])
     for kind, uses in WARM_USES.items():
         assert not WARM_CASES[kind] and set(uses) <= set(WARM_CASES)
+
+
+def test_warm_also_compiles_belong_to_warm_up_cases_and_name_functions():
+    import importlib
+
+    warm_up = {c for cases in WARM_CASES.values() for c in cases}
+    for case, refs in WARM_ALSO.items():
+        assert case in warm_up
+        for ref in refs:
+            module, name = ref.split(":")
+            assert callable(getattr(importlib.import_module(module), name))
 
 
 def test_warm_cache_refuses_an_unknown_kind():

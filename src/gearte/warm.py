@@ -23,11 +23,13 @@ file invalidates its kernels only.
 
 from __future__ import annotations
 
+import importlib
 import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 __all__ = [
+    "WARM_ALSO",
     "WARM_CASES",
     "WARM_CHAINS",
     "WARM_USES",
@@ -60,6 +62,14 @@ WARM_USES: dict[str, tuple[str, ...]] = {
 call (a chain's RV stage: the RV quasi-static solver; its pair stages' yield: the tolerance
 Monte-Carlo): ``gearte warm-cache --kind gear_chain`` warms those (it warmed nothing, and the
 first ``gear_chain`` run compiled for ~15 s CPU)."""
+
+WARM_ALSO: dict[str, tuple[str, ...]] = {
+    "jiang2024_spur_pair": ("gearte.tolerance.montecarlo:compile_general_kernel",),
+}
+"""Per warm-up case, ``module:function`` compiles run after it: kernel specialisations that no
+bundled case reaches but a user's case may (the Monte-Carlo kernel for a stack with a
+non-normal contributor, e.g. a ``[distributions]`` override: the bundled stacks are all
+normal and compile a specialisation without those draws)."""
 
 WARM_CHAINS: tuple[tuple[str, ...], ...] = (
     ("han2023_rv110e_yield",),  # the batched RV solver (solvers/rv_batch.py)
@@ -117,6 +127,9 @@ def _run_one(case: str) -> tuple[float, float]:
 
     w, c = time.perf_counter(), time.process_time()
     run_case(case, RunOptions(progress=False, samples=WARM_SAMPLES, workers=1))
+    for ref in WARM_ALSO.get(case, ()):
+        module, name = ref.split(":")
+        getattr(importlib.import_module(module), name)()
     return time.perf_counter() - w, time.process_time() - c
 
 

@@ -157,9 +157,13 @@ def _linear_stack_kernel(
     limit) in a vector loop of integer sums."""
     st = states.copy()
     lanes = lanes0.copy()
-    counts = np.zeros(nbins + 2, np.int64)
-    c32 = np.zeros(nbins + 2, np.int32)  # half the cache lines of int64; added in every 2³⁰
-    kept = np.empty(min(keep, n))
+    # np.empty and a fill, not np.zeros: each np.zeros dtype compiles an allocation and a
+    # zero fill of its own in a cold process (~0.3 s); min() is a conditional for the same reason
+    counts = np.empty(nbins + 2, np.int64)
+    counts[:] = 0
+    c32 = np.empty(nbins + 2, np.int32)  # half the cache lines of int64; added in every 2³⁰
+    c32[:] = 0
+    kept = np.empty(keep if keep < n else n)
     z = np.empty(_BLOCK)
     raw = np.empty(_BLOCK, np.uint64)
     rej = np.empty(_BLOCK, np.int64)
@@ -186,7 +190,7 @@ def _linear_stack_kernel(
             counts += c32
             c32[:] = 0
             added = done
-        m = min(_BLOCK, n - done)
+        m = _BLOCK if n - done > _BLOCK else n - done
         if group:  # the Gaussian group's normals; the previous block's bins counted on the way
             la = lanes[0]
             lb = lanes[1]
@@ -258,7 +262,7 @@ def _linear_stack_kernel(
                     y += sens[i] * v
                 z[j] = y
             st[DRAWS, 0], st[DRAWS, 1], st[DRAWS, 2], st[DRAWS, 3] = d0, d1, d2, d3
-        for j in range(min(m, keep - done)):
+        for j in range(m if keep - done > m else keep - done):
             kept[done + j] = z[j]
         if m == _BLOCK:  # pairwise (a fixed tree): elementwise loops, vector registers
             h = _BLOCK // 8
@@ -438,6 +442,20 @@ def _kept_samples(states: np.ndarray, n: int, args: tuple) -> np.ndarray:
     """The ``n`` samples of the kernel run with stack ``args``, all kept (a dummy reduction)."""
     red = (0.0, -1.0, 1.0, 1, -np.inf, np.inf, n)
     return _linear_stack_kernel(*(states, lane_states(states), n, *args, *red))[7]
+
+
+def compile_general_kernel() -> None:
+    """Compile (or load from numba's cache) the kernel for stacks with a contributor outside the
+    Gaussian group (uniform, Rayleigh, polar, empirical, constant).
+
+    A stack of normal contributors only runs a specialisation without their draws
+    (``others=None``), and every bundled case's stacks are such; ``gearte warm-cache`` calls
+    this so that a case with a ``[distributions]`` override finds the other one compiled too.
+    """
+    from gearte.tolerance.distributions import Uniform
+    from gearte.tolerance.stackup import Contributor
+
+    kernel_samples(LinearStack([Contributor("u", Uniform(0.0, 1.0), 1.0)]), 0, 2)
 
 
 def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
