@@ -49,7 +49,6 @@ __all__ = [
     "ZigguratTables",
     "ziggurat_tables",
     "stream_states",
-    "standard_normals",
     "Xoshiro256pp",
     "reference_normal",
     "STREAMS",
@@ -222,24 +221,6 @@ def lane_states(states: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(states[:LANES].T)
 
 
-def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
-    """``n`` standard normal numbers [-] from the chunk streams of ``seed`` (compiled).
-
-    Drawn by :mod:`gearte.tolerance.montecarlo`'s kernel for a stack of one standard normal
-    contributor (the block loop is written once, there).
-
-    Parameters
-    ----------
-    seed : int or SeedSequence
-        Seed of the streams (:func:`stream_states`).
-    n : int
-        How many numbers [-].
-    """
-    from gearte.tolerance.montecarlo import standard_normals as kernel_normals
-
-    return kernel_normals(seed, n)
-
-
 # ------------------------------------------------------------------------------------------------
 # plain twins
 # ------------------------------------------------------------------------------------------------
@@ -282,8 +263,9 @@ def _fast_ref(r: int, t: ZigguratTables) -> tuple[float, bool, int, int]:
 
 
 def reference_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
-    """Plain twin of :func:`standard_normals`: sample ``j`` from main stream ``j % LANES``
-    (:func:`reference_normal`), rejections from the tail stream, one sample at a time.
+    """Plain twin of :func:`gearte.tolerance.montecarlo.standard_normals`: sample ``j`` from
+    main stream ``j % LANES`` (:func:`reference_normal`), rejections from the tail stream, one
+    sample at a time.
 
     Parameters
     ----------
