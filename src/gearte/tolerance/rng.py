@@ -56,10 +56,6 @@ __all__ = [
     "TAIL",
     "DRAWS",
     "lane_states",
-    "next_u64",
-    "u64_to_unit",
-    "zig_fast",
-    "zig_slow",
     "reference_normals",
 ]
 
