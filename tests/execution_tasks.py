@@ -27,3 +27,14 @@ def weighted_chunk(chunk, shared):
     weights = shared["weights"]
     z = chunk.rng().standard_normal(chunk.size)
     return RunningStats.of(weights[np.arange(chunk.size) % weights.size] * z)
+
+
+def kernel_modules(_task):
+    """Call one cached numba kernel in this worker; whether ``scipy.linalg`` got imported (numba's
+    BLAS check imports it unless :mod:`gearte._blas` preloaded its two modules)."""
+    import sys
+
+    from gearte.models.contact_law import max_contact_pressure_scalar
+
+    max_contact_pressure_scalar(1000.0, -40.0, 3.0, 1.1e5, 10.0)
+    return "scipy.linalg" in sys.modules

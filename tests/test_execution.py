@@ -385,3 +385,14 @@ def test_progress_on_dask_counts_samples_with_the_uneven_last_chunk(client, monk
     assert on_dask.as_tuple() == here.as_tuple()
     for total, unit, *advances in seen:
         assert (total, unit, sorted(advances)) == (10_500, "samples", [2500, 4000, 4000])
+
+
+def test_local_process_workers_call_kernels_without_importing_scipy_linalg():
+    """A worker process's first kernel initialises numba's CPU target, whose BLAS check imports
+    the whole ``scipy.linalg`` package (~0.3 s CPU per worker) unless the worker's initializer
+    preloaded the two modules it needs (:mod:`gearte._blas`, issue 12)."""
+    from execution_tasks import kernel_modules
+    from gearte.execution import PoolExecutor
+
+    with PoolExecutor("processes", 1) as ex:
+        assert map_chunks(kernel_modules, [0], scheduler=ex, progress=False) == [False]

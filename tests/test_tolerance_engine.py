@@ -25,8 +25,8 @@ from gearte.tolerance.montecarlo import (
     monte_carlo,
     process_capability,
     reduce_samples,
+    standard_normals,
 )
-from gearte.tolerance.rng import standard_normals
 from gearte.tolerance.stackup import Contributor, FunctionStack, LinearStack, z_for_confidence
 from jiang2024_data import bevel_pair, spur_pair
 

@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from gearte.tolerance.montecarlo import standard_normals
 from gearte.tolerance.rng import (
     STREAMS,
     ZIG_R,
     Xoshiro256pp,
     reference_normals,
-    standard_normals,
     stream_states,
     ziggurat_tables,
 )

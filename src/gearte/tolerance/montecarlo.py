@@ -60,6 +60,7 @@ __all__ = [
     "reduce_samples",
     "kernel_samples",
     "process_capability",
+    "standard_normals",
 ]
 
 _TWO_PI = 2.0 * math.pi
@@ -460,8 +461,9 @@ def compile_general_kernel() -> None:
 
 def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
     """``n`` standard normal numbers [-] from the chunk streams of ``seed`` (compiled): the
-    Gaussian group of the kernel for a stack of one standard normal contributor
-    (:func:`gearte.tolerance.rng.standard_normals`).
+    Gaussian group of the kernel for a stack of one standard normal contributor; its plain
+    twin is :func:`gearte.tolerance.rng.reference_normals` (moved here from ``rng``, which
+    ``montecarlo`` imports: the block loop is written once, in the kernel).
 
     Parameters
     ----------

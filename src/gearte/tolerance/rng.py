@@ -49,7 +49,6 @@ __all__ = [
     "ZigguratTables",
     "ziggurat_tables",
     "stream_states",
-    "standard_normals",
     "Xoshiro256pp",
     "reference_normal",
     "STREAMS",
@@ -155,22 +154,18 @@ def stream_states(seed: int | np.random.SeedSequence, streams: int = STREAMS) ->
 # compile (docs/numba.md). zig_slow, with one call site, stays inlined.
 # ------------------------------------------------------------------------------------------------
 @njit(cache=True, nogil=True)
-def _rotl(x, k):  # pragma: no cover - compiled
-    """``x`` rotated left by ``k`` bits (both uint64: one signature, no literal ints)."""
-    return (x << k) | (x >> (uint64(64) - k))
-
-
-@njit(cache=True, nogil=True)
 def next_u64(s0, s1, s2, s3):  # pragma: no cover - compiled
-    """xoshiro256++: ``(output, s0, s1, s2, s3)``."""
-    r = _rotl(s0 + s3, uint64(23)) + s0
+    """xoshiro256++: ``(output, s0, s1, s2, s3)``. The two rotations (left by 23 and 45 bits)
+    are written out: a rotation kernel of its own was one more compile and call level."""
+    x = s0 + s3
+    r = ((x << uint64(23)) | (x >> uint64(41))) + s0
     t = s1 << uint64(17)
     s2 ^= s0
     s3 ^= s1
     s1 ^= s2
     s0 ^= s3
     s2 ^= t
-    s3 = _rotl(s3, uint64(45))
+    s3 = (s3 << uint64(45)) | (s3 >> uint64(19))
     return r, s0, s1, s2, s3
 
 
@@ -226,24 +221,6 @@ def lane_states(states: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(states[:LANES].T)
 
 
-def standard_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
-    """``n`` standard normal numbers [-] from the chunk streams of ``seed`` (compiled).
-
-    Drawn by :mod:`gearte.tolerance.montecarlo`'s kernel for a stack of one standard normal
-    contributor (the block loop is written once, there).
-
-    Parameters
-    ----------
-    seed : int or SeedSequence
-        Seed of the streams (:func:`stream_states`).
-    n : int
-        How many numbers [-].
-    """
-    from gearte.tolerance.montecarlo import standard_normals as kernel_normals
-
-    return kernel_normals(seed, n)
-
-
 # ------------------------------------------------------------------------------------------------
 # plain twins
 # ------------------------------------------------------------------------------------------------
@@ -286,8 +263,9 @@ def _fast_ref(r: int, t: ZigguratTables) -> tuple[float, bool, int, int]:
 
 
 def reference_normals(seed: int | np.random.SeedSequence, n: int) -> np.ndarray:
-    """Plain twin of :func:`standard_normals`: sample ``j`` from main stream ``j % LANES``
-    (:func:`reference_normal`), rejections from the tail stream, one sample at a time.
+    """Plain twin of :func:`gearte.tolerance.montecarlo.standard_normals`: sample ``j`` from
+    main stream ``j % LANES`` (:func:`reference_normal`), rejections from the tail stream, one
+    sample at a time.
 
     Parameters
     ----------
