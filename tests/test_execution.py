@@ -396,3 +396,12 @@ def test_local_process_workers_call_kernels_without_importing_scipy_linalg():
 
     with PoolExecutor("processes", 1) as ex:
         assert map_chunks(kernel_modules, [0], scheduler=ex, progress=False) == [False]
+
+
+def test_local_cluster_workers_call_kernels_without_importing_scipy_linalg():
+    """The same for the workers of gearte's ``"local-cluster"``: a worker plugin preloads the
+    two BLAS modules (:class:`gearte.execution._dask_plugins.PreloadBlas`, issue 12)."""
+    from execution_tasks import kernel_modules
+
+    with open_executor("local-cluster", 1) as ex:
+        assert map_chunks(kernel_modules, [0], scheduler=ex, progress=False) == [False]

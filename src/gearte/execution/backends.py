@@ -455,9 +455,11 @@ class DaskExecutor(ChunkExecutor):
                 self._owned.insert(0, self.client)
                 # Ctrl-C in a terminal reaches the local workers too: they ignore it (also
                 # workers the nannies restart), this process stops the work and the cluster.
-                from gearte.execution._dask_plugins import IgnoreSigint
+                # And they load numba's BLAS modules without scipy.linalg (gearte._blas).
+                from gearte.execution._dask_plugins import IgnoreSigint, PreloadBlas
 
                 self.client.register_plugin(IgnoreSigint(), name="gearte-ignore-sigint")
+                self.client.register_plugin(PreloadBlas(), name="gearte-preload-blas")
             elif isinstance(scheduler, str):
                 _probe_tcp(scheduler, connect_timeout_s)
                 self.client = _connect(distributed, scheduler, connect_timeout_s)
