@@ -150,18 +150,22 @@ def stream_states(seed: int | np.random.SeedSequence, streams: int = STREAMS) ->
 # compile (docs/numba.md). zig_slow, with one call site, stays inlined.
 # ------------------------------------------------------------------------------------------------
 @njit(cache=True, nogil=True)
+def _rotl(x, k):  # pragma: no cover - compiled
+    """``x`` rotated left by ``k`` bits (both uint64: one signature, no literal ints)."""
+    return (x << k) | (x >> (uint64(64) - k))
+
+
+@njit(cache=True, nogil=True)
 def next_u64(s0, s1, s2, s3):  # pragma: no cover - compiled
-    """xoshiro256++: ``(output, s0, s1, s2, s3)``. The two rotations (left by 23 and 45 bits)
-    are written out: a rotation kernel of its own was one more compile and call level."""
-    x = s0 + s3
-    r = ((x << uint64(23)) | (x >> uint64(41))) + s0
+    """xoshiro256++: ``(output, s0, s1, s2, s3)``."""
+    r = _rotl(s0 + s3, uint64(23)) + s0
     t = s1 << uint64(17)
     s2 ^= s0
     s3 ^= s1
     s1 ^= s2
     s0 ^= s3
     s2 ^= t
-    s3 = (s3 << uint64(45)) | (s3 >> uint64(19))
+    s3 = _rotl(s3, uint64(45))
     return r, s0, s1, s2, s3
 
 
