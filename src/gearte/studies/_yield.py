@@ -47,7 +47,14 @@ from pydantic import Field, model_validator
 from gearte.io.schema import StrictModel
 from gearte.results import AnalysisResult
 
-__all__ = ["YieldSection", "ToleranceEntry", "GradeTolerance", "yield_analysis", "to_toml"]
+__all__ = [
+    "YieldSection",
+    "ToleranceEntry",
+    "GradeTolerance",
+    "eccentricity_grade_tolerance",
+    "yield_analysis",
+    "to_toml",
+]
 
 
 class GradeTolerance(NamedTuple):
@@ -56,6 +63,63 @@ class GradeTolerance(NamedTuple):
 
     tolerance_um: float
     derivation: str
+
+
+def eccentricity_grade_tolerance(
+    field: str, grade: int, gear: str, teeth: int, module_mm: float, stage: str = ""
+) -> GradeTolerance:
+    """A gear's eccentricity tolerance from its ISO 1328-1:2013 class: ``F_rT / 2`` (run-out
+    ``F_rT = 0.9 F_pT``, rounded as §5.2.3, is twice the eccentricity) at ``d = m z``.
+
+    Parameters
+    ----------
+    field : str
+        The case key of the grade, named in the error.
+    grade : int
+        ISO 1328-1 flank tolerance class [-].
+    gear : str
+        The gear as the derivation names it (``"sun"``, ``"planet 2"`` …).
+    teeth : int
+        Its number of teeth [-].
+    module_mm : float
+        Its normal module [mm].
+    stage : str, optional
+        Words in front of the gear in the error (``"first stage's "``).
+
+    Returns
+    -------
+    GradeTolerance
+        The tolerance [µm] and its derivation.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``field`` where the gear is outside the standard's range of application.
+
+    References
+    ----------
+    ISO 1328-1:2013 Cylindrical gears — ISO system of flank tolerance classification — Part 1,
+    eq. (6) and §5.2.3 (:func:`gearte.tolerance.iso1328.runout_tolerance`).
+    """
+    from gearte.errors import ParameterError
+    from gearte.tolerance.iso1328 import runout_tolerance
+
+    m, d = module_mm, module_mm * teeth
+    where = f"{gear}: z = {teeth}, m_n = {m:g} mm, d = m_n z = {d:g} mm"
+    try:
+        f_rt = runout_tolerance(grade, m, d, teeth=teeth)
+    except ParameterError as exc:
+        raise ParameterError(
+            field,
+            grade,
+            f"the {stage}{where} is outside ISO 1328-1:2013's range of application "
+            f"({exc.field} = {exc.value:g}: {exc.reason}): give tolerance_um",
+        ) from None
+    return GradeTolerance(
+        0.5 * f_rt,
+        f"ISO 1328-1:2013 class {grade}, {where}: run-out F_rT = 0.9 F_pT = {f_rt:g} µm "
+        f"(rounded as §5.2.3), eccentricity tolerance F_rT/2 = {0.5 * f_rt:g} µm",
+    )
 
 
 #: ``grade_um(key, grade)``: the tolerance a grade gives an error (``None``: no grade applies;

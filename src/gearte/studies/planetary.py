@@ -808,8 +808,7 @@ def _grade_um(case: Case):
     and teeth of ``[gearset]`` (``d = m z``; run-out needs no face width). Any other key is an
     error naming it and saying why.
     """
-    from gearte.studies._yield import GradeTolerance
-    from gearte.tolerance.iso1328 import runout_tolerance
+    from gearte.studies._yield import GradeTolerance, eccentricity_grade_tolerance
 
     gs = case.gearset
     gears = {"E_s": ("sun", gs.z_sun), "E_r": ("ring (internal gear)", gs.z_ring)}
@@ -839,21 +838,6 @@ def _grade_um(case: Case):
             )
         else:
             return None
-        m, d = gs.module_mm, gs.module_mm * z
-        where = f"{name}: z = {z}, m_n = {m:g} mm, d = m_n z = {d:g} mm"
-        try:
-            f_rt = runout_tolerance(grade, m, d, teeth=z)
-        except ParameterError as exc:
-            raise ParameterError(
-                field,
-                grade,
-                f"the {where} is outside ISO 1328-1:2013's range of application "
-                f"({exc.field} = {exc.value:g}: {exc.reason}): give tolerance_um",
-            ) from None
-        return GradeTolerance(
-            0.5 * f_rt,
-            f"ISO 1328-1:2013 class {grade}, {where}: run-out F_rT = 0.9 F_pT = {f_rt:g} µm "
-            f"(rounded as §5.2.3), eccentricity tolerance F_rT/2 = {0.5 * f_rt:g} µm",
-        )
+        return eccentricity_grade_tolerance(field, grade, name, z, gs.module_mm)
 
     return grade_um

@@ -1509,9 +1509,7 @@ def _grade_um(case: Case):
     def grade_um(key: str, grade: int):
         """planet_base_circle / sun_eccentricity: eccentricity tolerance F_rT/2 of the planet /
         sun gear (ISO 1328-1:2013), reported with its derivation."""
-        from gearte.errors import ParameterError
-        from gearte.studies._yield import GradeTolerance
-        from gearte.tolerance.iso1328 import runout_tolerance
+        from gearte.studies._yield import eccentricity_grade_tolerance
 
         fs = case.reducer.first_stage
         gear = {"planet_base_circle": ("planet", fs.planet_teeth)}
@@ -1519,22 +1517,8 @@ def _grade_um(case: Case):
         if key.split(".")[0] not in gear:
             return None
         name, z = gear[key.split(".")[0]]
-        m, d = fs.module_mm, fs.module_mm * z
-        where = f"{name}: z = {z}, m_n = {m:g} mm, d = m_n z = {d:g} mm"
-        try:
-            f_rt = runout_tolerance(grade, m, d, teeth=z)
-        except ParameterError as exc:
-            raise ParameterError(
-                f"analyses.yield.tolerances.{key}.grade",
-                grade,
-                f"the first stage's {where} is outside ISO 1328-1:2013's range of application "
-                f"({exc.field} = {exc.value:g}: {exc.reason}): give tolerance_um",
-            ) from None
-        return GradeTolerance(
-            0.5 * f_rt,
-            f"ISO 1328-1:2013 class {grade}, {where}: run-out F_rT = 0.9 F_pT = {f_rt:g} µm "
-            f"(rounded as §5.2.3), eccentricity tolerance F_rT/2 = {0.5 * f_rt:g} µm",
-        )
+        field = f"analyses.yield.tolerances.{key}.grade"
+        return eccentricity_grade_tolerance(field, grade, name, z, fs.module_mm, "first stage's ")
 
     return grade_um
 
