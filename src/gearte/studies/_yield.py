@@ -424,7 +424,7 @@ def _tolerances(
                     t.grade,
                     "this error is not a gear's eccentricity: give tolerance_um",
                 )
-            tol = float(read[0] if isinstance(read, GradeTolerance) else read)
+            tol = float(read.tolerance_um if isinstance(read, GradeTolerance) else read)
             if derived is not None:
                 how = read.derivation if isinstance(read, GradeTolerance) else None
                 derived[ukey] = {"grade": t.grade, "derived_from": how or f"grade {t.grade}"}
