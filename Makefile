@@ -14,6 +14,9 @@ RUN_STAMP := $(VENV)/.installed-run-$(HASH)
 DEV_STAMP := $(VENV)/.installed-dev-$(HASH)
 PIP    := $(BIN)/python -m pip install --disable-pip-version-check -c $(CONSTRAINTS)
 DEMO_CASE ?= hu2020_rv80e_initial
+# pytest workers (pytest-xdist): one per core; TEST_WORKERS=0 runs the suite in one process
+TEST_WORKERS ?= auto
+PYTEST := $(BIN)/python -m pytest -q -n $(TEST_WORKERS)
 
 .PHONY: demo test test-slow test-latest lint typecheck bench lock clean fuzz docs
 
@@ -52,7 +55,7 @@ test: $(DEV_STAMP)
 	@echo "==> mypy (pydantic plugin; config in pyproject.toml)"
 	$(BIN)/mypy src/gearte
 	@echo "==> pytest"
-	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(PYTEST)
 
 # The docs site (mkdocs.yml) into site/, offline and strict (a broken link or reference fails);
 # the gallery runs the paper cases once per source tree (cached in .docs_cache/);
@@ -79,7 +82,7 @@ fuzz: $(DEV_STAMP)
 		--equivalence $(FUZZ_EQUIVALENCE) --record out/fuzz.jsonl
 
 test-slow: $(DEV_STAMP)
-	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(BIN)/python -m pytest -q -m slow
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(PYTEST) -m slow
 
 # The newest releases of every dependency, resolved now (no constraints): tells upstream drift apart.
 test-latest:
@@ -87,7 +90,7 @@ test-latest:
 	$(PYTHON) -m venv .venv-latest
 	.venv-latest/bin/python -m pip install --disable-pip-version-check --upgrade -e ".[dev]"
 	.venv-latest/bin/ruff check src tests benchmarks
-	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_latest .venv-latest/bin/python -m pytest -q
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_latest .venv-latest/bin/python -m pytest -q -n $(TEST_WORKERS)
 
 lock:
 	rm -rf .venv-lock
