@@ -357,6 +357,28 @@ def test_local_cluster_workers_run_without_profiler_and_with_a_slow_tick(referen
     assert _worker_dask_settings() == before
 
 
+def test_local_cluster_with_port_8787_taken_warns_nothing(reference):
+    """A second ``"local-cluster"`` on the machine (another gearte run, which Dask's default
+    scheduler HTTP port 8787 would make print "Port 8787 is already in use") starts silently
+    on a free port and gives the same bits."""
+    import warnings
+
+    holder = socket.socket()
+    try:
+        holder.bind(("127.0.0.1", 8787))
+        holder.listen(1)
+    except OSError:
+        pass  # already taken (by another cluster on this machine): the case under test
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            with open_executor("local-cluster", 1) as ex:
+                assert _stats(scheduler=ex).as_tuple() == reference.as_tuple()
+        assert not [w for w in caught if "8787" in str(w.message)], [str(w.message) for w in caught]
+    finally:
+        holder.close()
+
+
 def test_progress_on_dask_counts_samples_with_the_uneven_last_chunk(client, monkeypatch):
     """Issue 14: on a Dask cluster too the bar's total is the samples (10 500) and each finished
     chunk advances it by its own size (4000, 4000, 2500); the result equals the sequential one.

@@ -448,6 +448,10 @@ class DaskExecutor(ChunkExecutor):
                         threads_per_worker=1,
                         processes=True,
                         dashboard_address=None,
+                        # the scheduler's HTTP server (health and metrics routes; no dashboard)
+                        # on a free port: on 8787, Dask's default, a second local cluster on the
+                        # machine (another gearte run) printed "Port 8787 is already in use"
+                        scheduler_kwargs={"dashboard_address": ":0"},
                         silence_logs=logging.ERROR,
                     )
                 self._owned.append(cluster)
