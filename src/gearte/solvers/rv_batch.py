@@ -41,6 +41,7 @@ from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
     LAW_LINEAR,
     LAW_SECANT_PER_CONTACT,
+    NEWTON_MAXIT,
     _bearing_terms,
     _secant_update,
 )
@@ -812,7 +813,7 @@ def solve_batch(
     *,
     start: np.ndarray | None = None,
     tol: float = 1e-9,
-    maxit: int = 100,
+    maxit: int = NEWTON_MAXIT,
     exact: bool = True,
     compiled: bool = True,
 ) -> BatchSolution:
@@ -844,7 +845,8 @@ def solve_batch(
         Relative tolerance of the secant fixed point [-] (as
         :func:`gearte.solvers.rv_equilibrium.solve_positions`).
     maxit : int
-        Newton iterations per solve.
+        Most Newton iterations per solve [-] (default
+        :data:`gearte.solvers.rv_equilibrium.NEWTON_MAXIT`).
     exact : bool
         Per-contact law: Newton on the exact law (quadratic convergence to the secant fixed
         point's limit; :func:`_newton_mixed`, falling back to a line-searched Newton) instead
@@ -958,7 +960,7 @@ def solve_positions(
     q0: np.ndarray | None = None,
     k0: np.ndarray | None = None,
     tol: float = 1e-9,
-    maxit: int = 100,
+    maxit: int = NEWTON_MAXIT,
     compiled: bool = True,
     method: str = "batched",
 ):
@@ -982,7 +984,8 @@ def solve_positions(
     tol : float
         Relative tolerance of the contact-stiffness fixed point [-].
     maxit : int
-        Most Newton iterations per solve [-].
+        Most Newton iterations per solve [-] (default
+        :data:`gearte.solvers.rv_equilibrium.NEWTON_MAXIT`).
     compiled : bool
         ``False`` runs the plain-Python twin [-].
     method : str
@@ -1010,7 +1013,7 @@ def solve_system(
     q0: np.ndarray | None = None,
     k0: np.ndarray | None = None,
     tol: float = 1e-9,
-    maxit: int = 100,
+    maxit: int = NEWTON_MAXIT,
     compiled: bool = True,
 ):
     """:func:`gearte.solvers.rv_equilibrium.solve_positions` through the batched kernel.
@@ -1040,7 +1043,8 @@ def solve_system(
     tol : float
         Relative tolerance of the contact-stiffness fixed point [-].
     maxit : int
-        Most Newton iterations per solve [-].
+        Most Newton iterations per solve [-] (default
+        :data:`gearte.solvers.rv_equilibrium.NEWTON_MAXIT`).
     compiled : bool
         ``False`` runs the plain-Python twin [-].
 

@@ -48,6 +48,14 @@ _SCHEMES = {
 #: equilibrium unique when parts float in their clearances (at zero load); its force is below
 #: 1e-6 k c (< 1 N for 10 µm at 1e5 N/mm).
 CLEARANCE_RESIDUAL = 1e-6
+#: Most Newton iterations per solve: the ``maxit`` default of every RV equilibrium solver.
+#: Newton with a line search on the strictly convex Π converges from any start, but where parts
+#: float in their bearing clearances (a small torque) and the start is far (a sweep's cold first
+#: position) it crosses the clearances' kinks many times and converges linearly: the bundled
+#: serial without its crank-bore file took 150 iterations at 0.1 % of its torque (the cap was
+#: 100, docs/metrology.md). A solve that converges stops where it did before; the cap only ends
+#: one that does not.
+NEWTON_MAXIT = 1000
 
 _TWIN_LOCK = threading.Lock()
 
@@ -426,7 +434,7 @@ def solve_positions(
     q0: np.ndarray | None = None,
     k0: np.ndarray | None = None,
     tol: float = 1e-9,
-    maxit: int = 100,
+    maxit: int = NEWTON_MAXIT,
     compiled: bool = True,
 ) -> EquilibriumSolution:
     """Quasi-static equilibrium at every position of ``system`` under output torque(s), by the
@@ -446,7 +454,7 @@ def solve_positions(
     tol : float
         Relative tolerance of the contact-stiffness fixed point [-].
     maxit : int
-        Most fixed-point iterations per position [-].
+        Most Newton iterations per solve [-] (default :data:`NEWTON_MAXIT`).
     compiled : bool
         ``False`` runs the plain-Python twin of the same kernel (for tests).
     Raises
