@@ -95,6 +95,26 @@ def test_analysis_without_its_input_names_the_missing_key():
     assert "analyses.geometric_te needs reducer.cycloid_errors" in text
 
 
+def test_yield_without_the_rated_torque_names_the_missing_key():
+    """Found by ``make fuzz`` (2026-11-26): han2023_rv110e_yield without
+    ``reducer.rated_torque_Nm`` escaped as an internal TypeError; every sample's catalogue test
+    needs it, so the case file is refused naming the key, and the API says the same."""
+    from gearte.errors import ParameterError
+    from gearte.runners.yield_models import RVReducerYield
+    from gearte.studies.rv_reducer import build_reducer
+
+    data = _data("han2023_rv110e_yield")
+    del data["reducer"]["rated_torque_Nm"]
+    with pytest.raises(CaseFileError) as exc:
+        load_case_dict(data)
+    assert "analyses.yield needs reducer.rated_torque_Nm" in str(exc.value)
+    red = build_reducer(load_case_dict(_data("han2023_rv110e_yield")).reducer)
+    import dataclasses
+
+    with pytest.raises(ParameterError, match="reducer.rated_torque"):
+        RVReducerYield(dataclasses.replace(red, rated_torque=None))
+
+
 def test_adding_the_inputs_makes_an_analysis_run():
     """li2023_rv does not ask for load sharing; adding the section is all it takes."""
     data = _data("li2023_rv")

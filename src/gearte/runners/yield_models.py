@@ -307,6 +307,13 @@ class RVReducerYield:
 
         if int(positions) != positions or positions < 2:
             raise ParameterError("positions", positions, "must be an integer >= 2")
+        if reducer.rated_torque is None:
+            raise ParameterError(
+                "reducer.rated_torque",
+                None,
+                "every sample's catalogue virtual test (lost motion at ±3 % of it, rigidity, "
+                "hysteresis) needs the rated torque [N·mm]",
+            )
         self.reducer = reducer
         self.theta = output_positions(int(positions))
         self.te_torque = float(reducer.rated_torque if te_torque is None else te_torque)

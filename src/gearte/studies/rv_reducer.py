@@ -892,6 +892,8 @@ class Analyses(StrictModel):
 _NEEDS = {
     "catalogue": ("reducer.rated_torque_Nm",),
     "compensation": ("reducer.rated_torque_Nm",),
+    # every sample's catalogue virtual test (lost motion at ±3 % of the rated torque, rigidity)
+    "yield": ("reducer.rated_torque_Nm",),
     "geometric_te": ("reducer.cycloid_errors",),
     "cycloid_compensation": ("reducer.cycloid_errors",),
     **{k: ("reducer.dynamics", "operation") for k in dyn.ANALYSES},
@@ -914,7 +916,7 @@ class Case(CaseBase):
         problems = [
             f"analyses.{name} needs {key}, which the case does not give"
             for name, keys in _NEEDS.items()
-            if getattr(self.analyses, name) is not None
+            if getattr(self.analyses, "yield_" if name == "yield" else name) is not None
             for key in keys
             if not have[key]
         ]
