@@ -209,20 +209,29 @@ def test_lost_cluster_keeps_finished_chunks_and_says_so(tmp_path, monkeypatch):
     monkeypatch.setenv("GEARTE_TEST_STALL", str(marker))
     monkeypatch.setenv("PYTHONPATH", str(TESTS) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     case = load_case_dict({"case": {"kind": "stall_mc_test"}, "mc": {"samples": 10_000}})
+    # a scheduler here and its one worker a process of its own without a nanny: killed, it
+    # stays dead (a LocalCluster's nanny restarts its worker; distributed 2026 has no
+    # Nanny.auto_restart to stop it, and this test then ran every stalled chunk, 7 min)
     cluster = distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+        n_workers=0,
+        processes=True,
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard_address": ":0"},
     )
+    worker = subprocess.Popen(
+        [sys.executable, "-m", "distributed.cli.dask_worker", cluster.scheduler_address,
+         "--no-nanny", "--nthreads", "1", "--no-dashboard"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
     try:
         client = distributed.Client(cluster, set_as_default=False)
+        client.wait_for_workers(1, timeout=60)
         ex = DaskExecutor(client, no_worker_timeout_s=1.0)
 
         def kill_the_only_worker() -> None:
             while not marker.exists():  # chunk 3 runs: 0, 1, 2 are in memory
                 time.sleep(0.05)
-            for nanny in cluster.workers.values():
-                nanny.auto_restart = False
-            for pid in client.run(os.getpid).values():
-                os.kill(pid, signal.SIGKILL)
+            worker.kill()  # SIGKILL
 
         killer = threading.Thread(target=kill_the_only_worker, daemon=True)
         killer.start()
@@ -233,6 +242,8 @@ def test_lost_cluster_keeps_finished_chunks_and_says_so(tmp_path, monkeypatch):
         with contextlib.suppress(Exception):
             client.close()
         cluster.close()
+        worker.kill()
+        worker.wait(10)
     result = info.value.partial
     assert result is not None and result.partial
     kept = re.search(r"first: (\d+) of 10 chunks finished and kept", result.warnings[0])
