@@ -17,8 +17,15 @@ import pytest
 from gearte.report.outputs import write_file_set
 
 TESTS = Path(__file__).resolve().parent
+#: Each child starts with Python's own SIGINT handler, as a program started in a terminal does:
+#: a test run from a background job of a non-interactive shell (``cmd &``, nohup) passes SIGINT
+#: on ignored, and an ignored SIGINT stays ignored in its children (POSIX; Python keeps it so).
+_SIGINT_AS_IN_A_TERMINAL = (
+    "import signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+)
+
 CLI = (
-    f"import sys; sys.path.insert(0, {str(TESTS)!r}); "
+    _SIGINT_AS_IN_A_TERMINAL + f"import sys; sys.path.insert(0, {str(TESTS)!r}); "
     "from gearte.studies import register_kind; register_kind('stall_test', 'stall_kind'); "
     "from gearte.cli import main; sys.exit(main())"
 )
@@ -74,7 +81,7 @@ def test_interrupted_sweep_writes_finished_points_marked_partial(tmp_path, sig):
 
 
 MC_CLI = (
-    f"import sys; sys.path.insert(0, {str(TESTS)!r}); "
+    _SIGINT_AS_IN_A_TERMINAL + f"import sys; sys.path.insert(0, {str(TESTS)!r}); "
     "from gearte.studies import register_kind; register_kind('stall_mc_test', 'stall_mc_kind'); "
     "from gearte.cli import main; sys.exit(main())"
 )
