@@ -99,6 +99,8 @@ def test_yield_without_the_rated_torque_names_the_missing_key():
     """Found by ``make fuzz`` (2026-11-26): han2023_rv110e_yield without
     ``reducer.rated_torque_Nm`` escaped as an internal TypeError; every sample's catalogue test
     needs it, so the case file is refused naming the key, and the API says the same."""
+    import dataclasses
+
     from gearte.errors import ParameterError
     from gearte.runners.yield_models import RVReducerYield
     from gearte.studies.rv_reducer import build_reducer
@@ -109,8 +111,6 @@ def test_yield_without_the_rated_torque_names_the_missing_key():
         load_case_dict(data)
     assert "analyses.yield needs reducer.rated_torque_Nm" in str(exc.value)
     red = build_reducer(load_case_dict(_data("han2023_rv110e_yield")).reducer)
-    import dataclasses
-
     with pytest.raises(ParameterError, match="reducer.rated_torque"):
         RVReducerYield(dataclasses.replace(red, rated_torque=None))
 

@@ -913,10 +913,12 @@ class Case(CaseBase):
             "reducer.dynamics": self.reducer.dynamics is not None,
             "operation": self.operation is not None,
         }
+        # a section's case key is its field's alias where it has one (``yield`` → ``yield_``)
+        attr = {f.alias: n for n, f in Analyses.model_fields.items() if f.alias}
         problems = [
             f"analyses.{name} needs {key}, which the case does not give"
             for name, keys in _NEEDS.items()
-            if getattr(self.analyses, "yield_" if name == "yield" else name) is not None
+            if getattr(self.analyses, attr.get(name, name)) is not None
             for key in keys
             if not have[key]
         ]
