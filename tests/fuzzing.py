@@ -35,6 +35,11 @@ hostile metadata, cut or corrupted bytes), read by their reader: a complete obje
 numbers, or one ``BenchFileError``/``MeasurementFileError`` line naming the file; anything else
 is a crash.
 
+``--count -1`` replaces the random mutants by the **systematic sweep of extreme values**
+(:func:`extreme_mutants`, ``make fuzz-extremes``): every positive number of every bundled case
+set in turn to 1e-300, × 1e-9 and × 1e9, so every key is reached (docs/errors.md, "The
+extreme-value sweep").
+
 Small runs are part of the test suite (``tests/test_fuzz_cases.py``, hypothesis-driven); the long
 job is ``make fuzz`` (``python tests/fuzzing.py --count 10000 --files 10000 --runs -1``), which
 prints the tallies.
@@ -250,6 +255,37 @@ def mutant_text(base: dict[str, Any], rng: random.Random) -> tuple[str, str]:
             ],
         )
     return text, "; ".join(done)
+
+
+#: The extreme values of the systematic sweep (``--extremes``): each positive number of a
+#: bundled case replaced by the smallest positive double-ish value, and scaled by 1e-9 and 1e9.
+EXTREMES: list[tuple[str, Callable[[float], float]]] = [
+    ("= 1e-300", lambda v: 1e-300),
+    ("x 1e-9", lambda v: v * 1e-9),
+    ("x 1e9", lambda v: v * 1e9),
+]
+
+
+def extreme_mutants() -> list[tuple[str, str, str]]:
+    """Every positive number of every bundled case (the first element of a list) replaced in
+    turn by each of :data:`EXTREMES`: ``[(base, done, text)]``, in a fixed order. Unlike the
+    random mutants, this sweep reaches every key: a value inside the schema's range that no
+    drive could have must be refused naming the key, not end as a solver that did not
+    converge."""
+    out = []
+    for name, data in sorted(corpus().items()):
+        for path in _paths(data):
+            if path[0] == "case" or (isinstance(path[-1], int) and path[-1] != 0):
+                continue
+            v = _parent(data, path)[path[-1]]
+            if isinstance(v, bool) or not isinstance(v, int | float) or v <= 0:
+                continue
+            where = ".".join(map(str, path))
+            for label, f in EXTREMES:
+                new = json.loads(json.dumps(data))
+                _parent(new, path)[path[-1]] = float(f(float(v)))
+                out.append((name, f"extreme {where} {label}", to_toml(new)))
+    return out
 
 
 # ----------------------------------------------------------------------------- checking
@@ -922,7 +958,8 @@ def run(
     server: ForkServer | None = None,
     records: Any = None,
 ) -> Counter[str]:
-    """Fuzz ``count`` mutants; returns the tally of outcomes (examples printed if verbose).
+    """Fuzz ``count`` mutants (``-1``: the systematic sweep of :func:`extreme_mutants`); returns
+    the tally of outcomes (examples printed if verbose).
     The first ``runs`` accepted mutants (``-1``: every one) also go through ``gearte run``: in
     children of ``server`` when given, else in this process (:func:`run_cli`)."""
     rng = random.Random(seed)
@@ -930,9 +967,13 @@ def run(
     names = sorted(bases)
     tally: Counter[str] = Counter()
     link_case_data(tmp)
-    for i in range(count):
-        name = names[i % len(names)]
-        text, done = mutant_text(bases[name], rng)
+    sweep = extreme_mutants() if count < 0 else []
+    for i in range(len(sweep) if count < 0 else count):
+        if count < 0:
+            name, done, text = sweep[i]
+        else:
+            name = names[i % len(names)]
+            text, done = mutant_text(bases[name], rng)
         out = check_text(text, tmp)
         tally[out.status] += 1
         if server is not None:
@@ -1000,7 +1041,13 @@ def main(argv: list[str] | None = None) -> int:
     import tempfile
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--count", type=int, default=10_000, help="mutated case files")
+    ap.add_argument(
+        "--count",
+        type=int,
+        default=10_000,
+        help="mutated case files (-1: the systematic sweep of extreme values instead, "
+        "every positive number of every bundled case = 1e-300, x 1e-9, x 1e9)",
+    )
     ap.add_argument("--files", type=int, default=0, help="mutated measurement files")
     ap.add_argument("--seed", type=int, default=13)
     ap.add_argument("--quiet", action="store_true")
@@ -1079,8 +1126,11 @@ def main(argv: list[str] | None = None) -> int:
     peak_run = max((r.peak_rss_mb for r in runs), default=0.0) / 1024
     slowest = max((r.wall_s for r in runs), default=0.0)
     cpu = sum(r.cpu_s for r in runs)
+    what = "the extreme-value sweep:" if a.count < 0 else ""
+    n_cases = tally["accepted"] + tally["rejected"] + tally["crash"] + tally["coerced"]
+    n_cases += tally["bad_message"]
     print(
-        f"{a.count} fuzzed case files ({tally['run_total']} accepted mutants also run, "
+        f"{what} {n_cases} fuzzed case files ({tally['run_total']} accepted mutants also run, "
         f"{'fork server, ' + str(a.workers) + ' workers' if server else 'in process'}) in "
         f"{t1 - t0:.1f} s (warm-up {warm_s:.1f} s; runs {cpu:.1f} s CPU, slowest {slowest:.1f} s "
         f"wall, peak RSS of a run {peak_run:.2f} GB, bound {RUN_MEMORY_LIMIT / 2**30:.0f} GiB "

@@ -214,18 +214,19 @@ def test_speed_sweep_duration_lost_beside_the_settling_time_is_refused_by_valida
 
 
 def test_tooth_contact_deformation_beyond_the_elastic_range_is_refused_by_validate(tmp_path):
-    """E = 0.12 MPa: the solve at the paper's mesh position (the pre-flight) deforms a pin far
-    beyond 0.1 x pin radius; exit 2 naming the torque key, before any analysis."""
+    """E = 1000 MPa (the plausibility floor; 0.12 MPa, the value this test first used, is now
+    refused by the schema): the solve at the paper's mesh position (the pre-flight) deforms a
+    pin far beyond 0.1 x pin radius; exit 2 naming the torque key, before any analysis."""
     p = _mutant(
         tmp_path,
         "hu2020_rv80e_modified",
         "youngs_modulus_MPa = 2.06e5",
-        "youngs_modulus_MPa = 0.12",
+        "youngs_modulus_MPa = 1000.0",
     )
     v, r = _validate_and_run(p, tmp_path)
     assert v == r
     assert v.startswith("analyses.tooth_contact.torque_Nm = ")
-    assert "beyond the elastic contact model's range" in v and "youngs_modulus_MPa = 0.12" in v
+    assert "beyond the elastic contact model's range" in v and "youngs_modulus_MPa = 1000" in v
 
 
 def test_malformed_bench_file_is_refused_by_validate_as_by_run(tmp_path):
@@ -282,7 +283,7 @@ def test_rv_tooth_contact_deformation_beyond_the_elastic_range_is_refused_by_val
         tmp_path,
         "hu2020_rv80e_initial_reducer",
         "youngs_modulus_MPa = 2.06e5",
-        "youngs_modulus_MPa = 0.12",
+        "youngs_modulus_MPa = 1000.0",
     )
     v, r = _validate_and_run(p, tmp_path)
     assert v == r

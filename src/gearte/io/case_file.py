@@ -137,6 +137,36 @@ def _fields_at(root: Any, loc: tuple[Any, ...]) -> set[str]:
     return {name for m in models for name in m.model_fields}
 
 
+def _floor_message(root: Any, loc: tuple[Any, ...]) -> str | None:
+    """The plausibility-floor message of the field at ``loc`` (``gearte.io.schema.floored``),
+    or ``None`` where that field has no floor."""
+    if root is None or not loc:
+        return None
+
+    def field(model: Any, key: Any) -> Any:  # by name or by alias (``yield``)
+        for name, info in model.model_fields.items():
+            if key in (name, info.alias):
+                return info
+        return None
+
+    models = [root]
+    for part in loc[:-1]:
+        if isinstance(part, int):
+            continue
+        nxt: list[Any] = []
+        for m in models:
+            info = field(m, part)
+            if info is not None:
+                nxt += _model_classes(info.annotation)
+        models = nxt or models
+    for m in models:
+        info = field(m, loc[-1])
+        extra = getattr(info, "json_schema_extra", None)
+        if isinstance(extra, dict) and "plausibility_floor" in extra:
+            return str(extra["plausibility_floor"])
+    return None
+
+
 def _in_base_unit(unit: str) -> tuple[str, float] | None:
     """``(dimension, size of one ``unit`` in the dimension's base unit)`` of a key suffix (mm, N·mm,
     N, MPa, rad), or ``None`` for a suffix that is no known unit."""
@@ -216,6 +246,10 @@ def format_validation_errors(exc: Any, root: Any = None) -> list[tuple[str, str]
                 hint = did_you_mean(str(loc_t[-1]), _fields_at(root, loc_t[:-1]), err.get("input"))
                 if hint:
                     msg = f"unknown key; {hint}"
+        elif kind == "greater_than_equal":
+            floor = _floor_message(root, tuple(err.get("loc", ())))
+            if floor is not None:
+                msg = floor
         if "input" in err and kind not in ("missing",) and not isinstance(err["input"], dict):
             msg = f"{msg} (got {_short(err['input'])})"
         out.append((loc, msg))

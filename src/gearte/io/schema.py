@@ -13,7 +13,7 @@ from typing import Any
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, field_validator, model_validator
 
-__all__ = ["StrictModel", "CaseMeta", "CaseBase", "Sign"]
+__all__ = ["StrictModel", "CaseMeta", "CaseBase", "Sign", "floored"]
 
 
 def _not_bool(v: Any) -> Any:
@@ -24,6 +24,37 @@ def _not_bool(v: Any) -> Any:
 
 #: A sign, -1 or 1 (a ``true`` is refused: it would equal 1).
 Sign = typing.Annotated[typing.Literal[-1, 1], BeforeValidator(_not_bool)]
+
+
+def floored(quantity: str, default: Any = ..., **kwargs: Any) -> Any:
+    """A ``Field`` whose smallest value is the plausibility floor of ``quantity``.
+
+    ``quantity`` names an entry of :data:`gearte.io.plausibility.FLOORS` (``"linear_stiffness"``,
+    ``"load_torque"``, ...): the field gets ``ge=`` that floor, and a value below it is refused
+    at validation with the floor, its unit and the reason (``gearte.io.case_file``), e.g.
+    ``reducer.cranks.cam_bearing.stiffness_N_per_mm: must be >= 1 N/mm: no part of a reducer is
+    that soft ... (got 1e-300)``.
+
+    Parameters
+    ----------
+    quantity : str
+        Key of :data:`gearte.io.plausibility.FLOORS`.
+    default : Any
+        The field's default (``...``: required).
+    **kwargs
+        Passed on to ``pydantic.Field`` (``le``, ``description``, ...).
+
+    Returns
+    -------
+    pydantic.fields.FieldInfo
+        The field, ``ge`` its floor, the message in ``json_schema_extra["plausibility_floor"]``.
+    """
+    from gearte.io.plausibility import FLOORS
+
+    floor, unit, why = FLOORS[quantity]
+    unit_text = "" if unit == "-" else f" {unit}"
+    extra: dict[str, Any] = {"plausibility_floor": f"must be >= {floor:g}{unit_text}: {why}"}
+    return Field(default, ge=floor, json_schema_extra=extra, **kwargs)
 
 
 def _arrays_as_tuples(annotation: Any, value: Any) -> Any:

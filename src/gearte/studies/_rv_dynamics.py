@@ -611,6 +611,20 @@ def preflight_dynamics(case, red: RVReducer) -> None:
                 f"duration_s = {o.settle_s + o.duration_s:g} s in double precision; the "
                 f"integrator: {exc})",
             ) from None
+    if a.dte is not None:  # the spectrum needs 8 samples of the recorded trace
+        rec = a.dte.record_dt_s
+        if a.dte.method == "rk4":  # the trace is recorded every round(record_dt / step) steps
+            step = default_step(model, a.dte.step_fraction)
+            rec = max(1, round(rec / step)) * step
+        rounded = ", rounded to a multiple of the RK4 step" if a.dte.method == "rk4" else ""
+        if a.dte.duration_s < 8.0 * rec:
+            raise ParameterError(
+                "analyses.dte.duration_s",
+                a.dte.duration_s,
+                f"is shorter than 8 recording intervals of {rec:.4g} s (record_dt_s{rounded}); "
+                f"the DTE spectrum needs at least 8 samples: give duration_s >= "
+                f"{8.0 * rec:.4g} s",
+            )
     spans = []
     if a.dte is not None and a.dte.method == "rk4":
         spans.append((a.dte.step_fraction, a.dte.duration_s + a.dte.settle_s))

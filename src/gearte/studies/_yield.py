@@ -44,7 +44,7 @@ from typing import Any, Literal, NamedTuple
 
 from pydantic import Field, model_validator
 
-from gearte.io.schema import StrictModel
+from gearte.io.schema import StrictModel, floored
 from gearte.results import AnalysisResult
 
 __all__ = [
@@ -178,9 +178,9 @@ class ToleranceEntry(StrictModel):
         le=21_600,
         description="Mean of an angle in arcmin [arcmin]; default: the case's value.",
     )
-    sigmas: float | None = Field(
-        default=None,
-        gt=0,
+    sigmas: float | None = floored(
+        "tolerance_sigmas",
+        None,
         le=100,
         description="σ = tolerance / sigmas [-] (default 3; rayleigh 3.44, 99.73 % inside).",
     )

@@ -24,7 +24,7 @@ import numpy as np
 from pydantic import ConfigDict, Field, model_validator
 
 from gearte.errors import ConvergenceError, ParameterError
-from gearte.io.schema import CaseBase, StrictModel
+from gearte.io.schema import CaseBase, StrictModel, floored
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies._yield import YieldSection
 
@@ -95,7 +95,9 @@ class Stage(_Section):
     pin_circle_radius_mm: float = Field(gt=0, le=5000, description="Pin-centre-circle radius r_p.")
     pin_radius_mm: float = Field(gt=0, le=500, description="Pin radius r_rp.")
     eccentricity_mm: float = Field(gt=0, le=200, description="Eccentricity a.")
-    face_width_mm: float = Field(gt=0, le=1000, description="Face width b of one disc.")
+    face_width_mm: float = floored(
+        "part_length", ..., le=1000, description="Face width b of one disc."
+    )
     equidistant_modification_mm: float = Field(
         default=0.0, ge=-1.0, le=1.0, description="Equidistant modification Δr_rp."
     )
@@ -160,11 +162,15 @@ class GeometricTEOptions(_Section):
 class ToothContactOptions(_Section):
     """``[analyses.tooth_contact]``: loaded tooth contact analysis (section 4)."""
 
-    torque_Nm: float = Field(gt=0, le=1e6, description="Output torque of the stage T [N·m].")
-    disc_share: float = Field(
-        gt=0, le=1, description="Share of T carried by the analysed disc (Hu et al.: 0.55)."
+    torque_Nm: float = floored(
+        "load_torque", ..., le=1e6, description="Output torque of the stage T [N·m]."
     )
-    youngs_modulus_MPa: float = Field(gt=0, le=1e7, description="E of disc and pins [MPa].")
+    disc_share: float = floored(
+        "disc_share", le=1, description="Share of T carried by the analysed disc (Hu et al.: 0.55)."
+    )
+    youngs_modulus_MPa: float = floored(
+        "youngs_modulus", ..., le=1e7, description="E of disc and pins [MPa]."
+    )
     poisson_ratio: float = Field(ge=0, lt=0.5, description="μ of disc and pins [-].")
     mesh_positions: int = Field(
         default=1, ge=1, le=100000, description="Mesh positions over one tooth pitch (1: paper's)."

@@ -25,7 +25,7 @@ from typing import Annotated, Literal
 from pydantic import Field, field_validator, model_validator
 
 from gearte.errors import ParameterError
-from gearte.io.schema import CaseBase, StrictModel
+from gearte.io.schema import CaseBase, StrictModel, floored
 from gearte.models.backlash import (
     BEVEL_SOURCES,
     SPUR_SOURCES,
@@ -368,9 +368,9 @@ class SpurPairSpec(_Clearance, _Distributions):
     min_backlash_limit_um: float = Field(
         default=0.0, ge=0, le=10_000, description="Minimum limit normal backlash [µm]."
     )
-    face_width_mm: float | None = Field(
-        default=None,
-        gt=0,
+    face_width_mm: float | None = floored(
+        "part_length",
+        None,
         le=1000,
         description="Face width b [mm]; only for the pair's mesh stiffness as a drive (optional).",
     )
@@ -506,7 +506,7 @@ class BevelPairSpec(_NoBevelGrade, _Distributions):
         ge=0.05, le=100, description="Outer transverse module m [mm] (0.05 mm: the finest gears)."
     )
     pressure_angle_deg: float = Field(default=20.0, gt=0, lt=45, description="Pressure angle α.")
-    face_width_mm: float = Field(gt=0, le=1000, description="Face width B [mm].")
+    face_width_mm: float = floored("part_length", ..., le=1000, description="Face width B [mm].")
     shaft_angle_deg: float = Field(default=90.0, gt=0, lt=180, description="Shaft angle Σ.")
     shaft_distance_tol_um: float = Field(
         ge=0, le=10_000, description="Shaft-distance limit deviation fa [µm] (±fa)."

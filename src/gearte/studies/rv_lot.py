@@ -33,7 +33,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from gearte.io.schema import StrictModel
+from gearte.io.schema import StrictModel, floored
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies._measured import MeasuredPartsCase
 from gearte.studies.rv_bench import _resolve
@@ -107,7 +107,9 @@ class LotSection(StrictModel):
 
 
 class SelectiveAssemblySection(StrictModel):
-    torque_Nm: float = Field(gt=0, le=1e6, description="output torque of the TE spec")
+    torque_Nm: float = floored(
+        "load_torque", ..., le=1e6, description="output torque of the TE spec"
+    )
     positions: int = Field(default=360, ge=16, le=7200, description="output angles per rev")
     te_spec_arcsec: float = Field(gt=0, le=3600, description="total TE peak-to-peak spec")
     objective: Literal["count_in_spec", "worst"] = Field(

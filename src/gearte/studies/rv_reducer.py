@@ -80,7 +80,7 @@ from gearte.geometry.rv import (
     iso6336_mesh_stiffness,
     palmgren_radial_stiffness,
 )
-from gearte.io.schema import CaseBase, StrictModel
+from gearte.io.schema import CaseBase, StrictModel, floored
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies import _rv_dynamics as dyn
 from gearte.studies._yield import YieldSection
@@ -125,11 +125,13 @@ MATERIAL_DENSITY_KG_PER_M3 = {"steel": 7850.0}
 class Bearing(StrictModel):
     """A roller bearing: a given radial stiffness, or Palmgren data to derive it."""
 
-    stiffness_N_per_mm: float | None = Field(default=None, gt=0, le=1e9, description="[N/mm]")
+    stiffness_N_per_mm: float | None = floored(
+        "linear_stiffness", None, le=1e9, description="[N/mm]"
+    )
     rollers: int | None = Field(default=None, ge=3, le=200, description="number of rollers")
-    roller_length_mm: float | None = Field(default=None, gt=0, le=200, description="[mm]")
-    reference_load_N: float | None = Field(
-        default=None, gt=0, le=1e7, description="load of the secant stiffness [N]"
+    roller_length_mm: float | None = floored("part_length", None, le=200, description="[mm]")
+    reference_load_N: float | None = floored(
+        "bearing_reference_load", None, le=1e7, description="load of the secant stiffness [N]"
     )
     radial_clearance_um: float = Field(default=0.0, ge=0, le=200, description="[um]")
 
@@ -164,18 +166,18 @@ class FirstStageSection(StrictModel):
     pressure_angle_deg: float = Field(
         gt=0, lt=45, description="Pressure angle α of the first stage [deg]."
     )
-    mesh_stiffness_N_per_mm: float | None = Field(
-        default=None, gt=0, le=1e9, description="mean mesh stiffness; default ISO 6336 from b"
+    mesh_stiffness_N_per_mm: float | None = floored(
+        "linear_stiffness", None, le=1e9, description="mean mesh stiffness; default ISO 6336 from b"
     )
-    face_width_mm: float | None = Field(
-        default=None,
-        gt=0,
+    face_width_mm: float | None = floored(
+        "part_length",
+        None,
         le=200,
         description="ISO 6336 mesh stiffness c_gamma = 20 N/(mm um) when no mesh stiffness is "
         "given; sun and planet masses",
     )
-    sun_support_stiffness_N_per_mm: float = Field(
-        gt=0, le=1e9, description="Radial stiffness of the sun's support [N/mm]."
+    sun_support_stiffness_N_per_mm: float = floored(
+        "linear_stiffness", le=1e9, description="Radial stiffness of the sun's support [N/mm]."
     )
     sun_tooth_thickness_allowance: str | None = Field(
         default=None,
@@ -424,15 +426,17 @@ class CranksSection(StrictModel):
 
 class DiscsSection(StrictModel):
     count: int = Field(ge=1, le=3, description="Number of cycloid discs [-].")
-    face_width_mm: float = Field(gt=0, le=200, description="Face width of one disc [mm].")
+    face_width_mm: float = floored(
+        "part_length", ..., le=200, description="Face width of one disc [mm]."
+    )
     equidistant_modification_mm: float = Field(
         default=0.0, ge=-0.5, le=0.5, description="Equidistant modification Δr_rp [mm]."
     )
     shift_modification_mm: float = Field(
         default=0.0, ge=-0.5, le=0.5, description="Shifted modification Δr_p [mm]."
     )
-    youngs_modulus_MPa: float = Field(  # noqa: N815
-        gt=0, le=1e6, description="Young's modulus E of discs and pins [MPa]."
+    youngs_modulus_MPa: float = floored(  # noqa: N815
+        "youngs_modulus", le=1e6, description="Young's modulus E of discs and pins [MPa]."
     )
     poisson_ratio: float = Field(
         ge=0, lt=0.5, description="Poisson's ratio ν of discs and pins [-]."
@@ -490,8 +494,10 @@ class PinsSection(StrictModel):
 
 
 class SupportsSection(StrictModel):
-    carrier_radial_stiffness_N_per_mm: float = Field(
-        gt=0, le=1e10, description="Radial stiffness of the carrier (output) support [N/mm]."
+    carrier_radial_stiffness_N_per_mm: float = floored(
+        "linear_stiffness",
+        le=1e10,
+        description="Radial stiffness of the carrier (output) support [N/mm].",
     )
     main_bearing_clearance_um: float = Field(
         default=0.0,
@@ -585,21 +591,28 @@ class DynamicsSection(StrictModel):
         le=1e4,
         description="Moment of inertia of the output [kg·m²]; default: derived.",
     )
-    input_torsional_stiffness_Nm_per_rad: float = Field(  # noqa: N815
-        gt=0, le=1e9, description="Torsional stiffness of the input shaft [N·m/rad]."
+    input_torsional_stiffness_Nm_per_rad: float = floored(  # noqa: N815
+        "torsional_stiffness",
+        le=1e9,
+        description="Torsional stiffness of the input shaft [N·m/rad].",
     )
-    crank_torsional_stiffness_Nm_per_rad: float = Field(  # noqa: N815
-        gt=0, le=1e9, description="Torsional stiffness of one crank shaft [N·m/rad]."
+    crank_torsional_stiffness_Nm_per_rad: float = floored(  # noqa: N815
+        "torsional_stiffness",
+        le=1e9,
+        description="Torsional stiffness of one crank shaft [N·m/rad].",
     )
-    crank_bending_stiffness_N_per_mm: float = Field(  # noqa: N815
-        gt=0, le=1e10, description="Bending stiffness of one crank shaft [N/mm]."
+    crank_bending_stiffness_N_per_mm: float = floored(  # noqa: N815
+        "linear_stiffness", le=1e10, description="Bending stiffness of one crank shaft [N/mm]."
     )
     damping_ratio: float = Field(gt=0, lt=1, description="ζ of the lowest elastic mode")
     cycloid_stiffness: Literal["fourier", "mean"] = Field(
         "fourier", description="time-varying k_cr (Fourier) or its mean (as Li 2023 §4.1)"
     )
-    cycloid_mesh_stiffness_N_per_mm: float | None = Field(  # noqa: N815
-        None, gt=0, le=1e10, description="override of the mean k_cr from the loaded contact"
+    cycloid_mesh_stiffness_N_per_mm: float | None = floored(  # noqa: N815
+        "linear_stiffness",
+        None,
+        le=1e10,
+        description="override of the mean k_cr from the loaded contact",
     )
     cycloid_pressure_angle_deg: float | None = Field(
         None, ge=0, lt=90, description="override of the equivalent pressure angle β"
@@ -623,8 +636,8 @@ class DynamicsSection(StrictModel):
 
 
 class ReducerSection(StrictModel):
-    rated_torque_Nm: float | None = Field(
-        default=None, gt=0, le=1e6, description="catalogue rated torque (virtual torsion test)"
+    rated_torque_Nm: float | None = floored(
+        "load_torque", None, le=1e6, description="catalogue rated torque (virtual torsion test)"
     )
     contact_law: Literal["line_contact", "hu2020"] = Field(
         default="line_contact",
@@ -692,11 +705,13 @@ class OperationSection(StrictModel):
     """Operating point of the dynamic analyses."""
 
     input_speed_rpm: float = Field(gt=0, le=2e4, description="Input speed [rpm].")
-    output_torque_Nm: float = Field(gt=0, le=1e6, description="Output (load) torque [N·m].")  # noqa: N815
+    output_torque_Nm: float = floored(
+        "load_torque", ..., le=1e6, description="Output (load) torque [N·m]."
+    )  # noqa: N815
 
 
 class LoadSharingSection(StrictModel):
-    torque_Nm: float = Field(gt=0, le=1e6, description="Output torque [N·m].")
+    torque_Nm: float = floored("load_torque", ..., le=1e6, description="Output torque [N·m].")
     positions: int = Field(
         default=360, ge=8, le=7200, description="Output positions over one revolution [-]."
     )
@@ -706,7 +721,9 @@ class LoadSharingSection(StrictModel):
 
 
 class TESection(StrictModel):
-    torque_Nm: float = Field(gt=0, le=1e6, description="Output torque of the loaded TE [N·m].")
+    torque_Nm: float = floored(
+        "load_torque", ..., le=1e6, description="Output torque of the loaded TE [N·m]."
+    )
     positions: int = Field(
         default=360, ge=8, le=7200, description="Output positions over one revolution [-]."
     )
@@ -784,8 +801,10 @@ class Bounds(StrictModel):
 
 
 class CompensationSection(StrictModel):
-    torque_Nm: float = Field(
-        gt=0, le=1e6, description="Output torque at which the objective is evaluated [N·m]."
+    torque_Nm: float = floored(
+        "load_torque",
+        le=1e6,
+        description="Output torque at which the objective is evaluated [N·m].",
     )
     objective: Literal["total_te_peak_to_peak", "mean_lag"] = Field(
         "total_te_peak_to_peak",
@@ -814,8 +833,12 @@ class CompensationSection(StrictModel):
 class ToothContactSection(StrictModel):
     """Loaded tooth contact of one disc (Hu 2020 section 4); material from ``[reducer.discs]``."""
 
-    torque_Nm: float = Field(gt=0, le=1e6, description="output torque of the stage T [N·m]")
-    disc_share: float = Field(gt=0, le=1, description="share of T carried by the analysed disc")
+    torque_Nm: float = floored(
+        "load_torque", ..., le=1e6, description="output torque of the stage T [N·m]"
+    )
+    disc_share: float = floored(
+        "disc_share", ..., le=1, description="share of T carried by the analysed disc"
+    )
     mesh_positions: int = Field(
         default=1,
         ge=1,
@@ -841,8 +864,8 @@ class RVYieldSection(YieldSection):
     ``pins.radius_errors.p7``, ``disc_radial_runout.d1``)."""
 
     positions: int = Field(default=36, ge=2, le=3600, description="TE output positions")
-    te_torque_Nm: float | None = Field(
-        default=None, gt=0, le=1e6, description="torque of the loaded TE; default rated"
+    te_torque_Nm: float | None = floored(
+        "load_torque", None, le=1e6, description="torque of the loaded TE; default rated"
     )
     first_stage_backlash: FirstStageLaw = Field(
         default="additive",

@@ -1,0 +1,151 @@
+"""Plausibility floors of physical sizes (gearte.io.plausibility.FLOORS, gearte.io.schema.floored).
+
+Found by the systematic sweep of extreme values (``python tests/fuzzing.py --count -1``,
+docs/errors.md): a stiffness, roller length, face width, Young's modulus, bearing reference load
+or load torque of 1e-300 (or × 1e-9) passed the schema's ``> 0`` and ended in ``gearte run`` as
+"analysis failed: ... did not converge", "rk4: non-finite output statistics" — naming no key — or
+as an internal error (a ``ZeroDivisionError`` in the tooth-contact pre-flight, a numpy warning
+turned into exit 3). Each such key now refuses a value below its floor at validation, naming the
+key, the value, the floor with its unit and the reason, and each bundled case still runs with the
+key set to the floor itself.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from fuzzing import _parent, check_text, corpus, extreme_mutants, run_cli, to_toml
+from gearte.errors import CaseFileError, ParameterError
+from gearte.io.plausibility import FLOORS
+
+CORPUS = corpus()
+
+#: (bundled case, key path, floor quantity): one or more keys of every quantity, among them every
+#: key the sweep found failing in ``run``.
+KEYS = [
+    ("li2023_rv", "reducer.cranks.cam_bearing.stiffness_N_per_mm", "linear_stiffness"),
+    ("li2023_rv", "reducer.cranks.carrier_bearing.stiffness_N_per_mm", "linear_stiffness"),
+    ("li2023_rv", "reducer.first_stage.mesh_stiffness_N_per_mm", "linear_stiffness"),
+    ("li2023_rv", "reducer.dynamics.crank_bending_stiffness_N_per_mm", "linear_stiffness"),
+    ("li2023_rv", "reducer.dynamics.input_torsional_stiffness_Nm_per_rad", "torsional_stiffness"),
+    ("li2023_rv", "reducer.dynamics.crank_torsional_stiffness_Nm_per_rad", "torsional_stiffness"),
+    ("han2023_rv110e_no_errors", "reducer.cranks.cam_bearing.roller_length_mm", "part_length"),
+    (
+        "han2023_rv110e_no_errors",
+        "reducer.cranks.cam_bearing.reference_load_N",
+        "bearing_reference_load",
+    ),
+    ("han2023_rv110e_yield", "reducer.first_stage.face_width_mm", "part_length"),
+    ("han2023_rv110e_yield", "reducer.discs.youngs_modulus_MPa", "youngs_modulus"),
+    ("hu2020_rv80e_initial", "analyses.tooth_contact.torque_Nm", "load_torque"),
+    ("hu2020_rv80e_initial", "analyses.tooth_contact.disc_share", "disc_share"),
+    ("hu2020_rv80e_initial_reducer", "analyses.load_sharing.torque_Nm", "load_torque"),
+    ("synthetic_rv110e_lot", "analyses.selective_assembly.torque_Nm", "load_torque"),
+]
+
+
+def _with(name: str, key: str, value: float) -> str:
+    data = json.loads(json.dumps(CORPUS[name]))
+    path = tuple(key.split("."))
+    node = data
+    for i, part in enumerate(path[:-1]):  # a dotted key of a tolerance table stays one key
+        if part not in node:
+            rest = ".".join(path[i:-1])
+            node = node[rest]
+            break
+        node = node[part]
+    assert path[-1] in node, f"{name} has no {key}"
+    node[path[-1]] = value
+    return to_toml(data)
+
+
+def _errors(text: str, tmp_path) -> list[tuple[str, str]]:
+    from gearte.io.case_file import load_case
+
+    (tmp_path / "c.toml").write_text(text, encoding="utf-8")
+    with pytest.raises(CaseFileError) as info:
+        load_case(tmp_path / "c.toml")
+    return info.value.errors
+
+
+@pytest.mark.parametrize(("name", "key", "quantity"), KEYS, ids=[k[1] for k in KEYS])
+def test_a_value_below_the_floor_is_refused_naming_key_value_floor_and_reason(
+    tmp_path, name, key, quantity
+):
+    floor, unit, why = FLOORS[quantity]
+    for bad in (1e-300, floor * 0.5):
+        check_text(to_toml(CORPUS[name]), tmp_path)  # links the bundled data files
+        errors = _errors(_with(name, key, bad), tmp_path)
+        assert [f for f, _ in errors] == [key], errors
+        msg = errors[0][1]
+        assert msg.startswith(f"must be >= {floor:g}"), msg
+        if unit != "-":
+            assert unit in msg, msg
+        assert why in msg and f"(got {bad!r})" in msg, msg
+
+
+@pytest.mark.parametrize(("name", "key", "quantity"), KEYS, ids=[k[1] for k in KEYS])
+def test_the_floor_itself_validates(tmp_path, name, key, quantity):
+    out = check_text(_with(name, key, FLOORS[quantity][0]), tmp_path)
+    # a floored size may still make the drive's torque implausible (the pressure check names
+    # the torque): that is a refusal naming a key, not a solver failure
+    assert out.status in ("accepted", "rejected"), out
+    if out.status == "rejected":
+        assert "torque" in out.detail, out
+
+
+def test_the_tooth_contact_runs_at_the_torque_and_share_floors(tmp_path):
+    """Before: 1e-300 N·m or a share of 1e-300 raised ZeroDivisionError in the pre-flight."""
+    text = _with("hu2020_rv80e_initial", "analyses.tooth_contact.torque_Nm", 1e-3)
+    assert run_cli(text, tmp_path, 600.0).status == "run_exit_0"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "key", "quantity"), KEYS, ids=[k[1] for k in KEYS])
+def test_every_key_at_its_floor_runs(tmp_path, name, key, quantity):
+    text = _with(name, key, FLOORS[quantity][0])
+    if check_text(text, tmp_path).status != "accepted":
+        pytest.skip("refused at validation (the torque check), see the test above")
+    out = run_cli(text, tmp_path, 600.0)
+    assert out.status == "run_exit_0", out
+
+
+def test_a_floored_field_shows_its_floor_in_the_schema():
+    from gearte.studies.rv_reducer import Bearing
+
+    info = Bearing.model_fields["stiffness_N_per_mm"]
+    assert any(getattr(m, "ge", None) == FLOORS["linear_stiffness"][0] for m in info.metadata)
+    assert "plausibility_floor" in (info.json_schema_extra or {})
+
+
+def test_dte_shorter_than_eight_recording_intervals_is_refused_at_validation(tmp_path):
+    """Before: exit 2 in ``run`` naming 'dte = 1' (the sample count) instead of the key."""
+    from gearte.io.case_file import load_case
+    from gearte.studies import preflight
+
+    text = _with("li2023_rv", "analyses.dte.duration_s", 1e-9)
+    (tmp_path / "c.toml").write_text(text, encoding="utf-8")
+    check_text(to_toml(CORPUS["li2023_rv"]), tmp_path)
+    case = load_case(tmp_path / "c.toml")
+    with pytest.raises(ParameterError) as info:
+        preflight(case)
+    assert info.value.field == "analyses.dte.duration_s"
+    assert "8 recording intervals" in str(info.value)
+
+
+def test_the_extreme_sweep_reaches_every_positive_number_of_every_bundled_case():
+    sweep = extreme_mutants()
+    positive = 0
+    for data in CORPUS.values():
+        from fuzzing import _paths
+
+        for path in _paths(data):
+            if path[0] == "case" or (isinstance(path[-1], int) and path[-1] != 0):
+                continue
+            v = _parent(data, path)[path[-1]]
+            if isinstance(v, int | float) and not isinstance(v, bool) and v > 0:
+                positive += 1
+    assert len(sweep) == 3 * positive > 2000
+    assert {d.rsplit(" ", 2)[-2:][0] for _, d, _ in sweep} >= {"=", "x"}
