@@ -149,3 +149,16 @@ def test_the_extreme_sweep_reaches_every_positive_number_of_every_bundled_case()
                 positive += 1
     assert len(sweep) == 3 * positive > 2000
     assert {d.rsplit(" ", 2)[-2:][0] for _, d, _ in sweep} >= {"=", "x"}
+
+
+def test_serial_torque_in_n_mm_is_refused_naming_the_key(tmp_path):
+    """Fuzzing seed 16: ``rv_serial`` had no torque plausibility check; 1e6 'N·m' on an RV-110E
+    ended in ``run`` as "no equilibrium at position 1" (exit 1). Its analyses' torques are now
+    checked against the design's size in the pre-flight (validate and run), naming the key."""
+    text = _with("synthetic_rv110e_serial", "analyses.load_sharing.torque_Nm", 1e6)
+    out = check_text(text, tmp_path)
+    assert (out.status, out.detail) == ("rejected", "analyses.load_sharing.torque_Nm"), out
+    got = run_cli(text, tmp_path, 600.0)
+    assert got.status == "run_exit_2", got
+    assert "analyses.load_sharing.torque_Nm = 1000000.0: is implausible" in got.detail, got
+    assert "26,870 MPa" in got.detail, got  # the pressure the torque would give

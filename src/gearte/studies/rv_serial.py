@@ -282,10 +282,21 @@ def preflight(case: Case) -> None:
     ParameterError, MeasurementFileError
         Naming the key or the file.
     """
+    from gearte.errors import ParameterError
+    from gearte.io.plausibility import plausibility_problems
+
     if case._built is None:
         case._built = build_serial(case)
-    design = case._built[0]
-    rv.preflight(_design_case(case, design))
+    design = _design_case(case, case._built[0])
+    # the torques of this case's analyses against the design's size, as `validate` checks an
+    # rv_reducer case's (a torque in N·mm where N·m is asked ended as "no equilibrium" in run)
+    for field, message in plausibility_problems("rv_reducer", design):
+        section, _, key = field.removeprefix("analyses.").partition(".")
+        if field.startswith("analyses.") and getattr(case.analyses, section, None) is not None:
+            value = getattr(getattr(case.analyses, section), key)
+            reason = "is implausible" + message.split(" is implausible", 1)[-1]
+            raise ParameterError(field, value, reason)
+    rv.preflight(design)
 
 
 def run(case: Case, options=None) -> StudyResult:
