@@ -41,6 +41,15 @@ def test_misspelt_key_gets_a_suggestion():
     assert "did you mean 'eccentricity_mm'" in _errors(data)["stage.eccentricty_mm"]
 
 
+def test_misspelt_key_in_a_section_with_an_alias_gets_a_suggestion():
+    """``[analyses.yield]`` is the field ``yield_`` (alias ``yield``): the section's keys were
+    looked up by field name only, so a misspelt key there got no suggestion."""
+    data = _bundled("han2023_rv110e_yield")
+    data["analyses"]["yield"]["positons"] = data["analyses"]["yield"].pop("positions")
+    msg = _errors(data)["analyses.yield.positons"]
+    assert "did you mean 'positions'?" in msg
+
+
 def test_no_suggestion_for_a_key_like_nothing_known():
     assert did_you_mean("zzzz", {"pins", "eccentricity_mm"}) == ""
 

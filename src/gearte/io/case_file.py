@@ -120,21 +120,38 @@ def _tags(model: Any) -> set[str]:
     return tags
 
 
-def _fields_at(root: Any, loc: tuple[Any, ...]) -> set[str]:
-    """Field names of the section at ``loc`` (a pydantic error location) of ``root``."""
+def _field(model: Any, key: Any) -> Any:
+    """The field of ``model`` that the file's ``key`` names (its name, or its alias where it has
+    one: ``yield`` is the field ``yield_``), or ``None``."""
+    for name, info in model.model_fields.items():
+        if key in (name, info.alias):
+            return info
+    return None
+
+
+def _models_at(root: Any, loc: tuple[Any, ...]) -> list[Any]:
+    """The model classes the section at ``loc`` (a pydantic error location) of ``root`` may
+    be."""
     models = [root]
     for part in loc:
         if isinstance(part, int):
             continue
         nxt: list[Any] = []
         for m in models:
-            info = m.model_fields.get(part)
+            info = _field(m, part)
             if info is not None:
                 nxt += _model_classes(info.annotation)
-        if not nxt:  # a dict key (e.g. a pair name) or a discriminator tag: stay
-            continue
-        models = nxt
-    return {name for m in models for name in m.model_fields}
+        # a dict key (e.g. a pair name) or a discriminator tag: stay
+        models = nxt or models
+    return models
+
+
+def _fields_at(root: Any, loc: tuple[Any, ...]) -> set[str]:
+    """Keys of the section at ``loc`` (a pydantic error location) of ``root``, as a file writes
+    them (a field's alias where it has one)."""
+    return {
+        info.alias or name for m in _models_at(root, loc) for name, info in m.model_fields.items()
+    }
 
 
 def _floor_message(root: Any, loc: tuple[Any, ...]) -> str | None:
@@ -142,26 +159,8 @@ def _floor_message(root: Any, loc: tuple[Any, ...]) -> str | None:
     or ``None`` where that field has no floor."""
     if root is None or not loc:
         return None
-
-    def field(model: Any, key: Any) -> Any:  # by name or by alias (``yield``)
-        for name, info in model.model_fields.items():
-            if key in (name, info.alias):
-                return info
-        return None
-
-    models = [root]
-    for part in loc[:-1]:
-        if isinstance(part, int):
-            continue
-        nxt: list[Any] = []
-        for m in models:
-            info = field(m, part)
-            if info is not None:
-                nxt += _model_classes(info.annotation)
-        models = nxt or models
-    for m in models:
-        info = field(m, loc[-1])
-        extra = getattr(info, "json_schema_extra", None)
+    for m in _models_at(root, loc[:-1]):
+        extra = getattr(_field(m, loc[-1]), "json_schema_extra", None)
         if isinstance(extra, dict) and "plausibility_floor" in extra:
             return str(extra["plausibility_floor"])
     return None
