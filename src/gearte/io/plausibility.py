@@ -32,6 +32,7 @@ from gearte.errors import ParameterError
 __all__ = [
     "FLOORS",
     "MAX_CONTACT_PRESSURE_MPA",
+    "implausible_values",
     "pin_pressure_estimate",
     "plausibility_problems",
 ]
@@ -137,7 +138,7 @@ def pin_pressure_estimate(
 
 def _torque_problem(
     field: str, torque_Nm: float, stage: Any, share: float, E: float, nu: float
-) -> tuple[str, str] | None:
+) -> tuple[str, float, str] | None:
     from gearte.units import Nm_to_Nmm
 
     p = pin_pressure_estimate(stage, float(Nm_to_Nmm(torque_Nm)), share, E, nu)
@@ -145,14 +146,15 @@ def _torque_problem(
         return None
     return (
         field,
-        f"{torque_Nm:g} N·m is implausible for this stage: it gives a pin–disc contact pressure "
+        torque_Nm,
+        f"is implausible for this stage: it gives a pin–disc contact pressure "
         f"of about {p:,.0f} MPa (ideal load share, Hu 2020 eq 30), above the "
         f"{MAX_CONTACT_PRESSURE_MPA:,.0f} MPa no steel carries; was it given in N·mm? "
         f"({torque_Nm:g} N·mm = {torque_Nm / 1000:g} N·m)",
     )
 
 
-def _cycloid_stage(case: Any) -> list[tuple[str, str]]:
+def _cycloid_stage(case: Any) -> list[tuple[str, float, str]]:
     tc = case.analyses.tooth_contact
     if tc is None:
         return []
@@ -177,7 +179,7 @@ def _cycloid_stage(case: Any) -> list[tuple[str, str]]:
     return [got] if got else []
 
 
-def _rv_reducer(case: Any) -> list[tuple[str, str]]:
+def _rv_reducer(case: Any) -> list[tuple[str, float, str]]:
     from gearte.geometry.cycloid import CycloidStage
 
     r = case.reducer
@@ -212,14 +214,16 @@ def _rv_reducer(case: Any) -> list[tuple[str, str]]:
     return out
 
 
-_CHECKS: dict[str, Callable[[Any], list[tuple[str, str]]]] = {
+_CHECKS: dict[str, Callable[[Any], list[tuple[str, float, str]]]] = {
     "cycloid_stage": _cycloid_stage,
     "rv_reducer": _rv_reducer,
 }
 
 
-def plausibility_problems(kind: str, case: Any) -> list[tuple[str, str]]:
-    """``(field, message)`` for each implausible value of a validated ``case`` of ``kind``.
+def implausible_values(kind: str, case: Any) -> list[tuple[str, float, str]]:
+    """``(field, value, reason)`` for each implausible value of a validated ``case`` of
+    ``kind``: the value in the key's unit (every check so far is a torque's, [N·m]) and why it
+    is refused (``"is implausible for this stage: ..."``).
 
     Parameters
     ----------
@@ -231,7 +235,7 @@ def plausibility_problems(kind: str, case: Any) -> list[tuple[str, str]]:
 
     Returns
     -------
-    list of (str, str)
+    list of (str, float, str)
         Empty when every value is plausible, or when the drive itself cannot be built (the
         schema's own checks report that).
     """
@@ -242,3 +246,23 @@ def plausibility_problems(kind: str, case: Any) -> list[tuple[str, str]]:
         return check(case)
     except ParameterError:  # the geometry itself is refused: reported by the schema's checks
         return []
+
+
+def plausibility_problems(kind: str, case: Any) -> list[tuple[str, str]]:
+    """``(field, message)`` for each implausible value of a validated ``case`` of ``kind``
+    (:func:`implausible_values`, the message led by the value: ``"500000 N·m is implausible
+    ..."``).
+
+    Parameters
+    ----------
+    kind : str
+        The study kind.
+    case : Case
+        The case (validated; see :func:`implausible_values`).
+
+    Returns
+    -------
+    list of (str, str)
+        Empty when every value is plausible or the drive cannot be built.
+    """
+    return [(f, f"{v:g} N·m {reason}") for f, v, reason in implausible_values(kind, case)]

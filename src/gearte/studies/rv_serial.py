@@ -283,18 +283,16 @@ def preflight(case: Case) -> None:
         Naming the key or the file.
     """
     from gearte.errors import ParameterError
-    from gearte.io.plausibility import plausibility_problems
+    from gearte.io.plausibility import implausible_values
 
     if case._built is None:
         case._built = build_serial(case)
     design = _design_case(case, case._built[0])
     # the torques of this case's analyses against the design's size, as `validate` checks an
-    # rv_reducer case's (a torque in N·mm where N·m is asked ended as "no equilibrium" in run)
-    for field, message in plausibility_problems("rv_reducer", design):
-        section, _, key = field.removeprefix("analyses.").partition(".")
-        if field.startswith("analyses.") and getattr(case.analyses, section, None) is not None:
-            value = getattr(getattr(case.analyses, section), key)
-            reason = "is implausible" + message.split(" is implausible", 1)[-1]
+    # rv_reducer case's (a torque in N·mm where N·m is asked ended as "no equilibrium" in run);
+    # the design's own torques were checked when the design was validated
+    for field, value, reason in implausible_values("rv_reducer", design):
+        if field.startswith("analyses."):
             raise ParameterError(field, value, reason)
     rv.preflight(design)
 
