@@ -58,7 +58,7 @@ import sys
 import time
 import tomllib
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -967,13 +967,15 @@ def run(
     names = sorted(bases)
     tally: Counter[str] = Counter()
     link_case_data(tmp)
-    sweep = extreme_mutants() if count < 0 else []
-    for i in range(len(sweep) if count < 0 else count):
-        if count < 0:
-            name, done, text = sweep[i]
-        else:
+
+    def random_mutants() -> Iterator[tuple[str, str, str]]:
+        for i in range(count):
             name = names[i % len(names)]
             text, done = mutant_text(bases[name], rng)
+            yield name, done, text
+
+    mutants = extreme_mutants() if count < 0 else random_mutants()
+    for i, (name, done, text) in enumerate(mutants):
         out = check_text(text, tmp)
         tally[out.status] += 1
         if server is not None:
