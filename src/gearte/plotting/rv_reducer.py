@@ -69,7 +69,7 @@ def _peak(ls, ls0) -> Figure:
         ax.plot(deg, ls0.pin_force.max(axis=(1, 2)), color=PALETTE[0], label="without errors")
     ax.set_xlabel("output angle [deg]")
     ax.set_ylabel("largest pin load [N]")
-    fig.legend(loc="outside lower center", ncols=2, fontsize=8)
+    ax.legend(fontsize=8)  # the report puts it below the axes (plotting.display.polish)
     return Figure(
         "Peak pin load over one output revolution",
         "Largest pin load of both discs at each output angle, with and without the measured "
@@ -86,7 +86,7 @@ def _te(te) -> Figure:
     ax.plot(deg, rad_to_arcsec(te.elastic), color=PALETTE[1], label="elastic = total - geometric")
     ax.set_xlabel("output angle [deg]")
     ax.set_ylabel("output angle error [arcsec]")
-    fig.legend(loc="outside lower center", ncols=3, fontsize=8)
+    ax.legend(fontsize=8)  # the report puts it below the axes (plotting.display.polish)
     return Figure(
         "Transmission error over one output revolution",
         "Output angle error (actual - nominal, negative = lag) with the input held, split into "

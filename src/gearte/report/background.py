@@ -44,8 +44,6 @@ def warm_up_plotting(case: Any = None) -> None:
     here), and give the figure a log axis (building matplotlib's mathtext parser for its tick
     labels, ~0.15-0.3 s CPU) only where that plotting module draws one (``LOG_AXES``). A case
     whose kind cannot be read is ignored here (unpickling imports what it needs)."""
-    import io
-
     import jinja2  # noqa: F401
     from matplotlib.backends import backend_agg  # noqa: F401
 
@@ -54,6 +52,7 @@ def warm_up_plotting(case: Any = None) -> None:
     import gearte.report.summary  # noqa: F401
     import gearte.report.tables  # noqa: F401
     from gearte.plotting import new_figure
+    from gearte.report.html import figure_to_png_base64
 
     log_axes = case is None
     if case is not None:
@@ -66,7 +65,7 @@ def warm_up_plotting(case: Any = None) -> None:
     ax.set_ylabel("−.,e+ [arcmin]")
     ax.set_title("Warm-up")
     ax.legend()
-    fig.savefig(io.BytesIO(), format="png", dpi=50)
+    figure_to_png_base64(fig, dpi=50)  # the report's own path: layout, drawing, PNG
 
 
 def _plotting_module(case: Any) -> Any:
