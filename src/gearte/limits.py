@@ -1,4 +1,4 @@
-"""Resource bounds decided before any work starts (issue 13).
+"""Resource bounds decided before any work starts (issue 13), and the plausibility floors.
 
 Every input that sizes an allocation or a loop has a bound in its schema (``Field(le=...)``);
 where the size comes from a combination of inputs (the harmonics of planetary terms, a sweep grid,
@@ -21,6 +21,11 @@ worker                     counts as lost
 base samples, bootstrap, kept worst samples, allocation search and verification, random
 assemblies, diagnosis draws, speed-sweep points, quasi-random starts — at ``N``, never below the
 field's own minimum (``gearte.studies.sample_cap``; docs/errors.md, "``--samples N``").
+
+Plausibility floors (:data:`FLOORS`): the smallest value of each physical size (a load torque, a
+Young's modulus, a stiffness, ...) that gearte accepts. They live here, in the lowest layer, so
+that the case files (``gearte.io.schema.floored``) and the model functions that take such a size
+as an argument (:func:`check_floor`) refuse the same values with the same message.
 """
 
 from __future__ import annotations
@@ -31,6 +36,9 @@ from typing import Any
 from gearte.errors import ParameterError
 
 __all__ = [
+    "FLOORS",
+    "floor_reason",
+    "check_floor",
     "max_memory_bytes",
     "max_seconds",
     "max_sweep_points",
@@ -39,6 +47,132 @@ __all__ = [
     "check_sweep_points",
     "no_worker_timeout_s",
 ]
+
+#: Plausibility floors of physical sizes: ``name -> (smallest value, unit, why)``. A case-file key
+#: of such a size (``gearte.io.schema.floored``) refuses a value below its floor at validation,
+#: and a model function that takes such a size as an argument refuses it too
+#: (:func:`check_floor`, the floor converted to the function's unit), naming the key or the
+#: argument, the value, the floor and the reason, where before a value such as 1e-300 or
+#: a stiffness × 1e-9 passed the schema (``> 0``) and ended in ``run`` as "analysis failed: ...
+#: did not converge" or "non-finite output", naming no key (the systematic sweep ``python
+#: tests/fuzzing.py --count -1``, docs/errors.md). Each floor lies two to five decades below
+#: the smallest value a real robot-joint reducer has, and every bundled case runs with each of
+#: its floored keys set to the floor (tests/test_plausibility_floors.py).
+FLOORS: dict[str, tuple[float, str, str]] = {
+    "linear_stiffness": (
+        1.0,
+        "N/mm",
+        "no part of a reducer is that soft (bearings, meshes, shafts and supports have "
+        "1e4 - 1e7 N/mm); the equilibrium solvers lose the stiffer parts' deflections to "
+        "round-off below it",
+    ),
+    "torsional_stiffness": (
+        1.0,
+        "N·m/rad",
+        "no shaft of a reducer is that soft (1e3 - 1e6 N·m/rad); the static equilibrium "
+        "loses the stiffer parts' deflections to round-off below it",
+    ),
+    "part_length": (
+        0.1,
+        "mm",
+        "thinner than any gear, disc or bearing roller (needle rollers start at about 1 mm)",
+    ),
+    "bearing_reference_load": (
+        1.0,
+        "N",
+        "Palmgren's secant stiffness at a reference load below 1 N is not the stiffness of a "
+        "bearing that carries a reducer's loads (kN)",
+    ),
+    "youngs_modulus": (
+        1000.0,
+        "MPa",
+        "softer than any engineering material a reducer is made of (polymers 1 000 - 3 000 "
+        "MPa, steel 206 000 MPa)",
+    ),
+    "load_torque": (
+        1e-3,
+        "N·m",
+        "below 1 mN·m the elastic deflections of the contacts (< 1e-7 mm) are lost to the "
+        "round-off of the geometry and the load solvers cannot converge; no analysis of a "
+        "reducer is meaningful there",
+    ),
+    "disc_share": (
+        0.01,
+        "-",
+        "a disc that carries less than 1 % of the torque is not a load case of the stage",
+    ),
+    "tolerance_sigmas": (
+        1.0,
+        "-",
+        "±t must span at least ±1σ (68 % inside); below it the drawn errors mostly fall "
+        "outside the tolerance they model, and at 1e-300 σ overflows",
+    ),
+}
+
+
+def floor_reason(quantity: str, *, scale: float = 1.0, unit: str | None = None) -> str:
+    """The reason a value below the floor of ``quantity`` is refused: ``"must be >= <floor>
+    <unit>: <why>"`` (the wording of the case files' floor message, ``gearte.io.schema.floored``).
+
+    Parameters
+    ----------
+    quantity : str
+        Key of :data:`FLOORS` (``"load_torque"``, ``"youngs_modulus"``, ...).
+    scale : float
+        Size of one unit of :data:`FLOORS` in the caller's unit [-] (1000 for a torque in N·mm
+        against the floor's N·m: ``float(gearte.units.Nm_to_Nmm(1.0))``).
+    unit : str, optional
+        The caller's unit (default the floor's own); ``"-"`` for a dimensionless size.
+
+    Returns
+    -------
+    str
+        E.g. ``"must be >= 1 N·mm: below 1 mN·m the elastic deflections ..."``.
+    """
+    floor, floor_unit, why = FLOORS[quantity]
+    shown = floor_unit if unit is None else unit
+    unit_text = "" if shown == "-" else f" {shown}"
+    return f"must be >= {floor * scale:g}{unit_text}: {why}"
+
+
+def check_floor(
+    field: str, value: float, quantity: str, *, scale: float = 1.0, unit: str | None = None
+) -> None:
+    """Raise :class:`ParameterError` naming ``field`` when ``value`` lies below the plausibility
+    floor of ``quantity`` (or is NaN).
+
+    The floor is ``FLOORS[quantity][0] * scale`` in the caller's unit; ``inf`` passes (a caller
+    that needs a finite value checks that itself).
+
+    Parameters
+    ----------
+    field : str
+        The argument or key that carried the value (named in the error).
+    value : float
+        Its value [the caller's unit: the floor's unit times ``scale``].
+    quantity : str
+        Key of :data:`FLOORS`.
+    scale : float
+        Size of one unit of :data:`FLOORS` in the caller's unit [-] (see :func:`floor_reason`).
+    unit : str, optional
+        The caller's unit, for the message (default the floor's own).
+
+    Raises
+    ------
+    ParameterError
+        ``value`` below the floor: ``"<field> = <value>: must be >= <floor> <unit>: <why>"``.
+
+    Examples
+    --------
+    >>> check_floor("torque", 5.0, "load_torque", scale=1000.0, unit="N·mm")  # 5 N·mm: passes
+    >>> check_floor("disc_share", 0.001, "disc_share")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    gearte.errors.ParameterError: disc_share = 0.001: must be >= 0.01: a disc that carries ...
+    """
+    if not value >= FLOORS[quantity][0] * scale:
+        raise ParameterError(field, value, floor_reason(quantity, scale=scale, unit=unit))
+
 
 _DEFAULTS = {"GEARTE_MAX_MEMORY_GB": 4.0, "GEARTE_MAX_SECONDS": 3600.0}
 _DEFAULT_SWEEP_POINTS = 1000

@@ -59,6 +59,7 @@ import numpy as np
 
 from gearte.errors import ParameterError
 from gearte.geometry.planetary import EccentricityError, SunPlanetErrors, SunPlanets
+from gearte.limits import check_floor
 from gearte.units import um_to_mm
 
 __all__ = [
@@ -280,7 +281,8 @@ class Discs:
         Hu 2020 ``Δr_rp`` and ``Δr_p`` [mm]; a positive ``Δr_rp`` opens the clearance, a negative
         ``Δr_p`` opens it (the convention of Hu et al. 2020, eq 1–3 and 32).
     youngs_modulus : float
-        ``E`` [MPa] of disc and pins.
+        ``E`` [MPa] of disc and pins, at least the plausibility floor of a Young's modulus
+        (1 000 MPa, ``gearte.limits.FLOORS``).
     poisson_ratio : float
         ``mu`` [-].
     crank_bore_diameter, centre_bore_diameter : float or None
@@ -312,6 +314,7 @@ class Discs:
             if not np.isfinite(v) or abs(v) > 0.5:
                 raise ParameterError(f"discs.{name}", v, "must be finite with |value| <= 0.5 mm")
         _check_pos("discs.youngs_modulus", self.youngs_modulus)
+        check_floor("discs.youngs_modulus", self.youngs_modulus, "youngs_modulus")
         if not 0.0 <= self.poisson_ratio < 0.5:
             raise ParameterError("discs.poisson_ratio", self.poisson_ratio, "must be in [0, 0.5)")
 

@@ -28,6 +28,7 @@ from collections.abc import Callable
 from typing import Any
 
 from gearte.errors import ParameterError
+from gearte.limits import FLOORS  # re-exported: the table lives in the lowest layer
 
 __all__ = [
     "FLOORS",
@@ -36,65 +37,6 @@ __all__ = [
     "pin_pressure_estimate",
     "plausibility_problems",
 ]
-
-#: Plausibility floors of physical sizes: ``name -> (smallest value, unit, why)``. A case-file key
-#: of such a size (``gearte.io.schema.floored``) refuses a value below its floor at validation,
-#: naming the key, the value, the floor and the reason, where before a value such as 1e-300 or
-#: a stiffness × 1e-9 passed the schema (``> 0``) and ended in ``run`` as "analysis failed: ...
-#: did not converge" or "non-finite output", naming no key (the systematic sweep ``python
-#: tests/fuzzing.py --count -1``, docs/errors.md). Each floor lies two to five decades below
-#: the smallest value a real robot-joint reducer has, and every bundled case runs with each of
-#: its floored keys set to the floor (tests/test_plausibility_floors.py).
-FLOORS: dict[str, tuple[float, str, str]] = {
-    "linear_stiffness": (
-        1.0,
-        "N/mm",
-        "no part of a reducer is that soft (bearings, meshes, shafts and supports have "
-        "1e4 - 1e7 N/mm); the equilibrium solvers lose the stiffer parts' deflections to "
-        "round-off below it",
-    ),
-    "torsional_stiffness": (
-        1.0,
-        "N·m/rad",
-        "no shaft of a reducer is that soft (1e3 - 1e6 N·m/rad); the static equilibrium "
-        "loses the stiffer parts' deflections to round-off below it",
-    ),
-    "part_length": (
-        0.1,
-        "mm",
-        "thinner than any gear, disc or bearing roller (needle rollers start at about 1 mm)",
-    ),
-    "bearing_reference_load": (
-        1.0,
-        "N",
-        "Palmgren's secant stiffness at a reference load below 1 N is not the stiffness of a "
-        "bearing that carries a reducer's loads (kN)",
-    ),
-    "youngs_modulus": (
-        1000.0,
-        "MPa",
-        "softer than any engineering material a reducer is made of (polymers 1 000 - 3 000 "
-        "MPa, steel 206 000 MPa)",
-    ),
-    "load_torque": (
-        1e-3,
-        "N·m",
-        "below 1 mN·m the elastic deflections of the contacts (< 1e-7 mm) are lost to the "
-        "round-off of the geometry and the load solvers cannot converge; no analysis of a "
-        "reducer is meaningful there",
-    ),
-    "disc_share": (
-        0.01,
-        "-",
-        "a disc that carries less than 1 % of the torque is not a load case of the stage",
-    ),
-    "tolerance_sigmas": (
-        1.0,
-        "-",
-        "±t must span at least ±1σ (68 % inside); below it the drawn errors mostly fall "
-        "outside the tolerance they model, and at 1e-300 σ overflows",
-    ),
-}
 
 #: Largest pin–disc Hertz pressure a torque may give at validation [MPa] (2.5× the static
 #: capacity of bearing steel in line contact: far beyond any real design, reached by a torque

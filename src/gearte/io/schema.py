@@ -29,16 +29,17 @@ Sign = typing.Annotated[typing.Literal[-1, 1], BeforeValidator(_not_bool)]
 def floored(quantity: str, default: Any = ..., **kwargs: Any) -> Any:
     """A ``Field`` whose smallest value is the plausibility floor of ``quantity``.
 
-    ``quantity`` names an entry of :data:`gearte.io.plausibility.FLOORS` (``"linear_stiffness"``,
+    ``quantity`` names an entry of :data:`gearte.limits.FLOORS` (``"linear_stiffness"``,
     ``"load_torque"``, ...): the field gets ``ge=`` that floor, and a value below it is refused
-    at validation with the floor, its unit and the reason (``gearte.io.case_file``), e.g.
+    at validation with the floor, its unit and the reason (``gearte.io.case_file``; the wording
+    of :func:`gearte.limits.floor_reason`, which the model functions use too), e.g.
     ``reducer.cranks.cam_bearing.stiffness_N_per_mm: must be >= 1 N/mm: no part of a reducer is
     that soft ... (got 1e-300)``.
 
     Parameters
     ----------
     quantity : str
-        Key of :data:`gearte.io.plausibility.FLOORS`.
+        Key of :data:`gearte.limits.FLOORS`.
     default : Any
         The field's default (``...``: required).
     **kwargs
@@ -49,12 +50,10 @@ def floored(quantity: str, default: Any = ..., **kwargs: Any) -> Any:
     pydantic.fields.FieldInfo
         The field, ``ge`` its floor, the message in ``json_schema_extra["plausibility_floor"]``.
     """
-    from gearte.io.plausibility import FLOORS
+    from gearte.limits import FLOORS, floor_reason
 
-    floor, unit, why = FLOORS[quantity]
-    unit_text = "" if unit == "-" else f" {unit}"
-    extra: dict[str, Any] = {"plausibility_floor": f"must be >= {floor:g}{unit_text}: {why}"}
-    return Field(default, ge=floor, json_schema_extra=extra, **kwargs)
+    extra: dict[str, Any] = {"plausibility_floor": floor_reason(quantity)}
+    return Field(default, ge=FLOORS[quantity][0], json_schema_extra=extra, **kwargs)
 
 
 def _arrays_as_tuples(annotation: Any, value: Any) -> Any:

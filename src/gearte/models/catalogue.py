@@ -41,6 +41,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
+from gearte.limits import check_floor
+from gearte.units import Nm_to_Nmm
 
 __all__ = [
     "ZERO_TORQUE_FRACTION",
@@ -82,6 +84,10 @@ class Branches:
     def mid(self, torque: ArrayLike) -> np.ndarray:
         """Mid-curve ``(θ_asc + θ_desc)/2`` [rad]."""
         return 0.5 * (self.ascending(torque) + self.descending(torque))
+
+
+#: N·mm in one N·m (the torque floor of ``gearte.limits.FLOORS`` is in N·m) [-].
+_NMM_PER_NM = float(Nm_to_Nmm(1.0))
 
 
 def branch_directions(torque: ArrayLike, threshold: float = 0.02) -> np.ndarray:
@@ -135,6 +141,32 @@ def _runs(direction: np.ndarray) -> list[tuple[int, int, int]]:
     ]
 
 
+def _check_rated_torque(rated_torque: float, branches: Branches | None = None) -> None:
+    """A :class:`ParameterError` naming ``rated_torque`` unless it is finite, at least the
+    plausibility floor of a load torque (1 N·mm, ``gearte.limits.FLOORS``; far below it the
+    readings at T_r/2 and T_r coincide and the rigidity is 0/0) and, with ``branches``, no more
+    than twice their reach (the readings at ±T_r/2 must lie on them, not beyond their ends)."""
+    if not np.isfinite(rated_torque) or rated_torque <= 0:
+        raise ParameterError("rated_torque", rated_torque, "must be finite and > 0 [N·mm]")
+    check_floor("rated_torque", rated_torque, "load_torque", scale=_NMM_PER_NM, unit="N·mm")
+    if branches is None:
+        return
+    reach = min(
+        -branches.asc_torque[0],
+        branches.asc_torque[-1],
+        -branches.desc_torque[0],
+        branches.desc_torque[-1],
+    )
+    if not reach > 0.5 * rated_torque:
+        raise ParameterError(
+            "rated_torque",
+            rated_torque,
+            f"[N·mm] is more than twice the reach of the branches (±{reach:.6g} N·mm): their "
+            "readings at ±T_r/2 would lie beyond their ends; split the sweep with this rated "
+            "torque (split_branches)",
+        )
+
+
 def split_branches(
     torque: ArrayLike,
     angle: ArrayLike,
@@ -150,7 +182,7 @@ def split_branches(
     torque : (K,) [N·mm], in recording order
     angle : (K,) output torsion angle [rad]
     rated_torque : float
-        ``T_r`` [N·mm].
+        ``T_r`` [N·mm], at least the floor of a load torque (1 N·mm).
     direction : (K,) ints, optional
         +1 rising / −1 falling torque per sample [-] (a marked branch); inferred by
         :func:`branch_directions` when omitted.
@@ -173,8 +205,7 @@ def split_branches(
     a = np.asarray(angle, dtype=float)
     if t.shape != a.shape or t.ndim != 1:
         raise ParameterError("angle", a.shape, f"must have the shape of torque {t.shape}")
-    if not np.isfinite(rated_torque) or rated_torque <= 0:
-        raise ParameterError("rated_torque", rated_torque, "must be > 0 [N·mm]")
+    _check_rated_torque(rated_torque)
     d = branch_directions(t) if direction is None else np.asarray(direction)
     lo, hi = -reach * rated_torque, reach * rated_torque
     chosen: dict[int, tuple[int, int]] = {}
@@ -214,13 +245,14 @@ def torsional_rigidity(branches: Branches, rated_torque: float) -> float:
     branches : Branches
         Ascending and descending branches of the sweep (:func:`split_branches`).
     rated_torque : float
-        Rated torque T_r [N·mm].
+        Rated torque T_r [N·mm], at least the floor of a load torque (1 N·mm).
 
     Returns
     -------
     float
         b/a [N·mm/rad].
     """
+    _check_rated_torque(rated_torque, branches)
     tr = rated_torque
     hi = min(tr, branches.asc_torque[-1], branches.desc_torque[-1])
     lo = max(-tr, branches.asc_torque[0], branches.desc_torque[0])
@@ -238,7 +270,7 @@ def lost_motion(branches: Branches, rated_torque: float, fraction: float = 0.03)
     branches : Branches
         Ascending and descending branches of the sweep (:func:`split_branches`).
     rated_torque : float
-        Rated torque T_r [N·mm].
+        Rated torque T_r [N·mm], at least the floor of a load torque (1 N·mm).
     fraction : float
         f [-], in (0, 0.5).
 
@@ -247,6 +279,7 @@ def lost_motion(branches: Branches, rated_torque: float, fraction: float = 0.03)
     float
         Lost motion [rad].
     """
+    _check_rated_torque(rated_torque, branches)
     if not 0 < fraction < 0.5:
         raise ParameterError("lost_motion_fraction", fraction, "must be in (0, 0.5)")
     th = branches.mid(np.array([-fraction, fraction]) * rated_torque)
@@ -265,13 +298,14 @@ def backlash_at_zero(branches: Branches, rated_torque: float) -> float:
     branches : Branches
         Ascending and descending branches of the sweep (:func:`split_branches`).
     rated_torque : float
-        Rated torque T_r [N·mm].
+        Rated torque T_r [N·mm], at least the floor of a load torque (1 N·mm).
 
     Returns
     -------
     float
         Backlash [rad].
     """
+    _check_rated_torque(rated_torque, branches)
     half = np.array([-0.5, 0.5]) * rated_torque
     w_f = float(np.mean(branches.descending(half) - branches.ascending(half)))
     return hysteresis_loss(branches) - w_f
@@ -321,7 +355,7 @@ def hysteresis_values(
     angle : array_like, shape (K,)
         Output torsion angle [rad].
     rated_torque : float
-        Rated torque T_r [N·mm].
+        Rated torque T_r [N·mm], at least the floor of a load torque (1 N·mm).
     direction : array_like, optional
         +1 rising / −1 falling torque per sample [-]; inferred when omitted
         (:func:`split_branches`).
@@ -370,7 +404,7 @@ def hysteresis_values_many(
     angles : array_like, shape (S, K)
         Output torsion angle of each curve [rad].
     rated_torque : float
-        Rated torque T_r [N·mm].
+        Rated torque T_r [N·mm], at least the floor of a load torque (1 N·mm).
     direction : array_like, optional
         +1 rising / −1 falling torque per sample [-]; inferred when omitted.
     lost_motion_fraction : float

@@ -32,7 +32,9 @@ Both laws have the form ``δ(F) = F (a0 − a1 ln F)`` with ``a1 = 2 (1 − ν²
 δ in mm); :func:`log_law_coefficients` returns ``(a0, a1)`` so that solvers can evaluate any law
 without knowing which one it is.
 
-Units: mm, N, MPa.
+Units: mm, N, MPa. Every function checks its material (:func:`check_material`): E from the
+plausibility floor of a Young's modulus (1 000 MPa, ``gearte.limits.FLOORS``) to
+:data:`MAX_YOUNGS_MODULUS_MPA`, ν in [0, 0.5), each error naming the argument.
 
 References
 ----------
@@ -54,6 +56,7 @@ from numba import njit
 from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
+from gearte.limits import check_floor
 from gearte.solvers.contact import log_law_force
 
 __all__ = [
@@ -61,7 +64,9 @@ __all__ = [
     "DEFAULT_LAW",
     "HU2020_HALF_WIDTH_FACTOR",
     "ROARK_BAND_WIDTH_FACTOR",
+    "MAX_YOUNGS_MODULUS_MPA",
     "check_law",
+    "check_material",
     "contact_modulus",
     "relative_radius",
     "hertz_half_width",
@@ -84,6 +89,11 @@ HU2020_HALF_WIDTH_FACTOR = 4.99e-3
 #: Roark's constant of the contact band width of two cylinders, b = 1.60 (p K_D C_E)^½
 #: (= 2 (2/π)^½ = 1.596, the full width 2a of Hertz's strip).
 ROARK_BAND_WIDTH_FACTOR = 1.60
+#: Largest Young's modulus the contact laws accept [MPa]: ten times diamond's (about 1.05e6 MPa),
+#: the case files' upper bound of ``youngs_modulus_MPa`` (``cycloid_stage``). No material is that
+#: stiff, and far above it the law's products leave the range of a double (at E = 1e300 the
+#: compiled tooth contact divided by zero and the Hertz pressures overflowed to inf).
+MAX_YOUNGS_MODULUS_MPA = 1.0e7
 
 
 def check_law(law: str, field: str = "contact_law") -> str:
@@ -105,12 +115,51 @@ def check_law(law: str, field: str = "contact_law") -> str:
     return law
 
 
-def _check_material(E: float, nu: float, b: float) -> None:
-    for name, v in (("youngs_modulus", E), ("face_width", b)):
-        if not (math.isfinite(v) and v > 0.0):
-            raise ParameterError(name, v, "must be finite and > 0")
+def check_material(E: float, nu: float, *, fields: tuple[str, str] = ("E", "nu")) -> None:
+    """Raise :class:`ParameterError` unless E and ν are those of an engineering material.
+
+    E must be finite, at least the plausibility floor of a Young's modulus
+    (``gearte.limits.FLOORS["youngs_modulus"]``, 1 000 MPa) and at most
+    :data:`MAX_YOUNGS_MODULUS_MPA`; ν must lie in [0, 0.5).
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus [MPa].
+    nu : float
+        Poisson's ratio [-].
+    fields : (str, str)
+        The caller's names of E and ν (named in the error: ``("E", "mu")``,
+        ``("youngs_modulus_MPa", "poisson_ratio")``).
+
+    Raises
+    ------
+    ParameterError
+        Naming the first value out of its range, with the range and the reason.
+
+    References
+    ----------
+    See the module docstring.
+    """
+    e_name, nu_name = fields
+    if not (math.isfinite(E) and E > 0.0):
+        raise ParameterError(e_name, E, "must be finite and > 0 [MPa]")
+    check_floor(e_name, E, "youngs_modulus")
+    if E > MAX_YOUNGS_MODULUS_MPA:
+        raise ParameterError(
+            e_name,
+            E,
+            f"must be <= {MAX_YOUNGS_MODULUS_MPA:g} MPa: stiffer than any material "
+            "(diamond has about 1.05e6 MPa)",
+        )
     if not (math.isfinite(nu) and 0.0 <= nu < 0.5):
-        raise ParameterError("poisson_ratio", nu, "must be in [0, 0.5)")
+        raise ParameterError(nu_name, nu, "Poisson's ratio must be in [0, 0.5)")
+
+
+def _check_material(E: float, nu: float, b: float) -> None:
+    check_material(E, nu)
+    if not (math.isfinite(b) and b > 0.0):
+        raise ParameterError("b", b, "must be finite and > 0 [mm]")
 
 
 def contact_modulus(E: float, nu: float) -> float:
@@ -123,10 +172,16 @@ def contact_modulus(E: float, nu: float) -> float:
     nu : float
         Poisson's ratio [-].
 
+    Raises
+    ------
+    ParameterError
+        E or ν out of range (:func:`check_material`).
+
     References
     ----------
     Johnson (1985), eq 4.22 (1/E* = (1 − ν1²)/E1 + (1 − ν2²)/E2). doi:10.1017/CBO9781139171731
     """
+    check_material(E, nu)
     return E / (2.0 * (1.0 - nu * nu))
 
 

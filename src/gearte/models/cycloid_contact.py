@@ -38,11 +38,13 @@ from numpy.typing import ArrayLike
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.cycloid import CycloidStage, geometry_radii
 from gearte.geometry.cycloid_kernels import pin_mesh_table
+from gearte.limits import check_floor
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     HU2020_HALF_WIDTH_FACTOR,
     approach,
     check_law,
+    check_material,
     contact_modulus,
     force_from_coefficients,
     line_contact_a0_scalar,
@@ -53,14 +55,17 @@ from gearte.models.contact_law import (
 from gearte.solvers.contact import (
     _LIMIT,
     _OK,
+    _beyond_the_law,
     _log_force,
     _rotation_one,
     _solve_one,
     check_status,
+    check_torque_balance,
     compliance_limit,
     solve_load_sharing_plain,
     solve_rotation_plain,
 )
+from gearte.units import Nm_to_Nmm
 
 __all__ = [
     "compliance_constants",
@@ -75,6 +80,8 @@ __all__ = [
 
 #: The constant of eq 39 as printed (defined in :mod:`gearte.models.contact_law`).
 HALF_WIDTH_FACTOR = HU2020_HALF_WIDTH_FACTOR
+#: N·mm in one N·m (the torque floor of ``gearte.limits.FLOORS`` is in N·m) [-].
+_NMM_PER_NM = float(Nm_to_Nmm(1.0))
 
 
 def compliance_constants(
@@ -108,11 +115,10 @@ def compliance_constants(
     ----------
     Hu et al. (2020) eq 38–39 and 42–44, doi:10.3390/app10020481.
     """
-    for name, v in (("rho", abs(rho)), ("r", r), ("E", E), ("b", b)):
+    for name, v in (("rho", abs(rho)), ("r", r), ("b", b)):
         if not (math.isfinite(v) and v > 0.0):
             raise ParameterError(name, v, "must be finite and > 0")
-    if not (0.0 <= mu < 0.5):
-        raise ParameterError("mu", mu, "Poisson's ratio must be in [0, 0.5)")
+    check_material(E, mu, fields=("E", "mu"))
     a0, a1 = log_law_coefficients(law, rho, r, E, mu, b)
     A = float(a1)
     return A, float(math.exp(float(a0) / A - 2.0 / 3.0))
@@ -149,6 +155,7 @@ def half_width(F: ArrayLike, rho: float, r: float, E: float, mu: float, b: float
     ----------
     Hu et al. (2020) eq 39, doi:10.3390/app10020481.
     """
+    check_material(E, mu, fields=("E", "mu"))
     F = np.asarray(F, dtype=float)
     rho = abs(rho)
     return HALF_WIDTH_FACTOR * np.sqrt(4.0 * (1.0 - mu * mu) * F * rho * r / (E * b * (rho + r)))
@@ -192,6 +199,7 @@ def max_normal_deformation(
     ----------
     Hu et al. (2020) eq 38, doi:10.3390/app10020481.
     """
+    check_material(E, mu, fields=("E", "mu"))
     return approach(F, law, rho, r, E, mu, b)
 
 
@@ -366,14 +374,16 @@ def tooth_contact(
     stage : CycloidStage
         The modified stage (face width ``stage.b`` is one disc's).
     torque : float
-        Output torque of the stage T [N·mm].
+        Output torque of the stage T [N·mm], at least the plausibility floor of a load torque
+        (1 N·mm = 1 mN·m, ``gearte.limits.FLOORS``).
     disc_share : float
-        Share s of the torque carried by the analysed disc, T_c = s T [-] (Hu et al.: 0.55;
-        required, no paper value as a default).
+        Share s of the torque carried by the analysed disc, T_c = s T [-], in [0.01, 1] (the
+        floor of a disc share; Hu et al.: 0.55; required, no paper value as a default).
     E : float
-        Young's modulus [MPa].
+        Young's modulus [MPa], from the floor 1 000 MPa to
+        :data:`gearte.models.contact_law.MAX_YOUNGS_MODULUS_MPA`.
     mu : float
-        Poisson's ratio [-].
+        Poisson's ratio [-], in [0, 0.5).
     mesh_angle : array_like
         Mesh position(s) [rad], the phase of pin 1; 0 is the paper's position (pin 1 on the line
         of centres). One tooth pitch is 2π/z_p.
@@ -403,14 +413,25 @@ def tooth_contact(
     ToothContact
         Per-position and per-pin results.
 
+    Raises
+    ------
+    ParameterError
+        An argument out of its range (naming it), or a torque that loads a pin beyond the range
+        of the contact law (naming ``torque``).
+    ConvergenceError
+        The solver did not converge within ``max_iter``.
+
     References
     ----------
     Hu et al. (2020) section 4, eq 28–47, doi:10.3390/app10020481.
     """
     if not (math.isfinite(torque) and torque > 0.0):
         raise ParameterError("torque", torque, "must be finite and > 0 [N·mm]")
+    check_floor("torque", torque, "load_torque", scale=_NMM_PER_NM, unit="N·mm")
     if not (0.0 < disc_share <= 1.0):
         raise ParameterError("disc_share", disc_share, "must be in (0, 1]")
+    check_floor("disc_share", disc_share, "disc_share")
+    check_material(E, mu, fields=("E", "mu"))
     if implementation not in ("numba", "plain"):
         raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
     if clearance_model not in ("eq32", "envelope"):
@@ -439,7 +460,7 @@ def tooth_contact(
     if contact_law == "hu2020":
         A, B = compliance_constants(rho, stage.r, E, mu, stage.b, law="hu2020")
         warm = F_start is None
-        F0 = float(start_force(T_c, stage.K1, stage.z_c, stage.r_p) if F_start is None else F_start)
+        F0 = _default_start(stage, torque, T_c, B) if F_start is None else float(F_start)
         if not (math.isfinite(F0) and 0.0 < F0 < compliance_limit(B)):
             raise ParameterError(
                 "F_start",
@@ -464,16 +485,16 @@ def tooth_contact(
         if bad.size:
             k = int(bad[0])
             if status[k] == _LIMIT:
-                raise ParameterError(
-                    "torque",
-                    T_c,
-                    "[N·mm] loads a pin beyond the range of the elastic contact law (its "
-                    "approach δ(F) stops increasing); the stage is far too small for this torque",
-                )
+                raise _beyond_the_law(torque)
             raise ConvergenceError(
                 f"tooth contact (mesh position {k}): the disc rotation did not converge after "
                 f"{int(nev[k])} evaluations (tolerance {rtol:g})"
             )
+        try:  # the kernel's answer must carry T_c (it does not when a pin left the law's range)
+            carried = np.sum(np.where(lr > _LOADED, force * lr, 0.0), axis=1) * stage.r_c
+            check_torque_balance(carried, T_c, max(float(rtol), 1e-13))
+        except ParameterError:
+            raise _beyond_the_law(torque) from None
     _check_deformation(dmax, stage, torque)
     arrays = (phase, lr, clr, curvature, F, dmax, nev, approach_i, force, in_mesh, pressure)
     return _result(theta, arrays, T_c, rho, contact_law)
@@ -507,6 +528,21 @@ def _result(
 _LOADED = 1e-12
 #: Relative tolerance of each pin's force inside the rotation solve [-].
 _FORCE_RTOL = 1e-12
+
+
+def _default_start(stage: CycloidStage, torque: float, T_c: float, B: float) -> float:
+    """The paper's start force (eq 45) of ``"hu2020"``, or a :class:`ParameterError` naming the
+    torque when that start already lies beyond the compliance law's range (eq 38)."""
+    F0 = start_force(T_c, stage.K1, stage.z_c, stage.r_p)
+    if not F0 < compliance_limit(B):
+        raise ParameterError(
+            "torque",
+            torque,
+            f"[N·mm] is beyond the range of the compliance law: the paper's start force for "
+            f"it (eq 45), {F0:.4g} N, already exceeds the law's limit {compliance_limit(B):.4g} "
+            "N (eq 38: ln(16 r |rho| / c^2) must exceed 1/3); lower the torque or widen the face",
+        )
+    return F0
 
 
 def _check_deformation(dmax: np.ndarray, stage: CycloidStage, torque: float) -> None:
@@ -657,7 +693,7 @@ def _tooth_contact_plain(
     if contact_law == "hu2020":
         A, B = compliance_constants(rho, stage.r, E, mu, stage.b, law="hu2020")
         if F_start is None:
-            F_start = start_force(T_c, K1, stage.z_c, stage.r_p)
+            F_start = _default_start(stage, torque, T_c, B)
         F, nev = solve_load_sharing_plain(
             lr,
             np.where(loaded, clr, 1e300),
@@ -677,16 +713,19 @@ def _tooth_contact_plain(
             "line_contact", curvature, stage.r, E, mu, stage.b, rho_cap=cap
         )
         arm = np.where(loaded, lr * stage.r_c, 0.0)
-        rot, _ = solve_rotation_plain(
-            arm,
-            np.where(loaded, clr, 0.0),
-            a0,
-            a1,
-            T_c,
-            rtol=max(rtol, 1e-13),
-            force_rtol=_FORCE_RTOL,
-            max_iter=max_iter,
-        )
+        try:
+            rot, _ = solve_rotation_plain(
+                arm,
+                np.where(loaded, clr, 0.0),
+                a0,
+                a1,
+                T_c,
+                rtol=max(rtol, 1e-13),
+                force_rtol=_FORCE_RTOL,
+                max_iter=max_iter,
+            )
+        except ParameterError:  # T_c > 0 is finite: a pin beyond the law's range, on T_c
+            raise _beyond_the_law(torque) from None
         dmax = stage.r_c * rot
         b0, b1 = log_law_coefficients("line_contact", rho, stage.r, E, mu, stage.b, rho_cap=cap)
         F = force_from_coefficients(dmax, b0, b1)

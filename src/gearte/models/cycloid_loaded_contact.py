@@ -32,6 +32,7 @@ from gearte.geometry.cycloid import CycloidStage
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     check_law,
+    check_material,
     force_from_coefficients,
     log_law_coefficients,
     max_contact_pressure,
@@ -79,7 +80,9 @@ class CycloidPinPair:
     face_width_mm : float
         B, disc face width [mm].
     youngs_modulus_MPa, poisson_ratio : float
-        E [MPa] and ν [-] of disc and pins (one material, as in paper section 4).
+        E [MPa] and ν [-] of disc and pins (one material, as in paper section 4); E from the
+        plausibility floor 1 000 MPa to :data:`gearte.models.contact_law.MAX_YOUNGS_MODULUS_MPA`,
+        ν in [0, 0.5) (:func:`gearte.models.contact_law.check_material`).
     pin_radius_modification_mm : float
         Δr_rp, equidistant ("roller radius") modification [mm]; default 0 (unmodified).
     pin_position_modification_mm : float
@@ -123,8 +126,11 @@ class CycloidPinPair:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ParameterError(name, v, "must be finite and > 0")
-        if not 0.0 <= self.poisson_ratio < 0.5:
-            raise ParameterError("poisson_ratio", self.poisson_ratio, "must be in [0, 0.5)")
+        check_material(
+            self.youngs_modulus_MPa,
+            self.poisson_ratio,
+            fields=("youngs_modulus_MPa", "poisson_ratio"),
+        )
         if self.curvature_cap_mm is not None and not self.curvature_cap_mm > 0:
             raise ParameterError("curvature_cap_mm", self.curvature_cap_mm, "must be > 0")
         check_law(self.contact_law, "contact_law")
@@ -436,7 +442,10 @@ def solve_rotation(
     Li et al. (2023) eq 3–4, doi:10.3390/machines11060626; Hu et al. (2020) eq 37–44,
     doi:10.3390/app10020481.
     """
-    return _solve_rotation(arm, clearance, a0, a1, torque_Nmm, rtol=rtol)
+    try:
+        return _solve_rotation(arm, clearance, a0, a1, torque_Nmm, rtol=rtol)
+    except ParameterError as exc:  # the solver names its own argument, "torque"
+        raise ParameterError("torque_Nmm", torque_Nmm, exc.reason) from None
 
 
 def loaded_contact(

@@ -40,14 +40,16 @@ Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/ap
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from gearte.errors import ParameterError
+from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.cycloid import CycloidStage
 from gearte.geometry.rv import RVReducer, pin_contacts
+from gearte.limits import check_floor
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     check_law,
@@ -129,7 +131,8 @@ class PinContactLaw:
     youngs_modulus, poisson_ratio, face_width : float
         E [MPa], ν [-], b [mm] of the discs and pins.
     stiffness : float
-        Start value (or the constant of ``"linear"``) [N/mm].
+        Start value (or the constant of ``"linear"``) [N/mm]: finite and at least the
+        plausibility floor of a linear stiffness (1 N/mm, ``gearte.limits.FLOORS``).
     """
 
     name: str
@@ -138,6 +141,11 @@ class PinContactLaw:
     poisson_ratio: float
     face_width: float
     stiffness: float = 2.0e5
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.stiffness):
+            raise ParameterError("stiffness", self.stiffness, "must be finite [N/mm]")
+        check_floor("stiffness", self.stiffness, "linear_stiffness")
 
     def flank_curvature(self, phase: ArrayLike) -> np.ndarray:
         """Signed flank curvature radius [mm] where each pin touches, at meshing phase ``phase``."""
@@ -188,7 +196,8 @@ def contact_law(
     law : {"line_contact", "hu2020", "linear"}, optional
         The law's name; ``None``: the reducer's own.
     stiffness : float
-        Constant pin-contact stiffness of ``"linear"`` [N/mm].
+        Constant pin-contact stiffness of ``"linear"`` [N/mm] (finite, at least the floor of a
+        linear stiffness, 1 N/mm); the start value of the others.
 
     Returns
     -------
@@ -635,6 +644,12 @@ def load_sharing(
         Warm start of the first position: displacements [mm, rad] and per-disc contact
         stiffness [N/mm] of a nearby solution (``q`` and ``contact_stiffness`` rows of another
         :class:`LoadSharing`); the equilibrium is unique, so only the Newton path changes.
+
+    Raises
+    ------
+    ConvergenceError
+        No equilibrium found at a position (the message names the torque; a pin force beyond
+        the range of the contact law is one cause).
     """
     if not np.isfinite(torque):
         raise ParameterError("torque", torque, "must be finite [N·mm]")
@@ -642,7 +657,10 @@ def load_sharing(
         system = assemble(reducer, output_positions(360) if theta is None else theta)
     slaw = solver_law(reducer, system, law)
     q0, k0 = (None, None) if start is None else start
-    sol = solve_positions(system, torque, slaw, compiled=compiled, q0=q0, k0=k0)
+    try:
+        sol = solve_positions(system, torque, slaw, compiled=compiled, q0=q0, k0=k0)
+    except ConvergenceError as exc:  # say at which torque (the input the user can change)
+        raise ConvergenceError(f"load sharing at torque = {torque:g} N·mm: {exc}") from None
     return _postprocess(reducer, system, sol, torque, slaw.name)
 
 

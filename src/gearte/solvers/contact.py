@@ -48,6 +48,7 @@ __all__ = [
     "check_status",
     "log_law_force",
     "solve_rotation",
+    "check_torque_balance",
 ]
 # the plain twins, by name (tests and the models' ``implementation="plain"`` paths):
 # solve_load_sharing_plain, log_law_force_plain, solve_rotation_plain
@@ -574,6 +575,10 @@ def _rotation_inputs(arm, clearance, a0, a1, torque):
     return arm, clearance, a0, a1
 
 
+#: Largest relative torque imbalance of a solved rotation [-] (see :func:`check_torque_balance`).
+_BALANCE_RTOL = 1e-6
+
+
 def _beyond_the_law(torque: float) -> ParameterError:
     return ParameterError(
         "torque",
@@ -652,9 +657,48 @@ def solve_rotation(
         raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
     arm, clearance, a0, a1 = _rotation_inputs(arm, clearance, a0, a1, torque)
     if implementation == "plain":
-        return _solve_rotation_plain(
+        rot, force = _solve_rotation_plain(
             arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter
         )
+    else:
+        rot, force = _solve_rotation_compiled(
+            arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter
+        )
+    check_torque_balance(np.sum(force * np.where(arm > 0.0, arm, 0.0), axis=1), torque, rtol)
+    return rot, force
+
+
+def check_torque_balance(carried: np.ndarray, torque: float, rtol: float) -> None:
+    """Raise the out-of-range :class:`ParameterError` (naming ``"torque"``) when the pins'
+    torque ``carried`` = Σ F_i l_i of a solved position falls short of ``torque``.
+
+    The rotation solvers stop when the rotation's bracket is narrower than ``rtol``; when the
+    torque exceeds what the law can carry (a pin reaches the end of its range, δ(F) stops
+    increasing and F jumps to inf), the bracket closes on that edge instead of on a root and the
+    last finite state balances only part of the torque (found at × 1e9 of a bundled torque:
+    5 % – 1e-7 of it). A solved position balances it to about ``rtol``.
+
+    Parameters
+    ----------
+    carried : ndarray (n,)
+        Σ F_i l_i of each position [N·mm].
+    torque : float
+        The torque to carry [N·mm].
+    rtol : float
+        The solver's relative tolerance on the rotation [-]; the balance may be off by
+        ``max(1e-6, 10 rtol)``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``torque``: it loads a pin beyond the range of the law.
+    """
+    if np.any(np.abs(np.asarray(carried) - torque) > max(_BALANCE_RTOL, 10.0 * rtol) * torque):
+        raise _beyond_the_law(torque)
+
+
+def _solve_rotation_compiled(arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter):
+    """The compiled kernel over the positions in order (:func:`_rotation_batch`)."""
     n = arm.shape[0]
     rot0 = np.full(n, np.nan) if rot_start is None else np.broadcast_to(rot_start, (n,))
     rot, force, nev, status = _rotation_batch(

@@ -42,21 +42,30 @@ def involute_contact_ratio(z1: int, z2: int, module_mm: float, alpha_rad: float)
     return float(path / (np.pi * module_mm * np.cos(alpha_rad)))
 
 
+def _check_stiffness(field: str, k: float) -> None:
+    """A :class:`ParameterError` naming ``field`` unless the stiffness ``k`` [N/mm] is finite and
+    > 0. (Not the plausibility floor of a linear stiffness: these are derived values, e.g. the
+    single-pair stiffness of a mesh whose floored stiffness is 1 N/mm is 1/ε_α of it.)"""
+    if not (np.isfinite(k) and k > 0):
+        raise ParameterError(field, k, "must be finite and > 0 [N/mm]")
+
+
 def rectangular_mesh_stiffness_fourier(
     single_pair_stiffness: float, contact_ratio: float, n_harmonics: int, n_samples: int = 4096
 ) -> tuple[float, np.ndarray, np.ndarray]:
     """Fourier series (eq 11) of the rectangular-wave involute mesh stiffness.
 
     Two pairs in mesh (2 k_1) over the fraction ε_α − 1 of a mesh period, one pair (k_1) over the
-    rest: mean k_1 ε_α. ``single_pair_stiffness`` k_1 [N/mm], ``contact_ratio`` ε_α [-] in (1, 2),
-    ``n_harmonics`` kept [-], ``n_samples`` [-] points of the wave over one period. Returns
-    (mean, a_l, b_l) in the units of ``single_pair_stiffness``.
+    rest: mean k_1 ε_α. ``single_pair_stiffness`` k_1 [N/mm] (finite, > 0), ``contact_ratio``
+    ε_α [-] in (1, 2), ``n_harmonics`` kept [-], ``n_samples`` [-] points of the wave over one
+    period. Returns (mean, a_l, b_l) in the units of ``single_pair_stiffness``.
 
     References
     ----------
     Li X., Huang J., Ding C., Guo R., Niu W. (2023). Machines 11(6), 626.
     doi:10.3390/machines11060626
     """
+    _check_stiffness("single_pair_stiffness", single_pair_stiffness)
     if not 1.0 < contact_ratio < 2.0:
         raise ParameterError("contact_ratio", contact_ratio, "must be in (1, 2)")
     s = 2 * np.pi * np.arange(n_samples) / n_samples
@@ -83,7 +92,8 @@ def cycloid_mesh_stiffness_fourier(
     mean_only : bool
         Drop the ripple (paper 004 §4.1 feeds only the mean into the model).
     mean_N_per_mm : float, optional
-        Replaces the mean [N/mm]; the ripple is scaled with it (e.g. the paper's printed k_cr).
+        Replaces the mean [N/mm], finite and > 0; the ripple is scaled with it (e.g. the paper's
+        printed k_cr).
 
     Returns
     -------
@@ -94,6 +104,8 @@ def cycloid_mesh_stiffness_fourier(
     Li X., Huang J., Ding C., Guo R., Niu W. (2023). Machines 11(6), 626.
     doi:10.3390/machines11060626
     """
+    if mean_N_per_mm is not None:
+        _check_stiffness("mean_N_per_mm", mean_N_per_mm)
     k_mean, a, b = fourier_fit(mesh_stiffness, n_harmonics)
     if mean_only:
         a, b = np.zeros_like(a), np.zeros_like(b)
