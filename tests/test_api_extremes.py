@@ -29,6 +29,14 @@ What the sweep found before (each now refused, naming the argument):
 * ``rv_load_sharing.contact_law(stiffness=...)`` accepted 0, -1, NaN, inf and 1e-300 N/mm (a
   linear law of 1e-300 N/mm gave an output error of -4e8 rad); ``transmission_error`` at × 1e9
   of the rated torque ended in a ``ConvergenceError`` that named no input.
+* ``rv_load_sharing.load_sharing`` beyond the pin contact law's range returned finite numbers
+  that passed the finiteness check but were wrong (han2023_rv110e, one position: the discs'
+  moments sum to 0.963 of the torque at the rated torque and up to 1e8 N·mm, to 0.38 at 1e9,
+  0.04 at 1e10 and 0 at × 1e9, with an output error of -4e5 rad). Now ``load_sharing`` and
+  ``transmission_error`` refuse a torque whose estimated pin pressure exceeds the case files'
+  ceiling (``gearte.limits.MAX_CONTACT_PRESSURE_MPA``, 10 000 MPa: about 1.4e8 N·mm on
+  han2023_rv110e), naming ``torque``; the ``rv_catalogue`` functions refuse such a rated torque,
+  naming ``reducer.rated_torque``.
 * ``rectangular_mesh_stiffness_fourier`` and ``cycloid_mesh_stiffness_fourier`` accepted NaN,
   inf, 0 and negative stiffnesses (now: finite and > 0; no floor, the values are derived, e.g.
   a mesh stiffness at its floor over the contact ratio).
@@ -53,7 +61,10 @@ Covered (argument: values):
   all seven.
 * ``rv_load_sharing``: ``load_sharing(torque)`` (signed, 0 included: its documented domain is
   "finite"), ``transmission_error(torque)`` ("> 0"), ``contact_law(stiffness)`` with the
-  ``"linear"`` law, then solved: all seven.
+  ``"linear"`` law, then solved: all seven; both torques also at 1e9 and 1e10 N·mm, and the
+  discs' moments against the torque's balance identity at 1e8 N·mm.
+* ``rv_catalogue``: ``torsion_test``, ``backlash``, ``virtual_loop``, ``catalogue_values`` with
+  the reducer's rated torque × 1e9.
 * ``catalogue``: ``hysteresis_values(rated_torque)`` and, on branches split at the real rated
   torque, ``torsional_rigidity``, ``lost_motion``, ``backlash_at_zero``: all seven.
 * ``rv_dynamics``: ``rectangular_mesh_stiffness_fourier(single_pair_stiffness)``,
@@ -61,11 +72,10 @@ Covered (argument: values):
 
 Left, and why:
 
-* ``load_sharing`` beyond the pin contact law's range: the RV equilibrium solver returns finite
-  numbers that pass this test but look wrong (han2023_rv110e, one position: the discs' moments
-  sum to 0.963 of the torque at the rated torque and up to 1e8 N·mm, to 0.38 at 1e9, 0.04 at
-  1e10 and 0 at × 1e9, with an output error of -4e5 rad). Not fixed here: a check needs the
-  solver's residual or a proven balance identity.
+* ``load_sharing`` between the pressure ceiling and the end of the pin law's range: the
+  ceiling is an estimate, not the solver's residual. On han2023_rv110e the discs' moments still
+  balance the torque at 3e8 N·mm (about 14 700 MPa) and stop at 5e8 (0.73 of the torque), so
+  nothing the ceiling lets through is wrong there; another design's margin is not checked.
 * The force, approach and arm arrays (``F``, ``delta``, ...) of the one-equation functions
   beyond their three scales: element-wise array inputs, not a torque, modulus or stiffness.
 * ``solvers.contact.solve_rotation`` / ``cycloid_loaded_contact.solve_rotation``: reached through
@@ -74,8 +84,7 @@ Left, and why:
   the torque is used only for a reducer with per-pin or disc-profile errors (then checked finite
   and > 0), which the reducers used here do not have; that solve takes seconds per call.
 * ``rv_compensation.compensate(torque)``: an optimiser running ``load_sharing`` hundreds of times
-  (its torque goes to ``load_sharing``); ``rv_catalogue.torsion_test``, ``catalogue_values``,
-  ``virtual_loop`` take the reducer's own rated torque; ``read_catalogue`` passes its
+  (its torque goes to ``transmission_error``, which checks it); ``read_catalogue`` passes its
   ``rated_torque`` to ``hysteresis_values`` (covered).
 * Parameter objects with many fields (``RVDynamicsParameters``, ``ReducedRV``, the
   ``gearte.geometry`` descriptions): their case-file keys are floored at validation; of their
@@ -94,13 +103,14 @@ from typing import Any
 import numpy as np
 import pytest
 
-from gearte.errors import GearteError, ParameterError
+from gearte.errors import CaseFileError, GearteError, ParameterError
 from gearte.io.case_file import load_case
-from gearte.limits import FLOORS, check_floor, floor_reason
+from gearte.limits import FLOORS, MAX_CONTACT_PRESSURE_MPA, check_floor, floor_reason
 from gearte.models import catalogue as cat
 from gearte.models import contact_law as cl
 from gearte.models import cycloid_contact as cc
 from gearte.models import cycloid_loaded_contact as lc
+from gearte.models import rv_catalogue as rc
 from gearte.models import rv_load_sharing as ls
 from gearte.models.rv_dynamics import (
     cycloid_mesh_stiffness_fourier,
@@ -372,17 +382,119 @@ LOAD_RESULT = fields(
 @pytest.mark.parametrize("value", SCALES + EDGES)
 def test_load_sharing_torque_extremes(reducer, value):
     t = extreme(value, reducer.rated_torque)
-    outcome(lambda: ls.load_sharing(reducer, t, np.array([0.0])), "torque", LOAD_RESULT)
+    got = outcome(lambda: ls.load_sharing(reducer, t, np.array([0.0])), "torque", LOAD_RESULT)
+    if value in ("x1e9", "nan", "inf"):
+        assert got == "refused"  # beyond what the pins carry (x1e9 returned wrong numbers)
 
 
 @pytest.mark.parametrize("value", SCALES + EDGES)
 def test_transmission_error_torque_extremes(reducer, value):
     t = extreme(value, reducer.rated_torque)
-    outcome(
+    got = outcome(
         lambda: ls.transmission_error(reducer, t, np.array([0.0, 0.3]), mesh_samples=2),
         "torque",
         fields("total", "geometric", "elastic", "total_pp"),
     )
+    if value in ("x1e9", "0", "-1", "nan", "inf"):
+        assert got == "refused"  # beyond what the pins carry (x1e9), not > 0, or not finite
+
+
+def _pressure_reason(reducer, torque: float) -> str:
+    """The reason of the pin-pressure ceiling at ``torque`` [N·mm], written out from the
+    estimate (the wording of ``gearte.io.plausibility`` without its N·m hint)."""
+    d = reducer.discs
+    p = cl.pin_pressure_estimate(
+        ls.cycloid_stage(reducer), torque, 1.0 / d.count, d.youngs_modulus, d.poisson_ratio
+    )
+    assert p > MAX_CONTACT_PRESSURE_MPA
+    return (
+        f"is implausible for this stage: it gives a pin–disc contact pressure of about "
+        f"{p:,.0f} MPa (ideal load share, Hu 2020 eq 30), above the 10,000 MPa no steel "
+        f"carries ({torque:g} N·mm = {torque / 1000:g} N·m)"
+    )
+
+
+@pytest.mark.parametrize("torque", ["1e9", "1e10", "x1e9"])
+@pytest.mark.parametrize("name", ["load_sharing", "transmission_error"])
+def test_a_torque_beyond_what_the_pins_carry_is_refused_naming_it(reducer, name, torque):
+    """han2023_rv110e, before the check: the discs' moments summed to 0.38 of the torque at 1e9
+    N·mm, 0.04 at 1e10 and 0 at × 1e9 of the rated torque (output error -4e5 rad), finite."""
+    t = reducer.rated_torque * 1e9 if torque == "x1e9" else float(torque)
+    with pytest.raises(ParameterError) as err:
+        getattr(ls, name)(reducer, t, np.array([0.0]))
+    assert (err.value.field, err.value.value) == ("torque", t)
+    assert err.value.reason == _pressure_reason(reducer, t)
+
+
+def test_the_pin_pressure_error_at_1e10_n_mm_reads_as_documented(reducer):
+    with pytest.raises(ParameterError) as err:
+        ls.load_sharing(reducer, 1e10, np.array([0.0]))
+    assert str(err.value) == (
+        "torque = 10000000000.0: is implausible for this stage: it gives a pin–disc contact "
+        "pressure of about 84,970 MPa (ideal load share, Hu 2020 eq 30), above the 10,000 MPa "
+        "no steel carries (1e+10 N·mm = 1e+07 N·m)"
+    )
+    with pytest.raises(ParameterError, match=r"^torque = -10000000000\.0: is implausible"):
+        ls.load_sharing(reducer, -1e10, np.array([0.0]))  # the magnitude counts
+
+
+def test_below_the_ceiling_the_discs_moments_balance_the_torque(reducer):
+    """Every pin normal passes through the pitch point P, a z_p from the reducer's centre along
+    the eccentricity, so the pins' moment about a disc's centre (a from the centre) is z_c/z_p of
+    their moment about the reducer's centre, the ring's reaction T (1 − 1/i) (the sun carries
+    T/i): Σ M_disc = (z_c / z_p)(1 − 1/i) T, 39/40 · 80/81 = 26/27 = 0.963 on han2023_rv110e.
+    It holds to round-off (1e-14 here) while the pins carry the torque; beyond the law's range it
+    fell to 0.38 at 1e9 N·mm. 1e8 N·mm (8 497 MPa) lies just below the ceiling."""
+    z_c, z_p, i = reducer.cycloid_teeth, reducer.pins.count, reducer.ratio
+    expected = z_c / z_p * (1.0 - 1.0 / i)
+    assert expected == pytest.approx(26 / 27, rel=1e-15)
+    got = ls.load_sharing(reducer, 1e8, np.array([0.0, 0.7, 2.0]))
+    np.testing.assert_allclose(got.disc_torque.sum(axis=1) / 1e8, expected, rtol=1e-9, atol=0)
+
+
+def test_the_pin_pressure_estimate_is_the_same_through_both_import_paths(reducer, tmp_path):
+    """``pin_pressure_estimate`` and ``MAX_CONTACT_PRESSURE_MPA`` moved below the model layer;
+    ``gearte.io.plausibility`` re-exports them, and the case files and the API give the same
+    pressure for the same torque (1e6 N·m = 1e9 N·mm on han2023_rv110e)."""
+    from gearte import limits
+    from gearte.io import plausibility
+
+    assert plausibility.pin_pressure_estimate is cl.pin_pressure_estimate
+    assert plausibility.MAX_CONTACT_PRESSURE_MPA == limits.MAX_CONTACT_PRESSURE_MPA == 10_000.0
+    d = reducer.discs
+    args = (ls.cycloid_stage(reducer), 1e9, 0.5, d.youngs_modulus, d.poisson_ratio)
+    p = plausibility.pin_pressure_estimate(*args)
+    assert p == cl.pin_pressure_estimate(*args)
+    assert p == pytest.approx(26_870, abs=0.5)  # docs/errors.md's example
+    # the case-file path: the same pressure, then its N·m hint
+    from gearte.cases import case_path
+
+    text = case_path("han2023_rv110e").read_text(encoding="utf-8")
+    assert text.count("rated_torque_Nm = 1078.0") == 1
+    (tmp_path / "c.toml").write_text(
+        text.replace("rated_torque_Nm = 1078.0", "rated_torque_Nm = 1000000.0"), encoding="utf-8"
+    )
+    with pytest.raises(CaseFileError) as info:
+        load_case(tmp_path / "c.toml")
+    with pytest.raises(ParameterError) as api:
+        ls.load_sharing(reducer, 1e9, np.array([0.0]))
+    common = api.value.reason.split(" (1e+09 N·mm")[0]
+    assert common.endswith("above the 10,000 MPa no steel carries")
+    assert info.value.errors == [
+        (
+            "reducer.rated_torque_Nm",
+            f"1e+06 N·m {common}; was it given in N·mm? (1e+06 N·mm = 1000 N·m)",
+        )
+    ]
+
+
+@pytest.mark.parametrize("name", ["torsion_test", "backlash", "virtual_loop", "catalogue_values"])
+def test_the_catalogue_test_refuses_a_rated_torque_beyond_what_the_pins_carry(reducer, name):
+    big = reducer.replace(rated_torque=reducer.rated_torque * 1e9)
+    with pytest.raises(ParameterError) as err:
+        getattr(rc, name)(big)
+    assert (err.value.field, err.value.value) == ("reducer.rated_torque", big.rated_torque)
+    assert err.value.reason == _pressure_reason(big, big.rated_torque)
 
 
 @pytest.mark.parametrize("value", SCALES + EDGES)

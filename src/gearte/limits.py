@@ -25,7 +25,9 @@ field's own minimum (``gearte.studies.sample_cap``; docs/errors.md, "``--samples
 Plausibility floors (:data:`FLOORS`): the smallest value of each physical size (a load torque, a
 Young's modulus, a stiffness, ...) that gearte accepts. They live here, in the lowest layer, so
 that the case files (``gearte.io.schema.floored``) and the model functions that take such a size
-as an argument (:func:`check_floor`) refuse the same values with the same message.
+as an argument (:func:`check_floor`) refuse the same values with the same message. The ceiling of
+a torque against the drive's size, :data:`MAX_CONTACT_PRESSURE_MPA`, lives here for the same
+reason.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from gearte.errors import ParameterError
 
 __all__ = [
     "FLOORS",
+    "MAX_CONTACT_PRESSURE_MPA",
     "floor_reason",
     "check_floor",
     "max_memory_bytes",
@@ -108,6 +111,15 @@ FLOORS: dict[str, tuple[float, str, str]] = {
         "outside the tolerance they model, and at 1e-300 σ overflows",
     ),
 }
+
+
+#: Largest pin–disc Hertz pressure a torque may give [MPa] (2.5× the static capacity of bearing
+#: steel in line contact, about 4 000 MPa, ISO 76: far beyond any real design, reached by a torque
+#: given in N·mm where N·m is asked for, which multiplies the pressure by √1000 ≈ 32). The case
+#: files (``gearte.io.plausibility``) and the RV model API
+#: (``gearte.models.rv_load_sharing.check_reducer_torque``) refuse a torque above it, estimated by
+#: ``gearte.models.contact_law.pin_pressure_estimate``.
+MAX_CONTACT_PRESSURE_MPA = 10_000.0
 
 
 def floor_reason(quantity: str, *, scale: float = 1.0, unit: str | None = None) -> str:

@@ -10,7 +10,7 @@ Torque against size (``cycloid_stage``, ``rv_reducer``): the torque a disc carri
 the force on the most loaded pin with Hu et al. (2020) eq 30 (all z_p/2 pins of the loaded flank
 share the torque: F = 4 T_c / (K1 z_c r_p), a lower bound of the real F_max) and into the largest
 Hertz line-contact pressure of that pin on the flank at its first-contact phase φ0 (Johnson eq
-4.45, :func:`gearte.models.contact_law.max_contact_pressure`). Above
+4.45; :func:`gearte.models.contact_law.pin_pressure_estimate`, re-exported here). Above
 :data:`MAX_CONTACT_PRESSURE_MPA` no steel carries the load even once (through-hardened bearing
 steel: about 4 000 MPa static line contact, ISO 76), so the torque is refused with the pressure and
 the torque read as N·mm beside it. A torque that is high but possible is left to the analyses (and
@@ -28,7 +28,11 @@ from collections.abc import Callable
 from typing import Any
 
 from gearte.errors import ParameterError
-from gearte.limits import FLOORS  # re-exported: the table lives in the lowest layer
+
+# re-exported: the table, the ceiling and the estimate live in lower layers, where the model API
+# checks them too (gearte.models.rv_load_sharing.check_reducer_torque)
+from gearte.limits import FLOORS, MAX_CONTACT_PRESSURE_MPA
+from gearte.models.contact_law import implausible_pin_pressure, pin_pressure_estimate
 
 __all__ = [
     "FLOORS",
@@ -38,61 +42,19 @@ __all__ = [
     "plausibility_problems",
 ]
 
-#: Largest pin–disc Hertz pressure a torque may give at validation [MPa] (2.5× the static
-#: capacity of bearing steel in line contact: far beyond any real design, reached by a torque
-#: given in N·mm where N·m is asked for, which multiplies the pressure by √1000 ≈ 32).
-MAX_CONTACT_PRESSURE_MPA = 10_000.0
-
-
-def pin_pressure_estimate(
-    stage: Any, torque_Nmm: float, share: float, E: float, nu: float
-) -> float:
-    """Hertz pressure of the most loaded pin under an ideal load share [MPa].
-
-    Parameters
-    ----------
-    stage : CycloidStage
-        The cycloid–pin stage (its K1, z_c, r_p, pin radius, face width and ρ(φ0)).
-    torque_Nmm : float
-        Output torque of the stage [N·mm].
-    share : float
-        Share of the torque carried by one disc [-].
-    E : float
-        Young's modulus [MPa].
-    nu : float
-        Poisson's ratio [-].
-
-    Returns
-    -------
-    float
-        p0 [MPa] of the force F = 4 share T / (K1 z_c r_p) (Hu 2020 eq 30) at the flank curvature
-        ρ(φ0) (eq 40).
-
-    References
-    ----------
-    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
-    """
-    from gearte.models.contact_law import max_contact_pressure
-
-    force = 4.0 * share * torque_Nmm / (stage.K1 * stage.z_c * stage.r_p)
-    return float(max_contact_pressure(force, stage.rho0, stage.r, E, nu, stage.b))
-
 
 def _torque_problem(
     field: str, torque_Nm: float, stage: Any, share: float, E: float, nu: float
 ) -> tuple[str, float, str] | None:
     from gearte.units import Nm_to_Nmm
 
-    p = pin_pressure_estimate(stage, float(Nm_to_Nmm(torque_Nm)), share, E, nu)
-    if p <= MAX_CONTACT_PRESSURE_MPA:
+    reason = implausible_pin_pressure(stage, float(Nm_to_Nmm(torque_Nm)), share, E, nu)
+    if reason is None:
         return None
     return (
         field,
         torque_Nm,
-        f"is implausible for this stage: it gives a pin–disc contact pressure "
-        f"of about {p:,.0f} MPa (ideal load share, Hu 2020 eq 30), above the "
-        f"{MAX_CONTACT_PRESSURE_MPA:,.0f} MPa no steel carries; was it given in N·mm? "
-        f"({torque_Nm:g} N·mm = {torque_Nm / 1000:g} N·m)",
+        f"{reason}; was it given in N·mm? ({torque_Nm:g} N·mm = {torque_Nm / 1000:g} N·m)",
     )
 
 

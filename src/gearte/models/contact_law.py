@@ -56,7 +56,8 @@ from numba import njit
 from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
-from gearte.limits import check_floor
+from gearte.geometry.cycloid import CycloidStage
+from gearte.limits import MAX_CONTACT_PRESSURE_MPA, check_floor
 from gearte.solvers.contact import log_law_force
 
 __all__ = [
@@ -71,6 +72,9 @@ __all__ = [
     "relative_radius",
     "hertz_half_width",
     "max_contact_pressure",
+    "pin_pressure_estimate",
+    "implausible_pin_pressure",
+    "check_pin_pressure",
     "log_law_coefficients",
     "approach",
     "force",
@@ -280,6 +284,132 @@ def max_contact_pressure(
     f = np.maximum(np.asarray(F, dtype=float), 0.0)
     rs = relative_radius(rho, r)
     return np.sqrt(f * contact_modulus(E, nu) / (math.pi * b * rs))
+
+
+def pin_pressure_estimate(
+    stage: CycloidStage, torque_Nmm: float, share: float, E: float, nu: float
+) -> float:
+    """Hertz pressure of the most loaded pin under an ideal load share [MPa].
+
+    Parameters
+    ----------
+    stage : CycloidStage
+        The cycloid–pin stage (its K1, z_c, r_p, pin radius, face width and ρ(φ0)).
+    torque_Nmm : float
+        Output torque of the stage [N·mm] (a negative torque gives 0: see ``max_contact_pressure``).
+    share : float
+        Share of the torque carried by one disc [-].
+    E : float
+        Young's modulus [MPa].
+    nu : float
+        Poisson's ratio [-].
+
+    Returns
+    -------
+    float
+        p0 [MPa] of the force F = 4 share T / (K1 z_c r_p) (Hu 2020 eq 30) at the flank curvature
+        ρ(φ0) (eq 40).
+
+    Notes
+    -----
+    Eq 30 lets all z_p/2 pins of the loaded flank share the disc's torque, so F is a lower bound
+    of the real largest pin force and p0 a lower bound of its pressure (Johnson eq 4.45,
+    :func:`max_contact_pressure`). Used by the case files' plausibility check
+    (``gearte.io.plausibility``, which re-exports it) and by :func:`check_pin_pressure`.
+
+    Examples
+    --------
+    >>> from gearte.geometry.cycloid import CycloidStage
+    >>> st = CycloidStage(z_p=40, r_p=82.0, r_rp=3.5, a=1.5, b=13.0)  # han2023_rv110e's pins
+    >>> round(pin_pressure_estimate(st, 1.078e6, 0.5, 2.06e5, 0.3))  # rated torque, two discs
+    882
+
+    References
+    ----------
+    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+    Johnson K. L. (1985). Contact Mechanics, eq 4.45. doi:10.1017/CBO9781139171731
+    """
+    force = 4.0 * share * torque_Nmm / (stage.K1 * stage.z_c * stage.r_p)
+    return float(max_contact_pressure(force, stage.rho0, stage.r, E, nu, stage.b))
+
+
+def implausible_pin_pressure(
+    stage: CycloidStage, torque_Nmm: float, share: float, E: float, nu: float
+) -> str | None:
+    """Why ``torque_Nmm`` is impossible for ``stage``, or ``None`` when it is not.
+
+    A torque is impossible when its :func:`pin_pressure_estimate` exceeds
+    :data:`gearte.limits.MAX_CONTACT_PRESSURE_MPA`: no steel carries the load even once.
+
+    Parameters
+    ----------
+    stage : CycloidStage
+        The cycloid–pin stage.
+    torque_Nmm : float
+        Output torque of the stage [N·mm] (its magnitude counts).
+    share : float
+        Share of the torque carried by one disc [-].
+    E, nu : float
+        Young's modulus [MPa] and Poisson's ratio [-].
+
+    Returns
+    -------
+    str or None
+        ``"is implausible for this stage: it gives a pin–disc contact pressure of about <p> MPa
+        (ideal load share, Hu 2020 eq 30), above the 10,000 MPa no steel carries"`` (the case
+        files' wording, which adds a hint on units), or ``None``.
+    References
+    ----------
+    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+    Johnson K. L. (1985). Contact Mechanics, eq 4.45. doi:10.1017/CBO9781139171731
+    """
+    p = pin_pressure_estimate(stage, abs(torque_Nmm), share, E, nu)
+    if p <= MAX_CONTACT_PRESSURE_MPA:
+        return None
+    return (
+        f"is implausible for this stage: it gives a pin–disc contact pressure "
+        f"of about {p:,.0f} MPa (ideal load share, Hu 2020 eq 30), above the "
+        f"{MAX_CONTACT_PRESSURE_MPA:,.0f} MPa no steel carries"
+    )
+
+
+def check_pin_pressure(
+    field: str, torque_Nmm: float, stage: CycloidStage, share: float, E: float, nu: float
+) -> None:
+    """Raise :class:`ParameterError` naming ``field`` when ``torque_Nmm`` is impossible for
+    ``stage`` (:func:`implausible_pin_pressure`).
+
+    Parameters
+    ----------
+    field : str
+        The argument that carried the torque (named in the error).
+    torque_Nmm : float
+        Output torque of the stage [N·mm] (its magnitude counts).
+    stage : CycloidStage
+        The cycloid–pin stage.
+    share : float
+        Share of the torque carried by one disc [-].
+    E, nu : float
+        Young's modulus [MPa] and Poisson's ratio [-].
+
+    Raises
+    ------
+    ParameterError
+        ``"<field> = <value>: is implausible for this stage: it gives a pin–disc contact
+        pressure of about <p> MPa (ideal load share, Hu 2020 eq 30), above the 10,000 MPa no
+        steel carries (<value> N·mm = <value / 1000> N·m)"``.
+    References
+    ----------
+    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+    Johnson K. L. (1985). Contact Mechanics, eq 4.45. doi:10.1017/CBO9781139171731
+    """
+    reason = implausible_pin_pressure(stage, torque_Nmm, share, E, nu)
+    if reason is not None:
+        raise ParameterError(
+            field,
+            torque_Nmm,
+            f"{reason} ({torque_Nmm:g} N·mm = {torque_Nmm / 1000:g} N·m)",
+        )
 
 
 def log_law_coefficients(

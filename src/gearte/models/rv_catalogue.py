@@ -33,7 +33,13 @@ from numpy.typing import ArrayLike
 from gearte.errors import ParameterError
 from gearte.geometry.rv import RVReducer
 from gearte.models.catalogue import ZERO_TORQUE_FRACTION, hysteresis_values
-from gearte.models.rv_load_sharing import PinContactLaw, assemble, contact_law, solver_law
+from gearte.models.rv_load_sharing import (
+    PinContactLaw,
+    assemble,
+    check_reducer_torque,
+    contact_law,
+    solver_law,
+)
 from gearte.solvers.rv_batch import solve_positions
 from gearte.solvers.rv_equilibrium import ContactLaw
 
@@ -106,7 +112,9 @@ class TorsionTest:
 
 
 def _rated(reducer: RVReducer) -> float:
-    """The rated torque [N·mm], which the virtual test needs (a case may leave it out)."""
+    """The rated torque [N·mm], which the virtual test needs (a case may leave it out), checked
+    against the reducer's size as the case files check ``reducer.rated_torque_Nm``
+    (:func:`gearte.models.rv_load_sharing.check_reducer_torque`)."""
     if reducer.rated_torque is None:
         raise ParameterError(
             "reducer.rated_torque_Nm",
@@ -114,6 +122,7 @@ def _rated(reducer: RVReducer) -> float:
             "needed by the virtual torsion test (catalogue, backlash, compensation): the torque "
             "sweep is in fractions of the rated torque",
         )
+    check_reducer_torque(reducer, reducer.rated_torque, "reducer.rated_torque")
     return float(reducer.rated_torque)
 
 
@@ -152,6 +161,12 @@ def torsion_test(
     -------
     TorsionTest
         Torque [N·mm] and output torsion angle [rad] along the sweep.
+
+    Raises
+    ------
+    ParameterError
+        The reducer has no rated torque, or one beyond what its pins can carry (named
+        ``reducer.rated_torque``; :func:`gearte.models.rv_load_sharing.check_reducer_torque`).
     """
     frac = torque_path(turning_points, steps_per_segment)
     law = contact_law(reducer) if law is None else law
@@ -187,6 +202,12 @@ def backlash(
     -------
     float
         Backlash [rad].
+
+    Raises
+    ------
+    ParameterError
+        The reducer has no rated torque, or one beyond what its pins can carry (named
+        ``reducer.rated_torque``; :func:`gearte.models.rv_load_sharing.check_reducer_torque`).
     """
     law = contact_law(reducer) if law is None else law
     th = np.atleast_1d(np.asarray(theta, dtype=float))
@@ -246,9 +267,15 @@ def virtual_loop(
     -------
     (TorsionTest, numpy.ndarray)
         The loop and its branch marks [-].
+
+    Raises
+    ------
+    ParameterError
+        The reducer has no rated torque, or one beyond what its pins can carry (named
+        ``reducer.rated_torque``; :func:`gearte.models.rv_load_sharing.check_reducer_torque`).
     """
     law = contact_law(reducer) if law is None else law
-    tr = reducer.rated_torque
+    tr = _rated(reducer)
     levels = np.array([1.0, 0.5, lost_motion_fraction, ZERO_TORQUE_FRACTION])
     unload_pos = _follow(reducer, theta, levels * tr, law)
     unload_neg = _follow(reducer, theta, -levels * tr, law)
@@ -300,6 +327,12 @@ def catalogue_values(
     -------
     CatalogueValues
         Rigidity [N·mm/rad], lost motion, backlash and hysteresis loss [rad].
+
+    Raises
+    ------
+    ParameterError
+        The reducer has no rated torque, or one beyond what its pins can carry (named
+        ``reducer.rated_torque``; :func:`gearte.models.rv_load_sharing.check_reducer_torque`).
     """
     if not 0 < lost_motion_fraction < 0.5:
         raise ParameterError("lost_motion_fraction", lost_motion_fraction, "must be in (0, 0.5)")

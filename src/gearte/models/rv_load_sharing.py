@@ -53,6 +53,7 @@ from gearte.limits import check_floor
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     check_law,
+    check_pin_pressure,
     log_law_coefficients,
     max_contact_pressure,
 )
@@ -68,6 +69,7 @@ __all__ = [
     "RVSystem",
     "dof_layout",
     "cycloid_stage",
+    "check_reducer_torque",
     "contact_law",
     "PinContactLaw",
     "solver_law",
@@ -112,6 +114,44 @@ def cycloid_stage(reducer: RVReducer) -> CycloidStage:
         b=reducer.discs.face_width,
         dr_rp=reducer.discs.equidistant_modification,
         dr_p=reducer.discs.shift_modification,
+    )
+
+
+def check_reducer_torque(reducer: RVReducer, torque: float, field: str = "torque") -> None:
+    """Refuse an output torque that no pin of ``reducer`` could carry, naming ``field``.
+
+    The check the case files make at validation (``gearte.io.plausibility``): the torque's
+    estimated pin pressure (:func:`gearte.models.contact_law.pin_pressure_estimate`: Hu 2020
+    eq 30 with the ideal share ``1 / discs.count``, Johnson's line-contact pressure at ρ(φ0) of
+    :func:`cycloid_stage`, the discs' E and ν) must not exceed
+    :data:`gearte.limits.MAX_CONTACT_PRESSURE_MPA`. Far beyond it the load-sharing equilibrium
+    leaves the range of the pin contact law and returns finite numbers whose disc moments no
+    longer balance the torque (han2023_rv110e: refused above about 1.4e8 N·mm, the moments
+    balance up to 3e8 N·mm).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+    torque : float
+        Output torque [N·mm] (its magnitude counts).
+    field : str
+        The argument that carried the torque (named in the error).
+
+    Raises
+    ------
+    ParameterError
+        ``"torque = 10000000000.0: is implausible for this stage: it gives a pin–disc contact
+        pressure of about 84,970 MPa (ideal load share, Hu 2020 eq 30), above the 10,000 MPa
+        no steel carries (1e+10 N·mm = 1e+07 N·m)"``.
+
+    References
+    ----------
+    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+    """
+    d = reducer.discs
+    check_pin_pressure(
+        field, torque, cycloid_stage(reducer), 1.0 / d.count, d.youngs_modulus, d.poisson_ratio
     )
 
 
@@ -647,12 +687,16 @@ def load_sharing(
 
     Raises
     ------
+    ParameterError
+        ``torque`` not finite, or beyond what the pins can carry (:func:`check_reducer_torque`,
+        the case files' plausibility check).
     ConvergenceError
         No equilibrium found at a position (the message names the torque; a pin force beyond
         the range of the contact law is one cause).
     """
     if not np.isfinite(torque):
         raise ParameterError("torque", torque, "must be finite [N·mm]")
+    check_reducer_torque(reducer, torque)
     if system is None:
         system = assemble(reducer, output_positions(360) if theta is None else theta)
     slaw = solver_law(reducer, system, law)
@@ -746,9 +790,15 @@ def transmission_error(
     -------
     TransmissionError
         Total, geometric and elastic output angle error [rad] over ``theta``.
+
+    Raises
+    ------
+    ParameterError
+        ``torque`` not > 0, or beyond what the pins can carry (:func:`check_reducer_torque`).
     """
     if not torque > 0:
         raise ParameterError("torque", torque, "must be > 0 N·mm for the TE analysis")
+    check_reducer_torque(reducer, torque)
     if not 0 < zero_load_fraction < 0.05:
         raise ParameterError("zero_load_fraction", zero_load_fraction, "must be in (0, 0.05)")
     if int(mesh_samples) != mesh_samples or mesh_samples < 0:
