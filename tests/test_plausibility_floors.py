@@ -196,3 +196,27 @@ def test_serial_torque_in_n_mm_is_refused_naming_the_key(tmp_path):
     assert got.status == "run_exit_2", got
     assert "analyses.load_sharing.torque_Nm = 1000000.0: is implausible" in got.detail, got
     assert "26,870 MPa" in got.detail, got  # the pressure the torque would give
+
+
+def test_validating_a_case_without_a_torque_check_imports_no_numba():
+    """The pin-pressure estimate (``gearte.models.contact_law``, which imports numba) is
+    imported by ``gearte.io.plausibility`` on first use: loading and validating a case of a kind
+    with no torque check and no kernel (a gear chain) imports no numba (~0.3 s of a ~1.4 s warm
+    run), and the re-exported name still resolves."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "from gearte.cases import case_path\n"
+        "from gearte.io.case_file import load_case\n"
+        "load_case(case_path('jiang2024_shoulder_swing'))\n"
+        "print('numba' in sys.modules)\n"
+        "from gearte.io import plausibility\n"
+        "from gearte.models import contact_law\n"
+        "print(plausibility.pin_pressure_estimate is contact_law.pin_pressure_estimate)\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
+    ).stdout.split()
+    assert out == ["False", "True"], out

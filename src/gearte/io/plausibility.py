@@ -25,14 +25,16 @@ Johnson K. L. (1985). Contact Mechanics, eq 4.45. doi:10.1017/CBO9781139171731
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from gearte.errors import ParameterError
 
 # re-exported: the table, the ceiling and the estimate live in lower layers, where the model API
 # checks them too (gearte.models.rv_load_sharing.check_reducer_torque)
 from gearte.limits import FLOORS, MAX_CONTACT_PRESSURE_MPA
-from gearte.models.contact_law import implausible_pin_pressure, pin_pressure_estimate
+
+if TYPE_CHECKING:  # pragma: no cover
+    from gearte.models.contact_law import pin_pressure_estimate
 
 __all__ = [
     "FLOORS",
@@ -43,9 +45,20 @@ __all__ = [
 ]
 
 
+def __getattr__(name: str) -> Any:
+    # imported on first use: gearte.models.contact_law imports numba (~0.3 s), which validating
+    # a case of a kind without a torque check (or without any kernel) must not pay
+    if name == "pin_pressure_estimate":
+        from gearte.models.contact_law import pin_pressure_estimate
+
+        return pin_pressure_estimate
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 def _torque_problem(
     field: str, torque_Nm: float, stage: Any, share: float, E: float, nu: float
 ) -> tuple[str, float, str] | None:
+    from gearte.models.contact_law import implausible_pin_pressure
     from gearte.units import Nm_to_Nmm
 
     reason = implausible_pin_pressure(stage, float(Nm_to_Nmm(torque_Nm)), share, E, nu)
