@@ -81,8 +81,9 @@ Left, and why:
 * ``solvers.contact.solve_rotation`` / ``cycloid_loaded_contact.solve_rotation``: reached through
   ``loaded_contact`` (the same wrapper); their other inputs are solver arrays.
 * ``rv_dynamics.disc_rotation_error(torque_per_disc)``, ``errors_from_reducer(output_torque_Nm)``:
-  the torque is used only for a reducer with per-pin or disc-profile errors (then checked finite
-  and > 0), which the reducers used here do not have; that solve takes seconds per call.
+  only their refusals (a torque beyond the pins' ceiling, 0, -1, NaN, inf on han2023_rv110e with
+  one oversize pin), not the scales they accept: the loaded-rotation solve behind them takes
+  seconds per call.
 * ``rv_compensation.compensate(torque)``: an optimiser running ``load_sharing`` hundreds of times
   (its torque goes to ``transmission_error``, which checks it); ``read_catalogue`` passes its
   ``rated_torque`` to ``hysteresis_values`` (covered).
@@ -569,3 +570,46 @@ def test_floors_live_in_limits_and_io_re_exports_the_same_table():
     for bad in (0.999, math.nan, -math.inf):
         with pytest.raises(ParameterError, match=r"^k = .*: must be >= 1 N/mm: no part"):
             check_floor("k", bad, "linear_stiffness")
+
+
+@pytest.fixture(scope="module")
+def reducer_with_pin_errors(reducer):
+    """han2023_rv110e with a 2 µm oversize pin 1: an error the dynamics turn into each disc's
+    loaded rotation excitation (:func:`gearte.models.rv_dynamics.excitation.has_pin_errors`)."""
+    from gearte.geometry.rv import PinRing
+    from gearte.models.rv_dynamics.excitation import has_pin_errors
+
+    p = reducer.pins
+    errors = np.zeros(p.count)
+    errors[0] = 2e-3
+    out = reducer.replace(pins=PinRing(p.count, p.pin_radius, p.circle_radius, errors))
+    assert has_pin_errors(out)
+    return out
+
+
+@pytest.mark.parametrize("torque", ["1e9", "1e10", "x1e9", "0", "-1", "nan", "inf"])
+def test_the_dynamics_pin_error_excitation_refuses_a_torque_the_pins_cannot_carry(
+    reducer_with_pin_errors, torque
+):
+    """``errors_from_reducer(output_torque_Nm)`` [N·m] and ``disc_rotation_error
+    (torque_per_disc)`` [N·mm] have the case files' ceiling too, naming their own argument;
+    before, a torque beyond the pins' law reached the loaded-rotation solve (seconds per call)
+    and was refused there naming ``torque``, or passed where the solve happened to balance."""
+    from gearte.models.rv_dynamics import errors_from_reducer
+    from gearte.models.rv_dynamics.excitation import disc_rotation_error
+
+    r = reducer_with_pin_errors
+    n = r.discs.count
+    t_nmm = r.rated_torque * 1e9 if torque == "x1e9" else float(torque)
+    beyond = t_nmm > 0 and math.isfinite(t_nmm)
+    # the same estimate as load_sharing's, the whole torque over the discs: "... about N MPa"
+    pressure = _pressure_reason(r, t_nmm).split(" (")[0] if beyond else "must be finite and > 0"
+    with pytest.raises(ParameterError) as err:
+        errors_from_reducer(r, output_torque_Nm=t_nmm / 1000.0)
+    assert err.value.field == "output_torque_Nm"
+    assert err.value.value == t_nmm / 1000.0 or math.isnan(t_nmm)
+    assert err.value.reason.startswith(pressure), err.value.reason
+    with pytest.raises(ParameterError) as err:
+        disc_rotation_error(r, t_nmm / n)
+    assert err.value.field == "torque_per_disc"
+    assert err.value.reason.startswith(pressure), err.value.reason

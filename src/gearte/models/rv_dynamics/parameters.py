@@ -382,6 +382,28 @@ DYNAMIC_ONLY = (
 )
 
 
+def _check_output_torque(reducer, output_torque_Nm: float) -> None:  # noqa: N803
+    """A :class:`ParameterError` naming ``output_torque_Nm`` [N·m] unless it is finite, > 0 and
+    within what the pins carry (the case files' pin-pressure ceiling, ideal share over the
+    discs: :func:`gearte.models.contact_law.implausible_pin_pressure`)."""
+    from gearte.models.contact_law import implausible_pin_pressure
+    from gearte.models.rv_load_sharing import cycloid_stage
+    from gearte.units import Nm_to_Nmm
+
+    if not (np.isfinite(output_torque_Nm) and output_torque_Nm > 0):
+        raise ParameterError("output_torque_Nm", output_torque_Nm, "must be finite and > 0 [N·m]")
+    d = reducer.discs
+    reason = implausible_pin_pressure(
+        cycloid_stage(reducer),
+        float(Nm_to_Nmm(output_torque_Nm)),
+        1.0 / d.count,
+        d.youngs_modulus,
+        d.poisson_ratio,
+    )
+    if reason is not None:
+        raise ParameterError("output_torque_Nm", output_torque_Nm, reason)
+
+
 def errors_from_reducer(
     reducer,
     *,
@@ -420,7 +442,8 @@ def errors_from_reducer(
     ------
     ParameterError
         Naming ``output_torque_Nm`` when the reducer has pin or disc-profile errors and no torque
-        is given (their effect on the loaded contact depends on the load).
+        is given (their effect on the loaded contact depends on the load), or a torque that is
+        not finite and > 0 or more than the pins carry (the case files' pin-pressure ceiling).
     """
     from gearte.models.rv_dynamics.excitation import disc_rotation_error, has_pin_errors
     from gearte.units import Nm_to_Nmm
@@ -440,6 +463,7 @@ def errors_from_reducer(
                 "needed to turn the pin and disc-profile errors into the discs' loaded "
                 "rotation excitation",
             )
+        _check_output_torque(reducer, output_torque_Nm)
         paper004["disc_rotation"] = disc_rotation_error(
             reducer, Nm_to_Nmm(output_torque_Nm) / n, samples_per_mesh
         )
