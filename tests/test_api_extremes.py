@@ -613,3 +613,18 @@ def test_the_dynamics_pin_error_excitation_refuses_a_torque_the_pins_cannot_carr
         disc_rotation_error(r, t_nmm / n)
     assert err.value.field == "torque_per_disc"
     assert err.value.reason.startswith(pressure), err.value.reason
+
+
+@pytest.mark.parametrize("torque", ["1e10", "x1e9"])
+def test_the_selective_assembly_linear_model_refuses_a_torque_the_pins_cannot_carry(
+    reducer, torque
+):
+    """``runners.selective_assembly.linear_te_model`` solves the design's equilibrium directly
+    (``solve_positions``, not ``load_sharing``): it has the same ceiling, naming ``torque``."""
+    from gearte.runners.selective_assembly import linear_te_model
+
+    t = reducer.rated_torque * 1e9 if torque == "x1e9" else float(torque)
+    with pytest.raises(ParameterError) as err:
+        linear_te_model(reducer, t, np.array([0.0]))
+    assert (err.value.field, err.value.value) == ("torque", t)
+    assert err.value.reason == _pressure_reason(reducer, t)

@@ -51,6 +51,7 @@ from gearte.geometry.rv import RVReducer
 from gearte.models.rv_load_sharing import (
     RVSystem,
     assemble,
+    check_reducer_torque,
     load_sharing,
     solver_law,
 )
@@ -289,7 +290,14 @@ def linear_te_model(design: RVReducer, torque: float, theta: np.ndarray) -> Line
         Output torque [N·mm].
     theta : numpy.ndarray
         Output angles [rad].
+
+    Raises
+    ------
+    ParameterError
+        Naming ``torque`` when it is more than the pins carry (the case files' pin-pressure
+        ceiling, :func:`gearte.models.rv_load_sharing.check_reducer_torque`).
     """
+    check_reducer_torque(design, torque)
     system = assemble(design, theta)
     law = solver_law(design, system, None)
     sol = solve_positions(system, torque, law)
