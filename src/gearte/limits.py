@@ -42,6 +42,7 @@ __all__ = [
     "MAX_CONTACT_PRESSURE_MPA",
     "floor_reason",
     "check_floor",
+    "check_load_torque",
     "max_memory_bytes",
     "max_seconds",
     "max_sweep_points",
@@ -184,6 +185,31 @@ def check_floor(
     """
     if not value >= FLOORS[quantity][0] * scale:
         raise ParameterError(field, value, floor_reason(quantity, scale=scale, unit=unit))
+
+
+def check_load_torque(field: str, torque_Nmm: float) -> None:  # noqa: N803 - unit in the name
+    """:func:`check_floor` of a load torque given in N·mm, the models' unit (the floor of
+    :data:`FLOORS` is in N·m: 1e-3 N·m = 1 N·mm).
+
+    Parameters
+    ----------
+    field : str
+        The argument that carried the torque (named in the error).
+    torque_Nmm : float
+        The torque [N·mm].
+
+    Raises
+    ------
+    ParameterError
+        ``"<field> = <value>: must be >= 1 N·mm: <why>"``.
+
+    Examples
+    --------
+    >>> check_load_torque("torque", 5.0)  # 5 N·mm: passes
+    """
+    from gearte.units import Nm_to_Nmm
+
+    check_floor(field, torque_Nmm, "load_torque", scale=float(Nm_to_Nmm(1.0)), unit="N·mm")
 
 
 _DEFAULTS = {"GEARTE_MAX_MEMORY_GB": 4.0, "GEARTE_MAX_SECONDS": 3600.0}

@@ -41,8 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
-from gearte.limits import check_floor
-from gearte.units import Nm_to_Nmm
+from gearte.limits import check_load_torque
 
 __all__ = [
     "ZERO_TORQUE_FRACTION",
@@ -84,10 +83,6 @@ class Branches:
     def mid(self, torque: ArrayLike) -> np.ndarray:
         """Mid-curve ``(θ_asc + θ_desc)/2`` [rad]."""
         return 0.5 * (self.ascending(torque) + self.descending(torque))
-
-
-#: N·mm in one N·m (the torque floor of ``gearte.limits.FLOORS`` is in N·m) [-].
-_NMM_PER_NM = float(Nm_to_Nmm(1.0))
 
 
 def branch_directions(torque: ArrayLike, threshold: float = 0.02) -> np.ndarray:
@@ -148,7 +143,7 @@ def _check_rated_torque(rated_torque: float, branches: Branches | None = None) -
     than twice their reach (the readings at ±T_r/2 must lie on them, not beyond their ends)."""
     if not np.isfinite(rated_torque) or rated_torque <= 0:
         raise ParameterError("rated_torque", rated_torque, "must be finite and > 0 [N·mm]")
-    check_floor("rated_torque", rated_torque, "load_torque", scale=_NMM_PER_NM, unit="N·mm")
+    check_load_torque("rated_torque", rated_torque)
     if branches is None:
         return
     reach = min(

@@ -38,7 +38,7 @@ from numpy.typing import ArrayLike
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.cycloid import CycloidStage, geometry_radii
 from gearte.geometry.cycloid_kernels import pin_mesh_table
-from gearte.limits import check_floor
+from gearte.limits import check_floor, check_load_torque
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     HU2020_HALF_WIDTH_FACTOR,
@@ -65,7 +65,6 @@ from gearte.solvers.contact import (
     solve_load_sharing_plain,
     solve_rotation_plain,
 )
-from gearte.units import Nm_to_Nmm
 
 __all__ = [
     "compliance_constants",
@@ -80,8 +79,6 @@ __all__ = [
 
 #: The constant of eq 39 as printed (defined in :mod:`gearte.models.contact_law`).
 HALF_WIDTH_FACTOR = HU2020_HALF_WIDTH_FACTOR
-#: N·mm in one N·m (the torque floor of ``gearte.limits.FLOORS`` is in N·m) [-].
-_NMM_PER_NM = float(Nm_to_Nmm(1.0))
 
 
 def compliance_constants(
@@ -427,7 +424,7 @@ def tooth_contact(
     """
     if not (math.isfinite(torque) and torque > 0.0):
         raise ParameterError("torque", torque, "must be finite and > 0 [N·mm]")
-    check_floor("torque", torque, "load_torque", scale=_NMM_PER_NM, unit="N·mm")
+    check_load_torque("torque", torque)
     if not (0.0 < disc_share <= 1.0):
         raise ParameterError("disc_share", disc_share, "must be in (0, 1]")
     check_floor("disc_share", disc_share, "disc_share")

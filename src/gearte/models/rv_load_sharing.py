@@ -54,6 +54,7 @@ from gearte.models.contact_law import (
     DEFAULT_LAW,
     check_law,
     check_pin_pressure,
+    implausible_pin_pressure,
     log_law_coefficients,
     max_contact_pressure,
 )
@@ -70,6 +71,7 @@ __all__ = [
     "dof_layout",
     "cycloid_stage",
     "check_reducer_torque",
+    "implausible_reducer_torque",
     "contact_law",
     "PinContactLaw",
     "solver_law",
@@ -117,7 +119,48 @@ def cycloid_stage(reducer: RVReducer) -> CycloidStage:
     )
 
 
-def check_reducer_torque(reducer: RVReducer, torque: float, field: str = "torque") -> None:
+def implausible_reducer_torque(
+    reducer: RVReducer, torque: float, share: float | None = None
+) -> str | None:
+    """Why no pin of ``reducer`` could carry ``torque`` [N·mm], or ``None`` when one could
+    (:func:`gearte.models.contact_law.implausible_pin_pressure` on :func:`cycloid_stage` with
+    the discs' E and ν; ``share`` of the torque on one disc, default ``1 / discs.count``).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description.
+    torque : float
+        Torque [N·mm] (its magnitude counts).
+    share : float, optional
+        Share of ``torque`` carried by one disc [-] (1 for a torque given per disc).
+
+    Returns
+    -------
+    str or None
+        The reason, in the case files' wording, or ``None``.
+
+    References
+    ----------
+    Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
+    """
+    stage, share, E, nu = _pin_pressure_inputs(reducer, share)
+    return implausible_pin_pressure(stage, torque, share, E, nu)
+
+
+def _pin_pressure_inputs(
+    reducer: RVReducer, share: float | None
+) -> tuple[CycloidStage, float, float, float]:
+    """(stage, share, E, nu) of the pin-pressure estimate of ``reducer`` (share default
+    ``1 / discs.count``)."""
+    d = reducer.discs
+    share = 1.0 / d.count if share is None else share
+    return cycloid_stage(reducer), share, d.youngs_modulus, d.poisson_ratio
+
+
+def check_reducer_torque(
+    reducer: RVReducer, torque: float, field: str = "torque", *, share: float | None = None
+) -> None:
     """Refuse an output torque that no pin of ``reducer`` could carry, naming ``field``.
 
     The check the case files make at validation (``gearte.io.plausibility``): the torque's
@@ -137,6 +180,9 @@ def check_reducer_torque(reducer: RVReducer, torque: float, field: str = "torque
         Output torque [N·mm] (its magnitude counts).
     field : str
         The argument that carried the torque (named in the error).
+    share : float, optional
+        Share of ``torque`` carried by one disc [-]; default ``1 / discs.count`` (1 for a
+        torque given per disc).
 
     Raises
     ------
@@ -149,10 +195,8 @@ def check_reducer_torque(reducer: RVReducer, torque: float, field: str = "torque
     ----------
     Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
     """
-    d = reducer.discs
-    check_pin_pressure(
-        field, torque, cycloid_stage(reducer), 1.0 / d.count, d.youngs_modulus, d.poisson_ratio
-    )
+    stage, share, E, nu = _pin_pressure_inputs(reducer, share)
+    check_pin_pressure(field, torque, stage, share, E, nu)
 
 
 @dataclass(frozen=True)

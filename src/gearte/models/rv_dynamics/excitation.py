@@ -143,7 +143,8 @@ def disc_rotation_error(
     torque_per_disc : float
         Torque each disc carries [N·mm] (the output torque / N), > 0, and no more than the
         pins carry (the case files' pin-pressure ceiling,
-        :func:`gearte.models.contact_law.check_pin_pressure`, with the whole share on one disc).
+        :func:`gearte.models.rv_load_sharing.check_reducer_torque` with the whole share on one
+        disc).
     samples_per_mesh : int
         Output angles per mesh period ``2π/(z_p z_c)`` [-] (≥ 2).
 
@@ -166,8 +167,7 @@ def disc_rotation_error(
     ----------
     Li X. et al. (2023), Machines 11(6), 626, eq 3-4. doi:10.3390/machines11060626
     """
-    from gearte.models.contact_law import check_pin_pressure
-    from gearte.models.rv_load_sharing import contact_law, cycloid_stage
+    from gearte.models.rv_load_sharing import check_reducer_torque, contact_law
 
     n_discs = reducer.discs.count
     if not has_pin_errors(reducer):
@@ -175,14 +175,7 @@ def disc_rotation_error(
     if not np.isfinite(torque_per_disc) or torque_per_disc <= 0:
         raise ParameterError("torque_per_disc", torque_per_disc, "must be finite and > 0 N·mm")
     # beyond the pins' contact law the loaded rotation is no solution (the case files' check)
-    check_pin_pressure(
-        "torque_per_disc",
-        torque_per_disc,
-        cycloid_stage(reducer),
-        1.0,
-        reducer.discs.youngs_modulus,
-        reducer.discs.poisson_ratio,
-    )
+    check_reducer_torque(reducer, torque_per_disc, "torque_per_disc", share=1.0)
     if int(samples_per_mesh) != samples_per_mesh or samples_per_mesh < 2:
         raise ParameterError("samples_per_mesh", samples_per_mesh, "must be an integer ≥ 2")
     zp, zc = reducer.pins.count, reducer.cycloid_teeth

@@ -385,21 +385,13 @@ DYNAMIC_ONLY = (
 def _check_output_torque(reducer, output_torque_Nm: float) -> None:  # noqa: N803
     """A :class:`ParameterError` naming ``output_torque_Nm`` [N·m] unless it is finite, > 0 and
     within what the pins carry (the case files' pin-pressure ceiling, ideal share over the
-    discs: :func:`gearte.models.contact_law.implausible_pin_pressure`)."""
-    from gearte.models.contact_law import implausible_pin_pressure
-    from gearte.models.rv_load_sharing import cycloid_stage
+    discs: :func:`gearte.models.rv_load_sharing.implausible_reducer_torque`)."""
+    from gearte.models.rv_load_sharing import implausible_reducer_torque
     from gearte.units import Nm_to_Nmm
 
     if not (np.isfinite(output_torque_Nm) and output_torque_Nm > 0):
         raise ParameterError("output_torque_Nm", output_torque_Nm, "must be finite and > 0 [N·m]")
-    d = reducer.discs
-    reason = implausible_pin_pressure(
-        cycloid_stage(reducer),
-        float(Nm_to_Nmm(output_torque_Nm)),
-        1.0 / d.count,
-        d.youngs_modulus,
-        d.poisson_ratio,
-    )
+    reason = implausible_reducer_torque(reducer, float(Nm_to_Nmm(output_torque_Nm)))
     if reason is not None:
         raise ParameterError("output_torque_Nm", output_torque_Nm, reason)
 
