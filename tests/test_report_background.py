@@ -244,6 +244,56 @@ def test_planetary_report_is_drawn_without_importing_numba(case: str) -> None:
     assert _page(html.removesuffix("\n")) == _page(render_report(result))
 
 
+_STAND_IN = r"""
+import pickle, sys
+from gearte.report.background import _numba_stand_in, _Report, warm_up_plotting
+_numba_stand_in()  # what the report process does first
+case, modules, case_bytes, analyses, final = pickle.loads(sys.stdin.buffer.read())
+warm_up_plotting(case)
+rep = _Report(preload=True)
+rep.take(("preload", modules, case_bytes))
+for i, data in enumerate(analyses):
+    rep.take(("analysis", i, data))
+while rep.todo or any(rep.built.values()):
+    rep.step()
+html, _ = rep.finish(final)
+print(sorted(m for m in sys.modules if m.startswith("numba.")))
+print(html)
+"""
+
+
+@pytest.mark.parametrize("case", ["hu2020_rv80e_initial", "li2023_rv_errors"])
+def test_report_process_unpickles_kernel_results_without_numba(case: str) -> None:
+    """The report process of a kind whose results live in modules that define kernels (tooth
+    contact, load sharing, TE, catalogue, mesh contact, modal, DTE, ODE results) imports the
+    parent's gearte modules and unpickles every analysis with the numba stand-in
+    (``_numba_stand_in``), importing nothing of numba, and the page it renders is the page
+    drawn in one process from the whole result."""
+    import pickle
+
+    from gearte.report.background import _analysis_bytes, _final_frame
+    from gearte.report.html import render_report
+    from gearte.studies import RunOptions, run_case
+
+    result = run_case(case, RunOptions(progress=False, samples=8))
+    sent = {id(a): (a, i, _analysis_bytes(a)) for i, a in enumerate(result.analyses)}
+    final = pickle.loads(_final_frame(result, sent)[8:])
+    modules = sorted(m for m in sys.modules if m.startswith("gearte.") and m != "gearte.__main__")
+    data = [case, modules, pickle.dumps(result.case), [v[2] for v in sent.values()], final]
+    p = subprocess.run(
+        [sys.executable, "-c", _STAND_IN],
+        input=pickle.dumps(data),
+        capture_output=True,
+        timeout=300,
+        check=False,
+    )
+    assert p.returncode == 0, p.stderr.decode()[-3000:]
+    numba, html = p.stdout.decode().split("\n", 1)
+    assert numba == "[]"  # not one numba submodule: the stand-in only
+    assert html.count("data:image/png;base64,") >= 5
+    assert _page(html.removesuffix("\n")) == _page(render_report(result))
+
+
 def _page(html: str) -> str:
     import re
 
