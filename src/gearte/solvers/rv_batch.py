@@ -140,6 +140,10 @@ def problem_from_system(system, law) -> tuple[BatchProblem, np.ndarray, np.ndarr
     """The batch problem of an assembled system (its ``G`` positions are the geometries) and its
     own per-sample inputs ``(h, bearing offsets, gaps)`` of shape (1, G, …).
 
+    Built once per system and law (code, start stiffness, coefficients): kept on ``system``
+    and returned again for the same law, with the condensation kept on the problem. The arrays
+    are shared between those calls: read them, do not modify them.
+
     Parameters
     ----------
     system : gearte.models.rv_load_sharing.RVSystem
@@ -148,12 +152,21 @@ def problem_from_system(system, law) -> tuple[BatchProblem, np.ndarray, np.ndarr
     from gearte.solvers.rv_equilibrium import _linear_parts, _split_springs, as_solver_law
 
     law = as_solver_law(law, system)
-    lin, Bn, en0, kn, cn = _split_springs(system)
     G, nd = system.theta.size, system.layout.size
+    nc = system.contact_gap.shape[1]
+    coef = law.coefficients(G, nc)
+    # kept on the system for the next solve with the same law (its condensation is kept on the
+    # problem): transmission_error solves each system at two torques, the compensation and
+    # the catalogue loop many systems several times
+    kept = system.__dict__.get("_batch_problem")
+    if kept is not None:
+        (code, stiffness, kept_coef), out = kept
+        if code == law.code and stiffness == law.stiffness and np.array_equal(kept_coef, coef):
+            return out
+    lin, Bn, en0, kn, cn = _split_springs(system)
     K0, f0 = _linear_parts(
         system.spring_B[:, lin], system.spring_e[:, lin], system.spring_k[lin], np.zeros((G, nd))
     )
-    nc = system.contact_gap.shape[1]
     problem = BatchProblem(
         K0=K0,
         unit_load=system.unit_load,
@@ -163,11 +176,13 @@ def problem_from_system(system, law) -> tuple[BatchProblem, np.ndarray, np.ndarr
         bearing_c=cn,
         group=system.contact_group.astype(np.int64),
         law=law.code,
-        coef=law.coefficients(G, nc),
+        coef=coef,
         start_stiffness=law.stiffness,
         output=system.layout.output_rotation,
     )
-    return problem, -f0[None], en0[None], system.contact_gap[None]
+    out = (problem, -f0[None], en0[None], system.contact_gap[None])
+    object.__setattr__(system, "_batch_problem", ((law.code, law.stiffness, coef), out))
+    return out
 
 
 @dataclass(frozen=True)
