@@ -272,13 +272,69 @@ def one_pass_layout(fig: Any) -> bool:
 
 
 def polish(fig: Any) -> Any:
-    """Decimate long lines of ``fig`` (a matplotlib figure), put legends outside the data and
-    integer ticks on integer data."""
+    """Decimate long lines of ``fig`` (a matplotlib figure), put legends outside the data,
+    integer ticks on integer data and plain-text labels on logarithmic axes."""
     cache_font_heights()
     _decimate_lines(fig)
     _integer_ticks(fig)
     _legends_outside(fig)
+    _plain_log_labels(fig)
     return fig
+
+
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+_PLAIN_LOG: list[Any] = []  # the formatter class, made on first use (matplotlib imports lazily)
+
+
+def _plain_log_formatter() -> Any:
+    """matplotlib's base-10 log tick formatter with the labels as plain text: ``10⁻³``,
+    ``2×10⁻³`` (Unicode superscripts) instead of mathtext (``$\\mathdefault{10^{-3}}$``).
+
+    Which ticks are labelled (decades, and minor ticks where the axis spans less than a decade
+    or so) is matplotlib's :class:`~matplotlib.ticker.LogFormatter` logic, unchanged; only the
+    text differs. Mathtext needs its parser, built on the first such label of a process
+    (~0.15-0.3 s CPU), and lays out each label in pieces."""
+    if not _PLAIN_LOG:
+        import math
+
+        from matplotlib.ticker import LogFormatter
+
+        class PlainLogFormatter(LogFormatter):
+            def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
+                fx = math.log10(x)
+                exponent = round(fx)
+                if abs(fx - exponent) < 1e-10:  # matplotlib's _is_close_to_int
+                    return "10" + str(exponent).translate(_SUPERSCRIPT)
+                exponent = math.floor(fx)
+                coeff = round(10.0 ** (fx - exponent))
+                return f"{coeff}×10" + str(exponent).translate(_SUPERSCRIPT)
+
+        _PLAIN_LOG.append(PlainLogFormatter)
+    return _PLAIN_LOG[0]
+
+
+def _plain_log_labels(fig: Any) -> None:
+    """Give every base-10 logarithmic axis of ``fig`` whose tick formatters are matplotlib's
+    defaults (:class:`~matplotlib.ticker.LogFormatterSciNotation`) the same formatters with
+    plain-text labels (:func:`_plain_log_formatter`)."""
+    from matplotlib.ticker import LogFormatterSciNotation
+
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            if axis.get_scale() != "log":
+                continue
+            for which in ("major", "minor"):
+                old = getattr(axis, f"get_{which}_formatter")()
+                # (its base and symlog threshold are private attributes: read with defaults)
+                if type(old) is not LogFormatterSciNotation or getattr(old, "_base", 0) != 10:
+                    continue
+                new = _plain_log_formatter()(
+                    base=10.0,
+                    labelOnlyBase=old.labelOnlyBase,
+                    minor_thresholds=old.minor_thresholds,
+                    linthresh=getattr(old, "_linthresh", None),
+                )
+                getattr(axis, f"set_{which}_formatter")(new)
 
 
 def distribution(ax: Any, samples: Any, *, color: str, label: str = "", density: bool = False,

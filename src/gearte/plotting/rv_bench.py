@@ -14,8 +14,6 @@ __all__ = ["figures", "SELF_CONTAINED"]
 #: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`);
 #: not the catalogue (its hysteresis figure draws the calibrated model beside the bench curve).
 SELF_CONTAINED = frozenset({"te_orders"})
-#: Some figure has a log axis (the report process warms matplotlib's mathtext parser up for it).
-LOG_AXES = True
 
 
 def _analysis(result, name):

@@ -14,8 +14,6 @@ __all__ = ["figures", "SELF_CONTAINED"]
 
 #: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`).
 SELF_CONTAINED = frozenset({"contact", "dte", "modal", "speed_sweep", "batch"})
-#: Some figure has a log axis (the report process warms matplotlib's mathtext parser up for it).
-LOG_AXES = True
 
 
 def _contact_figure(a) -> Figure:

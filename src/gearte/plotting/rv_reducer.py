@@ -26,8 +26,6 @@ SELF_CONTAINED = (
     | rv_dynamics.SELF_CONTAINED
     | _YIELD
 )
-#: Some figure has a log axis (the dynamics' DTE spectrum).
-LOG_AXES = rv_dynamics.LOG_AXES
 
 
 #: Width of the pin-load maps' colorbar and its gap to the last map [inch].

@@ -41,9 +41,9 @@ def warm_up_plotting(case: Any = None) -> None:
     text to PNG (loads the font and fills matplotlib's text caches); with ``case`` (what
     :func:`gearte.io.case_file.load_case` takes), first import its study kind and plotting
     module (what unpickling its result and drawing its figures need; the case is not validated
-    here), and give the figure a log axis (building matplotlib's mathtext parser for its tick
-    labels, ~0.15-0.3 s CPU) only where that plotting module draws one (``LOG_AXES``). A case
-    whose kind cannot be read is ignored here (unpickling imports what it needs)."""
+    here). A case whose kind cannot be read is ignored here (unpickling imports what it needs).
+    No figure needs matplotlib's mathtext parser (log axes get plain-text tick labels,
+    :func:`gearte.plotting.display.polish`), so the warm-up does not build it."""
     import jinja2  # noqa: F401
     from matplotlib.backends import backend_agg  # noqa: F401
 
@@ -54,13 +54,10 @@ def warm_up_plotting(case: Any = None) -> None:
     from gearte.plotting import new_figure
     from gearte.report.html import figure_to_png_base64
 
-    log_axes = case is None
     if case is not None:
-        log_axes = bool(getattr(_plotting_module(case), "LOG_AXES", False))
+        _plotting_module(case)
     fig, ax = new_figure(figsize=(2.0, 1.5))
     ax.plot([1.0, 2.0], [1.0, 100.0], label="x")
-    if log_axes:
-        ax.set_yscale("log")  # builds the mathtext parser of log tick labels
     ax.set_xlabel("0123456789 [mm]")
     ax.set_ylabel("−.,e+ [arcmin]")
     ax.set_title("Warm-up")
