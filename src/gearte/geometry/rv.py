@@ -817,12 +817,22 @@ class PinContacts:
     gap: np.ndarray
 
 
+def _sum2(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``np.sum`` of ``[x, y]`` stacked on a last axis, bit for bit, without the reduction.
+
+    ``np.add.reduce`` starts from its identity ``+0.0``: ``(0 + x) + y``, which differs from
+    ``x + y`` in the sign of a zero sum of two negative zeros.
+    """
+    return (0.0 + x) + y
+
+
 def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
     """Contact normals, arms and initial clearances of all pins of all discs (every error family).
 
     The one computation of the pin clearances that the quasi-static model
     (:func:`gearte.models.rv_load_sharing.assemble`) and the dynamics
-    (:func:`gearte.models.rv_dynamics.disc_rotation_error`) read.
+    (:func:`gearte.models.rv_dynamics.disc_rotation_error`) read. All discs are computed at
+    once; only the cumulative pitch error and a measured disc are added disc by disc.
 
     Parameters
     ----------
@@ -868,37 +878,53 @@ def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
         :, None
     ] * np.stack([-pin_dir[:, 1], pin_dir[:, 0]], -1)
     ecc = -zc * th[:, None] + 2.0 * np.pi * np.arange(N)[None, :] / N  # (P, N)
-    cdir = np.stack([np.cos(ecc), np.sin(ecc)], -1)  # (P, N, 2)
-    v = pin_pos[None, None] - (a * zp * cdir)[:, :, None, :]  # (P, N, zp, 2)
-    n = v / np.linalg.norm(v, axis=-1, keepdims=True)
-    lever = pin_pos[None, None] - pins.pin_radius * n - (a * cdir)[:, :, None, :]
-    arm = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
+    cx, cy = np.cos(ecc)[..., None], np.sin(ecc)[..., None]  # (P, N, 1): eccentric direction
+    # components (P, N, zp) of the pin's offset from the pitch point, its normal and lever
+    vx = pin_pos[:, 0] - a * zp * cx
+    vy = pin_pos[:, 1] - a * zp * cy
+    norm = np.sqrt(_sum2(vx * vx, vy * vy))  # numpy.linalg.norm, bit for bit
+    nx, ny = vx / norm, vy / norm
+    lx = pin_pos[:, 0] - pins.pin_radius * nx - a * cx
+    ly = pin_pos[:, 1] - pins.pin_radius * ny - a * cy
+    n = np.stack([nx, ny], -1)
+    lever = np.stack([lx, ly], -1)
+    arm = lx * ny - ly * nx
     phi = alpha_k[None, None, :] - ecc[:, :, None]
-    gap = np.empty((P, N, zp))
-    c, s_ = np.cos(th), np.sin(th)
-    for j in range(N):
-        d_rp, d_p = err.disc_modification[j]
-        g = normal_clearance_unclosed(
-            phi[:, j],
-            z_p=zp,
-            r_p=pins.circle_radius,
-            a=a,
-            dr_rp=reducer.discs.equidistant_modification + d_rp,
-            dr_p=reducer.discs.shift_modification + d_p,
+    # each disc's modified profile (nominal modifications + that disc's modification errors)
+    mods = np.stack(
+        [
+            reducer.discs.equidistant_modification + err.disc_modification[:, 0],
+            reducer.discs.shift_modification + err.disc_modification[:, 1],
+        ],
+        -1,
+    )  # (N, 2): dr_rp, dr_p
+    if np.all(mods.view(np.int64) == mods[:1].view(np.int64)):  # one profile, bit for bit
+        gap = normal_clearance_unclosed(
+            phi, z_p=zp, r_p=pins.circle_radius, a=a, dr_rp=mods[0, 0], dr_p=mods[0, 1]
         )
-        g = g - pins.radius_errors[None, :] + np.sum(n[:, j] * pin_err[None], axis=-1)
-        rx, ry = err.disc_runout[j]
-        runout = np.stack([rx * c - ry * s_, rx * s_ + ry * c], -1)  # disc frame -> ground
-        g = g - np.sum(n[:, j] * runout[:, None, :], axis=-1)
+    else:
+        gap = np.empty((P, N, zp))
+        for j in range(N):
+            gap[:, j] = normal_clearance_unclosed(
+                phi[:, j], z_p=zp, r_p=pins.circle_radius, a=a, dr_rp=mods[j, 0], dr_p=mods[j, 1]
+            )
+    gap = gap - pins.radius_errors + _sum2(nx * pin_err[:, 0], ny * pin_err[:, 1])
+    c, s_ = np.cos(th)[:, None], np.sin(th)[:, None]
+    rx, ry = err.disc_runout[:, 0], err.disc_runout[:, 1]
+    runout_x = (rx * c - ry * s_)[..., None]  # (P, N, 1): disc frame -> ground
+    runout_y = (rx * s_ + ry * c)[..., None]
+    gap = gap - _sum2(nx * runout_x, ny * runout_y)
+    for j in range(N):
         fp = float(np.hypot(*err.disc_pitch[j]))
         if fp > 0.0:
-            psi = np.arctan2(lever[:, j, :, 1], lever[:, j, :, 0]) - th[:, None]
+            psi = np.arctan2(ly[:, j], lx[:, j]) - th[:, None]
             ang = np.arctan2(err.disc_pitch[j, 1], err.disc_pitch[j, 0])
-            g = g - arm[:, j] * 0.5 * fp * np.sin(psi - ang) / (a * zc)
+            gap[:, j] = gap[:, j] - arm[:, j] * 0.5 * fp * np.sin(psi - ang) / (a * zc)
         measured = None if err.measured_discs is None else err.measured_discs[j]
         if measured is not None:  # measured flank per tooth and pitch per tooth (issue 16)
-            g = g + measured.gap_change(np.arange(zp)[None, :], phi[:, j], arm[:, j], a * zc)
-        gap[:, j] = g
+            gap[:, j] = gap[:, j] + measured.gap_change(
+                np.arange(zp)[None, :], phi[:, j], arm[:, j], a * zc
+            )
     return PinContacts(th, n, lever, arm, phi, gap)
 
 

@@ -40,6 +40,7 @@ Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/ap
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -412,21 +413,64 @@ def _u(a: np.ndarray) -> np.ndarray:
     return np.stack([np.cos(a), np.sin(a)], axis=-1)
 
 
-def _rot(v: np.ndarray, a: np.ndarray) -> np.ndarray:
-    """Rotate vectors ``v[..., 2]`` by angles ``a`` (broadcast)."""
-    c, s = np.cos(a), np.sin(a)
+def _rot(v: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Rotate vectors ``v[..., 2]`` by the angles of cosines ``c`` and sines ``s`` (broadcast)."""
     return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
 
 
-def _point_row(row: np.ndarray, dof: int, r: np.ndarray, n: np.ndarray, sign: float, rot=True):
-    """Add ``sign * n · u(point)`` of a body (dof x, y, theta) with lever ``r`` to ``row``.
+def _point_row(r: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Rotation entry ``r × n = r_x n_y − r_y n_x`` of a row ``n · u(point)``, lever ``r``.
 
-    ``row``: (P, nd); ``r``, ``n``: (P, 2).
+    A body (dof x, y, theta) enters the row ``n · u(point)`` with the entries
+    ``(n_x, n_y, r × n)``; ``r``, ``n``: ``(..., 2)``, broadcast.
     """
-    row[:, dof] += sign * n[:, 0]
-    row[:, dof + 1] += sign * n[:, 1]
-    if rot:
-        row[:, dof + 2] += sign * (r[:, 0] * n[:, 1] - r[:, 1] * n[:, 0])
+    return r[..., 0] * n[..., 1] - r[..., 1] * n[..., 0]
+
+
+@functools.lru_cache(maxsize=32)
+def _row_pattern(n_cranks: int, n_discs: int) -> tuple[np.ndarray, np.ndarray]:
+    """Constant entries of the spring rows and where the angle-dependent ones go.
+
+    Returns ``(B0, index)``: ``B0`` (ns, nd), the rows' entries that do not depend on the
+    output angle (the ``±1`` and ``0`` of the rows along ``x`` and ``y``); ``index``, the flat
+    indices into (ns, nd) of the others, in the order :func:`assemble` lists their values:
+    rotation of the carrier in the carrier crank bearings (crank, x/y), rotation of the crank
+    in the cam bearings (crank, disc, x/y), rotation of the disc in the cam bearings (crank,
+    disc, x/y), sun (x, y) then crank (x, y, theta) entries of each mesh (crank). Read-only.
+    """
+    lay = DofLayout(n_cranks, n_discs)
+    M, N, nd = n_cranks, n_discs, lay.size
+    s_car = 4
+    s_cam = s_car + 2 * M
+    s_mesh = s_cam + 2 * M * N
+    B0 = np.zeros((s_mesh + M, nd))
+    for d in range(2):
+        B0[d, lay.sun + d] = 1.0
+        B0[2 + d, lay.carrier + d] = 1.0
+    car_rot: list[tuple[int, int]] = []
+    cam_crank: list[tuple[int, int]] = []
+    cam_disc: list[tuple[int, int]] = []
+    for i in range(M):
+        for d in range(2):
+            row = s_car + 2 * i + d
+            B0[row, lay.crank(i) + d] = 1.0
+            B0[row, lay.carrier + d] = -1.0
+            car_rot.append((row, lay.carrier + 2))
+    for i in range(M):
+        for j in range(N):
+            for d in range(2):
+                row = s_cam + 2 * (i * N + j) + d
+                B0[row, lay.crank(i) + d] = 1.0
+                B0[row, lay.disc(j) + d] = -1.0
+                cam_crank.append((row, lay.crank(i) + 2))
+                cam_disc.append((row, lay.disc(j) + 2))
+    mesh = [(s_mesh + i, lay.sun + c) for i in range(M) for c in range(2)]
+    mesh += [(s_mesh + i, lay.crank(i) + c) for i in range(M) for c in range(3)]
+    rc = np.array(car_rot + cam_crank + cam_disc + mesh)
+    index = rc[:, 0] * nd + rc[:, 1]
+    B0.setflags(write=False)
+    index.setflags(write=False)
+    return B0, index
 
 
 def _measured(design: float, measured: np.ndarray | None, index) -> float:
@@ -436,6 +480,11 @@ def _measured(design: float, measured: np.ndarray | None, index) -> float:
 
 def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     """Spring and contact rows of ``reducer`` at output angles ``theta`` [rad].
+
+    Each family of rows (sun support, main bearings, carrier crank bearings, cam bearings,
+    sun–planet meshes, pin contacts) is computed at once for all angles, cranks, discs and both
+    directions ``x``, ``y`` of an isotropic bearing; rows are ordered crank by crank, then disc
+    by disc, ``x`` before ``y``.
 
     Parameters
     ----------
@@ -460,101 +509,101 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     err = reducer.errors
     assert err is not None  # RVReducer.__post_init__ fills in zero errors
     ex, ey = np.array([1.0, 0.0]), np.array([0.0, 1.0])
-    zero2 = np.zeros((P, 2))
+    dirs = np.stack([ex, ey])  # (2, 2): the direction of a bearing's x row, then its y row
 
-    rows: list[np.ndarray] = []
-    offs: list[np.ndarray] = []
-    ks: list[float] = []
-    cs: list[float] = []
-    labels: dict[str, slice] = {}
-
-    def add(row, off, k, c=0.0):
-        rows.append(row)
-        offs.append(off)
-        ks.append(k)
-        cs.append(c)
-
-    # sun support (2 rows): w = u_sun - seat offset (sun assembly error, ground frame)
-    start = len(rows)
-    for d in (ex, ey):
-        r = np.zeros((P, nd))
-        _point_row(r, lay.sun, zero2, np.broadcast_to(d, (P, 2)), 1.0, rot=False)
-        add(r, np.full(P, -err.sun_seat @ d), reducer.first_stage.sun_support_stiffness)
-    labels["sun_support"] = slice(start, len(rows))
-
-    # carrier main bearings (2 rows): w = u_carrier - seat offset (output assembly error)
-    start = len(rows)
-    for d in (ex, ey):
-        r = np.zeros((P, nd))
-        _point_row(r, lay.carrier, zero2, np.broadcast_to(d, (P, 2)), 1.0)
-        add(r, np.full(P, -err.output_seat @ d), reducer.supports.carrier_radial_stiffness)
-    labels["main_bearing"] = slice(start, len(rows))
-
-    crank_ang = th[:, None] + 2.0 * np.pi * np.arange(M)[None, :] / M  # (P, M)
-    crank_pos = Rdc * _u(crank_ang)  # (P, M, 2)
-    ecc1 = -zc * th  # absolute crank angle = eccentric direction of disc 1
-    ecc = ecc1[:, None] + 2.0 * np.pi * np.arange(N)[None, :] / N  # (P, N)
-
-    # carrier crank bearings: w = u_crank - u_carrier(bore) - eps_carrier
-    start = len(rows)
+    # Row layout: sun support (2: x, y), main bearings (2), carrier crank bearings (2 M),
+    # cam bearings (2 M N), sun-planet meshes (M). Every row w = B · q + e is a sum of body
+    # entries (n_x, n_y, r × n) (sign -1 for the second body) added to zeros, each (row, dof)
+    # once: B = 0.0 + entry, so a zero entry is +0.0; the x/y rows' ±1 and 0 are B0.
+    s_car = 4
+    s_cam = s_car + 2 * M
+    s_mesh = s_cam + 2 * M * N
+    ns = s_mesh + M
+    labels = {
+        "sun_support": slice(0, 2),
+        "main_bearing": slice(2, s_car),
+        "carrier_bearing": slice(s_car, s_cam),
+        "cam_bearing": slice(s_cam, s_mesh),
+        "mesh": slice(s_mesh, ns),
+    }
+    ks: list[float] = [reducer.first_stage.sun_support_stiffness] * 2
+    ks += [reducer.supports.carrier_radial_stiffness] * 2
+    cs: list[float] = [0.0] * 4
     for i in range(M):
-        eps = _rot(np.broadcast_to(err.carrier_bore[i], (P, 2)), crank_ang[:, i])
-        for d in (ex, ey):
-            r = np.zeros((P, nd))
-            dd = np.broadcast_to(d, (P, 2))
-            _point_row(r, lay.crank(i), zero2, dd, 1.0)
-            _point_row(r, lay.carrier, crank_pos[:, i], dd, -1.0)
-            add(
-                r,
-                -eps @ d,
-                reducer.cranks.carrier_bearing_stiffness,
-                _measured(reducer.cranks.carrier_bearing_clearance, err.carrier_clearance, i),
-            )
-    labels["carrier_bearing"] = slice(start, len(rows))
-
-    # cam bearings: w = u_crank(cam) + eps_cam - u_disc(bore) - eps_bore
-    start = len(rows)
+        ks += [reducer.cranks.carrier_bearing_stiffness] * 2
+        cs += [_measured(reducer.cranks.carrier_bearing_clearance, err.carrier_clearance, i)] * 2
     for i in range(M):
         for j in range(N):
-            cam_r = a * _u(ecc[:, j])
-            eps_cam = _rot(np.broadcast_to(err.cam[i, j], (P, 2)), ecc[:, j])
-            eps_bore = _rot(np.broadcast_to(err.disc_bore[j, i], (P, 2)), crank_ang[:, i])
-            for d in (ex, ey):
-                r = np.zeros((P, nd))
-                dd = np.broadcast_to(d, (P, 2))
-                _point_row(r, lay.crank(i), cam_r, dd, 1.0)
-                _point_row(r, lay.disc(j), crank_pos[:, i], dd, -1.0)
-                add(
-                    r,
-                    (eps_cam - eps_bore) @ d,
-                    reducer.cranks.cam_bearing_stiffness,
-                    _measured(reducer.cranks.cam_bearing_clearance, err.cam_clearance, (i, j)),
-                )
-    labels["cam_bearing"] = slice(start, len(rows))
+            ks += [reducer.cranks.cam_bearing_stiffness] * 2
+            cam_c = _measured(reducer.cranks.cam_bearing_clearance, err.cam_clearance, (i, j))
+            cs += [cam_c] * 2
+    ks += [reducer.first_stage.mesh_stiffness] * M
+    cs += [0.0] * M
+
+    crank_ang = th[:, None] + 2.0 * np.pi * np.arange(M)[None, :] / M  # (P, M)
+    rho = _u(crank_ang)  # (P, M, 2): radial direction of each crank
+    crank_pos = Rdc * rho
+    ecc1 = -zc * th  # absolute crank angle = eccentric direction of disc 1
+    ecc = ecc1[:, None] + 2.0 * np.pi * np.arange(N)[None, :] / N  # (P, N)
+    u_ecc = _u(ecc)  # (P, N, 2)
+    cam_r = a * u_ecc  # (P, N, 2)
+
+    # sun support: w = u_sun - seat offset (sun assembly error, ground frame);
+    # carrier main bearings: w = u_carrier - seat offset (output assembly error)
+    spring_e = np.empty((P, ns))
+    spring_e[:, :s_car] = [
+        -err.sun_seat @ ex,
+        -err.sun_seat @ ey,
+        -err.output_seat @ ex,
+        -err.output_seat @ ey,
+    ]
+
+    # carrier crank bearings (crank i; x, y): w = u_crank - u_carrier(bore) - eps_carrier
+    car_rot = -1.0 * _point_row(crank_pos[:, :, None, :], dirs)  # (P, M, 2): carrier at bore
+    cos_c, sin_c = rho[..., 0].T, rho[..., 1].T  # (M, P)
+    neg_eps = -_rot(err.carrier_bore[:, None, :], cos_c, sin_c)  # (M, P, 2)
+    e_car = np.stack([neg_eps @ ex, neg_eps @ ey], -1)  # (M, P, 2): one (P, 2) @ d per crank
+    spring_e[:, s_car:s_cam] = e_car.transpose(1, 0, 2).reshape(P, 2 * M)
+
+    # cam bearings (crank i, disc j; x, y): w = u_crank(cam) + eps_cam - u_disc(bore) - eps_bore
+    cam_rot = 1.0 * _point_row(cam_r[:, :, None, :], dirs)  # (P, N, 2): crank at its cam j
+    eps_cam = _rot(err.cam[:, :, None, :], u_ecc[..., 0].T, u_ecc[..., 1].T)  # (M, N, P, 2)
+    v = err.disc_bore.transpose(1, 0, 2)[:, :, None, :]  # (M, N, 1, 2)
+    de = eps_cam - _rot(v, cos_c[:, None], sin_c[:, None])  # (M, N, P, 2)
+    e_cam = np.stack([de @ ex, de @ ey], -1)  # (M, N, P, 2): one (P, 2) @ d per cam
+    spring_e[:, s_cam:s_mesh] = e_cam.transpose(2, 0, 1, 3).reshape(P, 2 * M * N)
 
     # sun-planet meshes along the working line of action (sun drives, counter-clockwise)
-    start = len(rows)
     alpha_w = reducer.working_pressure_angle
     rb1, _ = reducer.first_stage.base_radii
     z1, z2 = reducer.first_stage.sun_teeth, reducer.first_stage.planet_teeth
     rw1 = Rdc * z1 / (z1 + z2)
-    for i in range(M):
-        rho = _u(crank_ang[:, i])
-        t = _u(crank_ang[:, i] + np.pi / 2)
-        n = np.cos(alpha_w) * t + np.sin(alpha_w) * rho  # force direction on the planet
-        pitch = rw1 * rho
-        cp = crank_pos[:, i]
-        tp = pitch - np.sum((pitch - cp) * n, axis=-1, keepdims=True) * n
-        r = np.zeros((P, nd))
-        _point_row(r, lay.sun, zero2, n, 1.0, rot=False)
-        _point_row(r, lay.crank(i), tp - cp, n, -1.0)
-        eps_pl = _rot(np.broadcast_to(err.planet[i], (P, 2)), ecc1)
-        eps_sun = _rot(np.broadcast_to(err.sun, (P, 2)), reducer.ratio * th)
-        add(r, np.sum((eps_sun - eps_pl) * n, axis=-1), reducer.first_stage.mesh_stiffness)
-    labels["mesh"] = slice(start, len(rows))
+    t = _u(crank_ang + np.pi / 2)
+    n = np.cos(alpha_w) * t + np.sin(alpha_w) * rho  # (P, M, 2) force direction on the planet
+    pitch = rw1 * rho
+    cp = crank_pos
+    tp = pitch - np.sum((pitch - cp) * n, axis=-1, keepdims=True) * n
+    mesh_crank = -1.0 * np.stack([n[..., 0], n[..., 1], _point_row(tp - cp, n)], -1)
+    eps_pl = _rot(err.planet[:, None, :], np.cos(ecc1), np.sin(ecc1)).transpose(1, 0, 2)
+    sun_ang = reducer.ratio * th
+    eps_sun = _rot(err.sun, np.cos(sun_ang), np.sin(sun_ang))[:, None, :]  # (P, 1, 2)
+    spring_e[:, s_mesh:] = np.sum((eps_sun - eps_pl) * n, axis=-1)
 
-    spring_B = np.stack(rows, axis=1)
-    spring_e = np.stack(offs, axis=1)
+    B0, index = _row_pattern(M, N)
+    entries = np.concatenate(
+        [
+            car_rot.reshape(P, 2 * M),
+            np.broadcast_to(cam_rot[:, None], (P, M, N, 2)).reshape(P, 2 * M * N),
+            np.broadcast_to(car_rot[:, :, None], (P, M, N, 2)).reshape(P, 2 * M * N),
+            1.0 * n.reshape(P, 2 * M),  # the sun's (x, y) in each mesh
+            mesh_crank.reshape(P, 3 * M),  # the crank's (x, y, theta) in each mesh
+        ],
+        axis=1,
+    )
+    entries += 0.0  # added to the zeros of the row (turns -0.0 into +0.0)
+    spring_B = np.empty((P, ns, nd))
+    spring_B[:] = B0
+    spring_B.reshape(P, ns * nd)[:, index] = entries
     spring_k = np.asarray(ks)
 
     # pin contacts: normals, arms and initial clearances with every error family
