@@ -1467,6 +1467,12 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
     a = case.analyses
     out: list[AnalysisResult] = []
     warnings: list[str] = []
+    # the dynamics run first and are reported last: their figures (the DTE, its spectrum, the
+    # trajectories) are the costliest to draw, and the report process of `gearte run` draws
+    # each analysis's figures while the next analyses run (gearte.report.background)
+    dynamics: tuple[list[AnalysisResult], list[str]] = ([], [])
+    if any(getattr(a, k) is not None for k in dyn.ANALYSES):
+        dynamics = dyn.run_dynamics(case, red, options)
     if a.load_sharing is not None:
         out.append(_load_sharing(red, red0, a.load_sharing, law))
     if a.transmission_error is not None:
@@ -1485,10 +1491,8 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
         got, w = _cycloid_analyses(case, options)
         out += got
         warnings += w
-    if any(getattr(a, k) is not None for k in dyn.ANALYSES):
-        got, w = dyn.run_dynamics(case, red, options)
-        out += got
-        warnings += w
+    out += dynamics[0]
+    warnings += dynamics[1]
     for r in out:  # each says its law when it is made (a result is streamed to the report then)
         if r.name in ("load_sharing", "transmission_error", "catalogue", "compensation"):
             if r.values.get("contact_law") != case.reducer.contact_law:
