@@ -61,7 +61,8 @@ def main() -> None:
 
         # numpy: the same Nelder-Mead on a numpy objective, fewer starts, scaled per start
         _, harm, _ = frequency_basis(terms)
-        import gearte.runners.planetary_assembly as pa
+        # optimal_assembly imports sample_extremes from the model where it calls it: swap it there
+        import gearte.models.planetary_errors as pa
 
         real = pa.sample_extremes
 
