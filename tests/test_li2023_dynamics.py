@@ -92,6 +92,19 @@ def test_compiled_rhs_matches_plain_twin(model):
         np.testing.assert_allclose(out, ref, rtol=1e-11, atol=1e-9 * np.max(np.abs(ref)))
 
 
+def test_compiled_rhs_short_work_gives_nan(model):
+    """A work array shorter than RHS_WORK_SIZE is never written past its end: the kernel returns
+    NaN derivatives, which the integrators report as a divergence."""
+    args = model.kernel_args()
+    y = np.zeros(2 * model.n_dof)
+    out = np.zeros(2 * model.n_dof)
+    rv_rhs(0.0, y, args, out, np.full(RHS_WORK_SIZE - 1, np.nan))
+    assert np.all(np.isnan(out))
+    system = replace(ode_system(model), work_size=0)
+    with pytest.raises(DivergenceError):
+        integrate(system, y, (0.0, 1e-4), dt=1e-5)
+
+
 def test_static_equilibrium_torque_and_compression(model):
     q = model.static_equilibrium(0.0)
     p = model.params

@@ -12,10 +12,11 @@ never stores trajectories. Non-finite states are detected in the loop and raised
 linearised system is refused with the limit in the message.
 
 Caching: the kernels are copies of module-level templates whose globals bind the system's
-``rhs``/``output``, compiled with ``cache=True`` under a name that carries a hash of the source
-files of ``rhs`` and ``output``: editing the model gives a new cache entry instead of silently
-reusing a kernel with a stale inlined rhs (numba itself only checks the kernel's own file). No
-closures: numba keys cached closures by their pickled cells, which change every process.
+``rhs``/``output`` (``output`` inlined at its one call site), compiled with ``cache=True`` under a
+name that carries a hash of the source files of ``rhs`` and ``output``: editing the model gives a
+new cache entry instead of silently reusing a kernel with a stale inlined rhs (numba itself only
+checks the kernel's own file). No closures: numba keys cached closures by their pickled cells,
+which change every process.
 """
 
 from __future__ import annotations
@@ -161,7 +162,9 @@ rhs: Any = None
 output: Any = None
 
 
-@njit(cache=True, nogil=True)
+# The helpers have one call site in each template: typed there (inline="always") they cost less
+# than kernels of their own, which numba compiles, optimises and links into every caller.
+@njit(cache=True, nogil=True, inline="always")
 def _stats_update(stats, o):
     stats[0] += 1.0
     if o < stats[1]:
@@ -172,7 +175,7 @@ def _stats_update(stats, o):
     stats[4] += o * o
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _env_update(env, b, o):
     if o < env[b, 0]:
         env[b, 0] = o
@@ -201,41 +204,29 @@ def _rk4_template(
     n_out = n_steps - settle_steps + 1  # output samples after settling (envelope buckets)
     h2 = 0.5 * dt
     h6 = dt / 6.0
-    if settle_steps == 0:
-        o = output(t0, y, args)
-        _stats_update(stats, o)
-        if n_env > 0:
-            # bucket 0 as an int64 (0 * n_env), not the literal 0: numba compiles a kernel once
-            # per literal argument, and _env_update is called with an int64 below
-            _env_update(env, 0 * n_env, o)
-        if rec_every > 0:
-            if cap_t > 0:
-                trace[0] = o
-            if cap > 0:
-                for c in range(rec_idx.size):
-                    rec[0, c] = y[rec_idx[c]]
-            nrec = 1
-    for s in range(n_steps):
-        t = t0 + s * dt
-        rhs(t, y, args, k1, work)
-        for i in range(n):
-            tmp[i] = y[i] + h2 * k1[i]
-        rhs(t + h2, tmp, args, k2, work)
-        for i in range(n):
-            tmp[i] = y[i] + h2 * k2[i]
-        rhs(t + h2, tmp, args, k3, work)
-        for i in range(n):
-            tmp[i] = y[i] + dt * k3[i]
-        t_next = t0 + (s + 1) * dt  # bit-identical to the next step's t (rhs may memoise by t)
-        rhs(t_next, tmp, args, k4, work)
-        acc = 0.0
-        for i in range(n):
-            y[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            acc += y[i]
-        if not np.isfinite(acc):
-            return y, stats, nrec, s + 1
+    # s = -1 is the state at t0 (no step): one call site of output, which kernels() inlines
+    for s in range(-1, n_steps):
+        if s >= 0:
+            t = t0 + s * dt
+            rhs(t, y, args, k1, work)
+            for i in range(n):
+                tmp[i] = y[i] + h2 * k1[i]
+            rhs(t + h2, tmp, args, k2, work)
+            for i in range(n):
+                tmp[i] = y[i] + h2 * k2[i]
+            rhs(t + h2, tmp, args, k3, work)
+            for i in range(n):
+                tmp[i] = y[i] + dt * k3[i]
+            t_next = t0 + (s + 1) * dt  # bit-identical to the next step's t (rhs may memoise)
+            rhs(t_next, tmp, args, k4, work)
+            acc = 0.0
+            for i in range(n):
+                y[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+                acc += y[i]
+            if not np.isfinite(acc):
+                return y, stats, nrec, s + 1
         if s + 1 >= settle_steps:
-            o = output(t_next, y, args)
+            o = output(t0 + (s + 1) * dt, y, args)
             _stats_update(stats, o)
             j = s + 1 - settle_steps
             if n_env > 0:
@@ -402,7 +393,7 @@ def _specialise(template, rhs, output, key: str, name: str):
     """
     g = dict(template.__globals__)
     g["rhs"] = rhs
-    g["output"] = output
+    g["output"] = _inline_twin(output)
     fn = types.FunctionType(template.__code__, g, f"{name}_{key}", template.__defaults__, None)
     fn.__qualname__ = f"{name}_{key}"
     fn.__module__ = template.__module__
@@ -417,6 +408,16 @@ def _source_key(*funcs) -> str:
         h.update(py.__qualname__.encode())
         h.update(Path(inspect.getsourcefile(py) or "").read_bytes())
     return h.hexdigest()[:16]
+
+
+@lru_cache(maxsize=16)
+def _inline_twin(fn):
+    """``fn`` (a numba dispatcher, e.g. the system's output) as a kernel numba writes into its
+    caller (``inline="always"``): the templates call the output at one site, and a small function
+    typed there costs less than a kernel of its own (numba compiles, optimises and links a callee
+    separately, about 0.1–0.2 s on a cold cache; docs/numba.md). Not cached on its own: nothing
+    calls it from Python."""
+    return njit(inline="always", nogil=True)(fn.py_func)
 
 
 @lru_cache(maxsize=16)

@@ -2,8 +2,18 @@
 
 :func:`rv_rhs` is the numba kernel the integrators of :mod:`gearte.solvers.ode` call; its readable
 plain twin is :meth:`gearte.models.rv_dynamics.assembly.RVDynamicModel.rhs_numpy` (the element
-loop), and the tests compare both. The scalar parameter vector's layout is ``PF_INDEX``; its
-values are packed by :meth:`~gearte.models.rv_dynamics.assembly.RVDynamicModel.kernel_args`.
+loop), and the tests compare both. The kernel's arguments are two arrays: the scalar parameters
+``pf`` (layout ``PF_INDEX``) and the table ``tab`` of the per-body arrays (:func:`kernel_table`),
+both packed by :meth:`~gearte.models.rv_dynamics.assembly.RVDynamicModel.kernel_args`.
+
+What the first (cold-cache) compile of the kernels costs, and why the kernel is written as it is
+(issue 12, ``docs/numba.md``): numba types and lowers every statement and LLVM optimises the
+module once for :func:`rv_rhs` and again inside every integrator that calls it, so the kernel
+reads each array element once into a local, sums each body's forces in locals and stores them
+once (one store instead of a read and a write per element force), gives every variable one
+assignment (reassigned names cost numba's SSA pass a sweep over the function each) and takes
+two arrays instead of a tuple of twelve (each array in the tuple is unboxed, reference-counted
+and passed field by field in every function the tuple goes through).
 
 References
 ----------
@@ -20,7 +30,15 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-__all__ = ["rv_rhs", "rv_dte", "RHS_SOURCE_KEY", "RHS_WORK_SIZE", "PF_INDEX", "NPF"]
+__all__ = [
+    "rv_rhs",
+    "rv_dte",
+    "kernel_table",
+    "RHS_SOURCE_KEY",
+    "RHS_WORK_SIZE",
+    "PF_INDEX",
+    "NPF",
+]
 
 _SLOT = 16  # t, 6 trigonometric values, 6 involute and 3 cycloid mesh stiffnesses
 RHS_WORK_SIZE = 2 * _SLOT + 1
@@ -71,10 +89,40 @@ PF_INDEX = {
             "sin_alpha",
             "cos_beta_cr",
             "sin_beta_cr",
+            "n_fsp",  # Fourier terms of the involute mesh stiffness (columns of fsp)
+            "n_fcr",  # Fourier terms of the cycloid–pin stiffness (columns of fcr)
+            "n_rot",  # samples per output revolution of the discs' rotation excitation
         ]
     )
 }
 NPF = len(PF_INDEX)
+
+
+def kernel_table(inv_mass, err_g, err_m, err_mn, err_n, geo_m, geo_n, clear, fsp, fcr, rot_n):
+    """The per-body arrays of :func:`rv_rhs`, flattened (C order) one after the other into one
+    float array, in the order of the arguments (the kernel computes their offsets from the
+    counts in ``pf``):
+
+    inv_mass (nd) 1/mass [1/t, 1/(t·mm²)] of every DOF; err_g (3, 2) sun eccentricity, sun and
+    output assembly offsets; err_m (M, 2, 2) planet eccentricity, carrier hole; err_mn
+    (M, N, 2, 2) disc hole, cam; err_n (N, 2) pin composite error; geo_m (M, 4) cos/sin of the
+    crank angle ψ_i and of z_s ψ_i; geo_n (N, 4) cos/sin of the disc phase χ_j and of z_p χ_j;
+    clear (M, N + 1) bearing clearances [mm]; fsp (2, L1), fcr (2, L2) Fourier coefficients of
+    the mesh stiffnesses [N/mm]; rot_n (N, K) the discs' rotation excitation [rad]. Errors are
+    body-fixed Cartesian offsets (E cos β, E sin β) [mm].
+    """
+    parts = [
+        np.asarray(a, dtype=float)
+        for a in (inv_mass, err_g, err_m, err_mn, err_n, geo_m, geo_n, clear, fsp, fcr, rot_n)
+    ]
+    m, n = parts[3].shape[:2]
+    shapes = [(3 * (2 * m + n + 2),), (3, 2), (m, 2, 2), (m, n, 2, 2), (n, 2), (m, 4), (n, 4)]
+    shapes += [(m, n + 1), (2, -1), (2, -1), (n, -1)]  # -1: any length
+    for a, shape in zip(parts, shapes, strict=True):
+        ok = a.ndim == len(shape) and all(k in (-1, d) for k, d in zip(shape, a.shape, strict=True))
+        if not ok:
+            raise ValueError(f"kernel_table: an array of shape {a.shape}, expected {shape}")
+    return np.concatenate([a.ravel() for a in parts])
 
 
 @njit(cache=True, nogil=True)
@@ -90,55 +138,71 @@ def _bearing(dx, dy, vx, vy, k, c, cl):
 
 
 @njit(cache=True, nogil=True)
-def _fourier2(mean, coef, c1, s1):
-    """mean + Σ_l a_l cos(l s) + b_l sin(l s) given cos s and sin s (angle-addition recurrence)."""
+def _fourier2(mean, tab, o, n, c1, s1):
+    """mean + Σ_l a_l cos(l s) + b_l sin(l s) given cos s and sin s (angle-addition recurrence);
+    a_l = ``tab[o + l]``, b_l = ``tab[o + n + l]`` (l < n)."""
     c = c1
     s = s1
     val = mean
-    for ll in range(coef.shape[1]):
-        val += coef[0, ll] * c + coef[1, ll] * s
+    for ll in range(n):
+        val += tab[o + ll] * c + tab[o + n + ll] * s
         c, s = c * c1 - s * s1, s * c1 + c * s1
     return val
 
 
-@njit(cache=True, nogil=True)
+# no_rewrites (a numba target option its type stubs do not list): numba's IR rewrite passes
+# (array expressions, constant getitems, raises) find nothing to rewrite in this kernel; skipping
+# them saves ~10 % of its compile's Python work, for the same LLVM IR
+@njit(cache=True, nogil=True, no_rewrites=True)  # type: ignore[call-overload]
 def rv_rhs(t, y, args, dydt, work):
     """dy/dt of the lumped RV model at time ``t`` [s], written into ``dydt`` (compiled; plain twin:
     ``RVDynamicModel.rhs_numpy``).
 
     y = [q (6M+3N+6), q̇]; q per body (x [mm], y [mm], θ [rad]) in the order sun, planets 1..M,
-    cranks 1..M, discs 1..N, output. ``args`` = (pf, inv_mass, fsp, fcr, err_g, err_m, err_mn,
-    err_n, geo_m, geo_n, rot_n, clear) from :meth:`RVDynamicModel.kernel_args` (``rot_n``: the
-    discs' rotation excitation, ``clear``: the clearance of every crank bearing); errors are given
-    there as body-fixed Cartesian offsets (E cos β, E sin β) and rotated here with the body, so the
-    only trigonometric calls per evaluation are the five nominal angles. ``work`` (``RHS_WORK_SIZE``
-    floats, NaN-filled, one per integration) memoises them and the mesh stiffnesses for the last two
-    times, so RK4 computes them twice per step instead of four times; pass ``np.full(RHS_WORK_SIZE,
-    np.nan)`` (a shorter array makes the call allocate its own).
+    cranks 1..M, discs 1..N, output. ``args`` = (pf, tab) from :meth:`RVDynamicModel.kernel_args`:
+    the scalar parameters (``PF_INDEX``) and the per-body arrays (:func:`kernel_table`); errors
+    are given there as body-fixed Cartesian offsets (E cos β, E sin β) and rotated here with the
+    body, so the only trigonometric calls per evaluation are the five nominal angles. ``work``
+    (``RHS_WORK_SIZE`` floats, NaN-filled, one per integration) memoises them and the mesh
+    stiffnesses for the last two times, so RK4 computes them twice per step instead of four
+    times; pass ``np.full(RHS_WORK_SIZE, np.nan)`` (a shorter array gives NaN derivatives, which
+    the integrators report as a divergence).
     """
-    pf, inv_m, fsp, fcr, err_g, err_m, err_mn, err_n, geo_m, geo_n, rot_n, clear = args
-    nm = int(pf[30])
-    nn = int(pf[31])
+    pf, tab = args
+    nm = np.int64(pf[30])  # counts: exact integers stored as floats
+    nn = np.int64(pf[31])
+    n_sp = np.int64(pf[36])
+    n_cr = np.int64(pf[37])
+    n_rot = np.int64(pf[38])
     nd = 3 * (2 * nm + nn + 2)
+    # offsets of the arrays in tab, in kernel_table's order (inv_mass at 0)
+    o_eg = nd
+    o_em = o_eg + 6
+    o_emn = o_em + 4 * nm
+    o_en = o_emn + 4 * nm * nn
+    o_gm = o_en + 2 * nn
+    o_gn = o_gm + 4 * nm
+    o_cl = o_gn + 4 * nn
+    o_sp = o_cl + nm * (nn + 1)
+    o_cr = o_sp + 2 * n_sp
+    o_rot = o_cr + 2 * n_cr
+    if work.size < RHS_WORK_SIZE:  # too short for the memo: NaN, which the integrators refuse
+        dydt[:] = np.nan
+        return
     q = y[:nd]
     v = y[nd:]
     f = dydt[nd:]
-    for i in range(nd):
-        dydt[i] = v[i]
-        f[i] = 0.0
+    for i0 in range(nd):
+        dydt[i0] = v[i0]
+        f[i0] = 0.0
     w_o = pf[0]
     th_o = w_o * t
     th_s = pf[1] * th_o
     th_h = pf[3] + pf[2] * th_o
     # Memo of everything that depends on t only (nominal angles, mesh stiffnesses): two slots
     # [t, cos/sin of θ_o, θ_s, θ_H, k_sp,i (≤ 6), k_cr,j (≤ 3)] and a flag naming the older slot.
-    if work.size < RHS_WORK_SIZE:
-        work = np.full(RHS_WORK_SIZE, np.nan)
-    if work[0] == t:
-        o = 0
-    elif work[_SLOT] == t:
-        o = _SLOT
-    else:
+    o = 0 if work[0] == t else _SLOT  # the slot holding t, if one does
+    if work[o] != t:
         o = _SLOT if work[2 * _SLOT] != 1.0 else 0
         work[2 * _SLOT] = 1.0 if o == _SLOT else 0.0
         work[o] = t
@@ -151,22 +215,20 @@ def rv_rhs(t, y, args, dydt, work):
         ph_s = pf[8] * (th_s - th_o)
         cps0 = np.cos(ph_s)
         sps0 = np.sin(ph_s)
-        for i in range(nm):  # involute mesh stiffness (eq 11), phase z_s(θ_s − θ_o) + z_s ψ_i
-            work[o + 7 + i] = _fourier2(
-                pf[12],
-                fsp,
-                cps0 * geo_m[i, 2] - sps0 * geo_m[i, 3],
-                sps0 * geo_m[i, 2] + cps0 * geo_m[i, 3],
+        for i1 in range(nm):  # involute mesh stiffness (eq 11), phase z_s(θ_s − θ_o) + z_s ψ_i
+            c1 = tab[o_gm + 4 * i1 + 2]
+            s1 = tab[o_gm + 4 * i1 + 3]
+            work[o + 7 + i1] = _fourier2(
+                pf[12], tab, o_sp, n_sp, cps0 * c1 - sps0 * s1, sps0 * c1 + cps0 * s1
             )
         ph_c = pf[9] * th_h
         cpc0 = np.cos(ph_c)
         spc0 = np.sin(ph_c)
-        for j in range(nn):  # cycloid–pin stiffness (eq 13), phase z_p χ_j
-            work[o + 13 + j] = _fourier2(
-                pf[17],
-                fcr,
-                cpc0 * geo_n[j, 2] - spc0 * geo_n[j, 3],
-                spc0 * geo_n[j, 2] + cpc0 * geo_n[j, 3],
+        for j1 in range(nn):  # cycloid–pin stiffness (eq 13), phase z_p χ_j
+            c2 = tab[o_gn + 4 * j1 + 2]
+            s2 = tab[o_gn + 4 * j1 + 3]
+            work[o + 13 + j1] = _fourier2(
+                pf[17], tab, o_cr, n_cr, cpc0 * c2 - spc0 * s2, spc0 * c2 + cpc0 * s2
             )
     co = work[o + 1]
     so = work[o + 2]
@@ -181,35 +243,62 @@ def rv_rhs(t, y, args, dydt, work):
     sa = pf[33]
     br = pf[21]
     i_out = nd - 3
+    # Each body's force [N] and moment [N·mm] is summed in locals, element after element in the
+    # order of the element model, from 0.0 (0.0 - a, not -a: the sign of a zero result is kept),
+    # and stored once.
+    qsx = q[0]
+    qsy = q[1]
+    qst = q[2]
+    vsx = v[0]
+    vsy = v[1]
+    vst = v[2]
+    qox = q[i_out]
+    qoy = q[i_out + 1]
+    qot = q[i_out + 2]
+    vox = v[i_out]
+    voy = v[i_out + 1]
+    vot = v[i_out + 2]
     # sun support (ground seat offset = sun assembly error) and input shaft torsion
-    k = pf[10]
-    fx, fy = _bearing(q[0] - err_g[1, 0], q[1] - err_g[1, 1], v[0], v[1], k, br * k, 0.0)
-    f[0] += fx
-    f[1] += fy
-    k = pf[11]
-    f[2] += -k * q[2] - br * k * v[2]
+    k_s = pf[10]
+    bsx, bsy = _bearing(qsx - tab[o_eg + 2], qsy - tab[o_eg + 3], vsx, vsy, k_s, br * k_s, 0.0)
+    fsx = 0.0 + bsx
+    fsy = 0.0 + bsy
+    k_st = pf[11]
+    fst = 0.0 + (-k_st * qst - br * k_st * vst)
     # output support
-    k = pf[18]
-    fx, fy = _bearing(
-        q[i_out] - err_g[2, 0],
-        q[i_out + 1] - err_g[2, 1],
-        v[i_out],
-        v[i_out + 1],
-        k,
-        br * k,
-        pf[28],
-    )
-    f[i_out] += fx
-    f[i_out + 1] += fy
+    k_o = pf[18]
+    box, boy = _bearing(qox - tab[o_eg + 4], qoy - tab[o_eg + 5], vox, voy, k_o, br * k_o, pf[28])
+    fox = 0.0 + box
+    foy = 0.0 + boy
+    fot = 0.0
     # sun eccentricity offset (rotates with the sun)
-    sex = err_g[0, 0] * cs - err_g[0, 1] * ss
-    sey = err_g[0, 0] * ss + err_g[0, 1] * cs
+    es0 = tab[o_eg]
+    es1 = tab[o_eg + 1]
+    sex = es0 * cs - es1 * ss
+    sey = es0 * ss + es1 * cs
     w2 = w_o * w_o * a_h
+    mp_w2 = pf[23] * w2
+    mh_w2 = pf[24] * w2
+    k_h = pf[13]
+    k_ht = pf[14]
+    k_hb = pf[15]
     for i in range(nm):
         ip = 3 * (1 + i)
         ih = 3 * (1 + nm + i)
-        cps = co * geo_m[i, 0] - so * geo_m[i, 1]  # psi_i = th_o + 2π i / M
-        sps = so * geo_m[i, 0] + co * geo_m[i, 1]
+        qpx = q[ip]
+        qpy = q[ip + 1]
+        qpt = q[ip + 2]
+        vpx = v[ip]
+        vpy = v[ip + 1]
+        vpt = v[ip + 2]
+        qhx = q[ih]
+        qhy = q[ih + 1]
+        vhx = v[ih]
+        vhy = v[ih + 1]
+        gm0 = tab[o_gm + 4 * i]
+        gm1 = tab[o_gm + 4 * i + 1]
+        cps = co * gm0 - so * gm1  # psi_i = th_o + 2π i / M
+        sps = so * gm0 + co * gm1
         chx = a_h * cps
         chy = a_h * sps
         # sun–planet mesh i: line of action tangent to the sun base circle at angle psi − alpha
@@ -220,132 +309,144 @@ def rv_rhs(t, y, args, dydt, work):
         px = r_bs * tx
         py = r_bs * ty
         ksp = work[o + 7 + i]
-        pex = err_m[i, 0, 0] * chh - err_m[i, 0, 1] * shh
-        pey = err_m[i, 0, 0] * shh + err_m[i, 0, 1] * chh
+        ie = o_em + 4 * i
+        pe0 = tab[ie]
+        pe1 = tab[ie + 1]
+        pex = pe0 * chh - pe1 * shh
+        pey = pe0 * shh + pe1 * chh
         ga_t = px * ny - py * nx  # arm of the sun
         gb_t = (px - chx) * ny - (py - chy) * nx  # arm of the planet
         d = (
-            nx * (q[0] - q[ip])
-            + ny * (q[1] - q[ip + 1])
-            + ga_t * q[2]
-            - gb_t * q[ip + 2]
+            nx * (qsx - qpx)
+            + ny * (qsy - qpy)
+            + ga_t * qst
+            - gb_t * qpt
             + nx * (sex - pex)
             + ny * (sey - pey)
         )
-        dv = nx * (v[0] - v[ip]) + ny * (v[1] - v[ip + 1]) + ga_t * v[2] - gb_t * v[ip + 2]
+        dv = nx * (vsx - vpx) + ny * (vsy - vpy) + ga_t * vst - gb_t * vpt
         fn = -ksp * d - br * ksp * dv
-        f[0] += fn * nx
-        f[1] += fn * ny
-        f[2] += fn * ga_t
-        f[ip] -= fn * nx
-        f[ip + 1] -= fn * ny
-        f[ip + 2] -= fn * gb_t
+        fsx += fn * nx
+        fsy += fn * ny
+        fst += fn * ga_t
         # planet–crank shaft: bending (translation) and torsion
-        k = pf[13]
-        fx, fy = _bearing(
-            q[ip] - q[ih],
-            q[ip + 1] - q[ih + 1],
-            v[ip] - v[ih],
-            v[ip + 1] - v[ih + 1],
-            k,
-            br * k,
-            0.0,
-        )
-        f[ip] += fx
-        f[ip + 1] += fy
-        f[ih] -= fx
-        f[ih + 1] -= fy
-        k = pf[14]
-        tq = -k * (q[ip + 2] - q[ih + 2]) - br * k * (v[ip + 2] - v[ih + 2])
-        f[ip + 2] += tq
-        f[ih + 2] -= tq
+        fbx, fby = _bearing(qpx - qhx, qpy - qhy, vpx - vhx, vpy - vhy, k_h, br * k_h, 0.0)
+        tq = -k_ht * (qpt - q[ih + 2]) - br * k_ht * (vpt - v[ih + 2])
+        f[ip + 2] = (0.0 - fn * gb_t) + tq
+        f[ih + 2] = 0.0 - tq
         # crank support bearing in the output disc (hole offset rotates with the output)
-        k = pf[15]
-        ox = err_m[i, 1, 0] * cps - err_m[i, 1, 1] * sps
-        oy = err_m[i, 1, 0] * sps + err_m[i, 1, 1] * cps
+        oe0 = tab[ie + 2]
+        oe1 = tab[ie + 3]
+        ox = oe0 * cps - oe1 * sps
+        oy = oe0 * sps + oe1 * cps
         # output material point at c_H: u_o + θ_o ẑ×c_H
-        dx = q[ih] - (q[i_out] - q[i_out + 2] * chy) - ox
-        dy = q[ih + 1] - (q[i_out + 1] + q[i_out + 2] * chx) - oy
-        vx = v[ih] - (v[i_out] - v[i_out + 2] * chy)
-        vy = v[ih + 1] - (v[i_out + 1] + v[i_out + 2] * chx)
-        fx, fy = _bearing(dx, dy, vx, vy, k, br * k, clear[i, nn])
-        f[ih] += fx
-        f[ih + 1] += fy
-        f[i_out] -= fx
-        f[i_out + 1] -= fy
-        f[i_out + 2] -= chx * fy - chy * fx
+        dx = qhx - (qox - qot * chy) - ox
+        dy = qhy - (qoy + qot * chx) - oy
+        vx = vhx - (vox - vot * chy)
+        vy = vhy - (voy + vot * chx)
+        cl_h = tab[o_cl + (nn + 1) * i + nn]
+        fkx, fky = _bearing(dx, dy, vx, vy, k_hb, br * k_hb, cl_h)
+        fox -= fkx
+        foy -= fky
+        fot -= chx * fky - chy * fkx
         # centripetal load of the carried planet and crank (nominal circular motion)
-        f[ip] += pf[23] * w2 * cps
-        f[ip + 1] += pf[23] * w2 * sps
-        f[ih] += pf[24] * w2 * cps
-        f[ih + 1] += pf[24] * w2 * sps
+        f[ip] = ((0.0 - fn * nx) + fbx) + mp_w2 * cps
+        f[ip + 1] = ((0.0 - fn * ny) + fby) + mp_w2 * sps
+        f[ih] = ((0.0 - fbx) + fkx) + mh_w2 * cps
+        f[ih + 1] = ((0.0 - fby) + fky) + mh_w2 * sps
+    f[0] = fsx
+    f[1] = fsy
+    f[2] = fst
+    f[i_out] = fox
+    f[i_out + 1] = foy
     # discs
     w_h = pf[2] * w_o
     sb = pf[35]
     cb = pf[34]
+    k_cb = pf[16]
+    sgn_r = pf[20]
+    zp1 = pf[9] - 1.0
+    mc_w2 = pf[25] * w_h * w_h
     # pin and disc-profile errors: rotation shift Δθ_j(θ_o) of each disc, K samples per
     # output revolution, linearly interpolated (plain twin: assembly.periodic_interp)
-    n_rot = rot_n.shape[1]
     x_rot = th_o / (2.0 * np.pi)
     x_rot = (x_rot - np.floor(x_rot)) * n_rot
-    i_rot = int(x_rot)
-    w_rot = x_rot - i_rot
-    i_rot = i_rot % n_rot
+    i_x = int(x_rot)
+    w_rot = x_rot - i_x
+    i_rot = i_x % n_rot
     i_rot1 = (i_rot + 1) % n_rot
     for j in range(nn):
         ic = 3 * (1 + 2 * nm + j)
-        ex = chh * geo_n[j, 0] - shh * geo_n[j, 1]  # chi_j = th_h + π j
-        ey = shh * geo_n[j, 0] + chh * geo_n[j, 1]
+        qcx = q[ic]
+        qcy = q[ic + 1]
+        qct = q[ic + 2]
+        vcx = v[ic]
+        vcy = v[ic + 1]
+        vct = v[ic + 2]
+        gn0 = tab[o_gn + 4 * j]
+        gn1 = tab[o_gn + 4 * j + 1]
+        ex = chh * gn0 - shh * gn1  # chi_j = th_h + π j
+        ey = shh * gn0 + chh * gn1
         ccx = ecc * ex
         ccy = ecc * ey
-        for i in range(nm):
-            ih = 3 * (1 + nm + i)
-            cps = co * geo_m[i, 0] - so * geo_m[i, 1]
-            sps = so * geo_m[i, 0] + co * geo_m[i, 1]
-            chx = a_h * cps
-            chy = a_h * sps
+        fcx = 0.0  # the disc's force and moment
+        fcy = 0.0
+        fct = 0.0
+        for i2 in range(nm):
+            ih2 = 3 * (1 + nm + i2)
+            gk0 = tab[o_gm + 4 * i2]
+            gk1 = tab[o_gm + 4 * i2 + 1]
+            cps2 = co * gk0 - so * gk1
+            sps2 = so * gk0 + co * gk1
+            chx2 = a_h * cps2
+            chy2 = a_h * sps2
             # turning-arm bearing at the cam centre C = c_H + e ê_χ
-            k = pf[16]
-            amx = err_mn[i, j, 1, 0] * ex - err_mn[i, j, 1, 1] * ey  # cam (with crank)
-            amy = err_mn[i, j, 1, 0] * ey + err_mn[i, j, 1, 1] * ex
-            hox = err_mn[i, j, 0, 0] * cps - err_mn[i, j, 0, 1] * sps  # hole (with disc)
-            hoy = err_mn[i, j, 0, 0] * sps + err_mn[i, j, 0, 1] * cps
+            imn = o_emn + 4 * (nn * i2 + j)
+            ae0 = tab[imn + 2]
+            ae1 = tab[imn + 3]
+            amx = ae0 * ex - ae1 * ey  # cam (with crank)
+            amy = ae0 * ey + ae1 * ex
+            he0 = tab[imn]
+            he1 = tab[imn + 1]
+            hox = he0 * cps2 - he1 * sps2  # hole (with disc)
+            hoy = he0 * sps2 + he1 * cps2
             # arms: C − c_H = e ê_χ (crank), C − c_c = c_H (disc)
-            dx = (q[ih] - q[ih + 2] * ccy) - (q[ic] - q[ic + 2] * chy) + amx - hox
-            dy = (q[ih + 1] + q[ih + 2] * ccx) - (q[ic + 1] + q[ic + 2] * chx) + amy - hoy
-            vx = (v[ih] - v[ih + 2] * ccy) - (v[ic] - v[ic + 2] * chy)
-            vy = (v[ih + 1] + v[ih + 2] * ccx) - (v[ic + 1] + v[ic + 2] * chx)
-            fx, fy = _bearing(dx, dy, vx, vy, k, br * k, clear[i, j])
-            f[ih] += fx
-            f[ih + 1] += fy
-            f[ih + 2] += ccx * fy - ccy * fx
-            f[ic] -= fx
-            f[ic + 1] -= fy
-            f[ic + 2] -= chx * fy - chy * fx
+            qht = q[ih2 + 2]
+            vht = v[ih2 + 2]
+            dx2 = (q[ih2] - qht * ccy) - (qcx - qct * chy2) + amx - hox
+            dy2 = (q[ih2 + 1] + qht * ccx) - (qcy + qct * chx2) + amy - hoy
+            vx2 = (v[ih2] - vht * ccy) - (vcx - vct * chy2)
+            vy2 = (v[ih2 + 1] + vht * ccx) - (vcy + vct * chx2)
+            cl_a = tab[o_cl + (nn + 1) * i2 + j]
+            fax, fay = _bearing(dx2, dy2, vx2, vy2, k_cb, br * k_cb, cl_a)
+            f[ih2] += fax
+            f[ih2 + 1] += fay
+            f[ih2 + 2] += ccx * fay - ccy * fax
+            fcx -= fax
+            fcy -= fay
+            fct -= chx2 * fay - chy2 * fax
         # equivalent cycloid–pin contact at the pitch point P = z_p e ê_χ (eq 27, rotating)
         kcr = work[o + 13 + j]
         # force on the disc along d = sgn sinβ ê + cosβ ẑ×ê ; approach direction n = −d
-        nx = -(pf[20] * sb * ex - cb * ey)
-        ny = -(pf[20] * sb * ey + cb * ex)
-        rx = (pf[9] - 1.0) * ccx
-        ry = (pf[9] - 1.0) * ccy
-        g_t = rx * ny - ry * nx
-        ecr = (
-            err_n[j, 0] * so + err_n[j, 1] * co
-        )  # E sin(th_o + φ) = E cosφ sin th_o + E sinφ cos th_o
-        d_rot = (1.0 - w_rot) * rot_n[j, i_rot] + w_rot * rot_n[j, i_rot1]
-        d = nx * q[ic] + ny * q[ic + 1] + g_t * (q[ic + 2] - d_rot) + ecr
-        dv = nx * v[ic] + ny * v[ic + 1] + g_t * v[ic + 2]
-        fn = -kcr * d - br * kcr * dv
-        f[ic] += fn * nx
-        f[ic + 1] += fn * ny
-        f[ic + 2] += fn * g_t
+        nx2 = -(sgn_r * sb * ex - cb * ey)
+        ny2 = -(sgn_r * sb * ey + cb * ex)
+        rx = zp1 * ccx
+        ry = zp1 * ccy
+        g_t = rx * ny2 - ry * nx2
+        # E sin(th_o + φ) = E cosφ sin th_o + E sinφ cos th_o
+        ecr = tab[o_en + 2 * j] * so + tab[o_en + 2 * j + 1] * co
+        i_rj = o_rot + n_rot * j
+        d_rot = (1.0 - w_rot) * tab[i_rj + i_rot] + w_rot * tab[i_rj + i_rot1]
+        d2 = nx2 * qcx + ny2 * qcy + g_t * (qct - d_rot) + ecr
+        dv2 = nx2 * vcx + ny2 * vcy + g_t * vct
+        fn2 = -kcr * d2 - br * kcr * dv2
         # centripetal load of the disc on its eccentric circle
-        f[ic] += pf[25] * w_h * w_h * ccx
-        f[ic + 1] += pf[25] * w_h * w_h * ccy
-    f[i_out + 2] -= pf[22]
-    for i in range(nd):
-        f[i] *= inv_m[i]
+        f[ic] = (fcx + fn2 * nx2) + mc_w2 * ccx
+        f[ic + 1] = (fcy + fn2 * ny2) + mc_w2 * ccy
+        f[ic + 2] = fct + fn2 * g_t
+    f[i_out + 2] = fot - pf[22]
+    for i3 in range(nd):
+        f[i3] *= tab[i3]
 
 
 @njit(cache=True, nogil=True)
@@ -353,5 +454,5 @@ def rv_dte(t, y, args):
     """Dynamic transmission error θ_o − θ_s / i [rad] of state ``y`` at time ``t`` [s]; ``args``
     as for :func:`rv_rhs`."""
     pf = args[0]
-    nd = 3 * (2 * int(pf[30]) + int(pf[31]) + 2)
+    nd = 3 * (2 * np.int64(pf[30]) + np.int64(pf[31]) + 2)
     return y[nd - 1] - y[2] / pf[1]
