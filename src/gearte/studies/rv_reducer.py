@@ -1467,12 +1467,19 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
     a = case.analyses
     out: list[AnalysisResult] = []
     warnings: list[str] = []
-    # the dynamics run first and are reported last: their figures (the DTE, its spectrum, the
-    # trajectories) are the costliest to draw, and the report process of `gearte run` draws
-    # each analysis's figures while the next analyses run (gearte.report.background)
+    # the dynamics and the cycloid analyses run first and are reported last: their figures (the
+    # DTE, its spectrum, the trajectories; the profile, the sensitivities, the tooth contact)
+    # are the costliest to draw, and the report process of `gearte run` draws each analysis's
+    # figures while the next analyses run (gearte.report.background), here the quasi-static
+    # ones (the compensation: tenths of a second)
     dynamics: tuple[list[AnalysisResult], list[str]] = ([], [])
     if any(getattr(a, k) is not None for k in dyn.ANALYSES):
         dynamics = dyn.run_dynamics(case, red, options)
+    cycloid: tuple[list[AnalysisResult], list[str]] = ([], [])
+    if any(getattr(a, k) is not None for k in ("geometric_te", "tooth_contact")) or (
+        a.cycloid_compensation is not None
+    ):
+        cycloid = _cycloid_analyses(case, options)
     if a.load_sharing is not None:
         out.append(_load_sharing(red, red0, a.load_sharing, law))
     if a.transmission_error is not None:
@@ -1485,14 +1492,8 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
         out.append(_yield(case, red0 if red0 is not None else red, a.yield_, options))
     if case.reducer.first_stage.sun_tooth_thickness_allowance is not None:
         out.append(_first_stage_backlash(case, red))
-    if any(getattr(a, k) is not None for k in ("geometric_te", "tooth_contact")) or (
-        a.cycloid_compensation is not None
-    ):
-        got, w = _cycloid_analyses(case, options)
-        out += got
-        warnings += w
-    out += dynamics[0]
-    warnings += dynamics[1]
+    out += cycloid[0] + dynamics[0]
+    warnings += cycloid[1] + dynamics[1]
     for r in out:  # each says its law when it is made (a result is streamed to the report then)
         if r.name in ("load_sharing", "transmission_error", "catalogue", "compensation"):
             if r.values.get("contact_law") != case.reducer.contact_law:
