@@ -156,6 +156,26 @@ def _numba_stand_in() -> None:
     sys.modules["numba"] = stand_in
 
 
+#: Allocations between two young-generation collections of the report process (Python: 700).
+GC_THRESHOLD0 = 50_000
+
+
+def _fewer_collections() -> None:
+    """Move everything imported so far out of the collector's sight (``gc.freeze``) and let the
+    young generation grow to :data:`GC_THRESHOLD0` objects before it is collected.
+
+    Building and drawing matplotlib figures allocates millions of small containers, and the
+    collector's passes over them took ~15 % of the report process's figure CPU
+    (hu2020_rv80e_initial_reducer's 14 figures, 3 rounds each: 1.15–1.32 s with Python's
+    defaults, 1.01–1.04 s with this; ``gc.freeze`` alone: 1.20–1.28 s). The figures' reference
+    cycles are then freed later: peak RSS 288 → 387 MB for those 42 figures. The report process
+    draws one report and exits."""
+    import gc
+
+    gc.freeze()
+    gc.set_threshold(GC_THRESHOLD0, 20, 100)
+
+
 def _die_with_parent() -> None:
     """Linux: this process gets SIGKILL when its parent dies (no orphaned renderer)."""
     if not sys.platform.startswith("linux"):
@@ -397,6 +417,7 @@ def _serve(req: int, resp: int, parent: int, case: Any) -> None:
         _numba_stand_in()
         _no_setter_docstrings()
         warm_up_plotting(case)
+        _fewer_collections()
         warm = time.perf_counter() - t0
         # a kind whose results unpickle without numba: not the parent's numba-using modules
         numba_free = bool(getattr(_plotting_module(case), "NUMBA_FREE_RESULTS", False))
