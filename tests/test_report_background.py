@@ -195,22 +195,55 @@ def test_figures_of_one_analysis_are_those_of_the_whole_result(
     assert alone and alone == [p for p in whole if p[0] in drawn]  # same pixels and order
 
 
-_NUMBA_FREE = r"""
+_REPORT_SIDE = r"""
 import pickle, sys
-from gearte.report.background import _Report, _plotting_module, warm_up_plotting
-case, case_bytes, analyses, final = pickle.loads(sys.stdin.buffer.read())
+from gearte.report.background import _numba_stand_in, _Report, warm_up_plotting
+stand_in, case, modules, case_bytes, analyses, final = pickle.loads(sys.stdin.buffer.read())
+if stand_in:
+    _numba_stand_in()  # what the report process does first
 warm_up_plotting(case)
-assert _plotting_module(case).NUMBA_FREE_RESULTS
-rep = _Report(preload=False)
-rep.take(("preload", [], case_bytes))
+rep = _Report(preload=bool(modules))
+rep.take(("preload", modules, case_bytes))
 for i, data in enumerate(analyses):
     rep.take(("analysis", i, data))
 while rep.todo or any(rep.built.values()):
     rep.step()
 html, _ = rep.finish(final)
-print("numba" in sys.modules)
+print("numba" in sys.modules, sorted(m for m in sys.modules if m.startswith("numba.")))
 print(html)
 """
+
+
+def _report_side(case: str, samples: int, *, stand_in: bool, preload: bool):
+    """Run ``case`` here, then feed its report process's side (:class:`_Report`) in a fresh
+    interpreter as ``gearte run`` does: the case, each analysis as made, the final result;
+    ``preload``: with the names of this process's gearte modules. Returns the result, the
+    report side's first output line (numba imported, numba submodules) and its page."""
+    import pickle
+
+    from gearte.report.background import _analysis_bytes, _final_frame
+    from gearte.studies import RunOptions, run_case
+
+    result = run_case(case, RunOptions(progress=False, samples=samples))
+    sent = {id(a): (a, i, _analysis_bytes(a)) for i, a in enumerate(result.analyses)}
+    final = pickle.loads(_final_frame(result, sent)[8:])
+    modules = (
+        sorted(m for m in sys.modules if m.startswith("gearte.") and m != "gearte.__main__")
+        if preload
+        else []
+    )
+    analyses = [v[2] for v in sent.values()]
+    data = [stand_in, case, modules, pickle.dumps(result.case), analyses, final]
+    p = subprocess.run(
+        [sys.executable, "-c", _REPORT_SIDE],
+        input=pickle.dumps(data),
+        capture_output=True,
+        timeout=300,
+        check=False,
+    )
+    assert p.returncode == 0, p.stderr.decode()[-3000:]
+    numba, html = p.stdout.decode().split("\n", 1)
+    return result, numba, html.removesuffix("\n")
 
 
 @pytest.mark.parametrize("case", ["wang2013_2kh_eq9", "wang2013_2kh_eq9_yield"])
@@ -220,46 +253,14 @@ def test_planetary_report_is_drawn_without_importing_numba(case: str) -> None:
     figures early and rendering the page import no numba (~0.5 s CPU beside the analyses); the
     page (the histogram built alone after the result: ``OTHERS_READ_ALONE``) is the page drawn
     in one process from the whole result."""
-    import pickle
-
-    from gearte.report.background import _analysis_bytes, _final_frame
+    from gearte.report.background import _plotting_module
     from gearte.report.html import render_report
-    from gearte.studies import RunOptions, run_case
 
-    result = run_case(case, RunOptions(progress=False, samples=2000))
-    sent = {id(a): (a, i, _analysis_bytes(a)) for i, a in enumerate(result.analyses)}
-    final = pickle.loads(_final_frame(result, sent)[8:])
-    data = [case, pickle.dumps(result.case), [v[2] for v in sent.values()], final]
-    p = subprocess.run(
-        [sys.executable, "-c", _NUMBA_FREE],
-        input=pickle.dumps(data),
-        capture_output=True,
-        timeout=300,
-        check=False,
-    )
-    assert p.returncode == 0, p.stderr.decode()[-3000:]
-    numba, html = p.stdout.decode().split("\n", 1)
-    assert numba == "False"
+    assert _plotting_module(case).NUMBA_FREE_RESULTS
+    result, numba, html = _report_side(case, 2000, stand_in=False, preload=False)
+    assert numba == "False []"
     assert html.count("data:image/png;base64,") >= 3
-    assert _page(html.removesuffix("\n")) == _page(render_report(result))
-
-
-_STAND_IN = r"""
-import pickle, sys
-from gearte.report.background import _numba_stand_in, _Report, warm_up_plotting
-_numba_stand_in()  # what the report process does first
-case, modules, case_bytes, analyses, final = pickle.loads(sys.stdin.buffer.read())
-warm_up_plotting(case)
-rep = _Report(preload=True)
-rep.take(("preload", modules, case_bytes))
-for i, data in enumerate(analyses):
-    rep.take(("analysis", i, data))
-while rep.todo or any(rep.built.values()):
-    rep.step()
-html, _ = rep.finish(final)
-print(sorted(m for m in sys.modules if m.startswith("numba.")))
-print(html)
-"""
+    assert _page(html) == _page(render_report(result))
 
 
 @pytest.mark.parametrize("case", ["hu2020_rv80e_initial", "li2023_rv_errors"])
@@ -269,29 +270,12 @@ def test_report_process_unpickles_kernel_results_without_numba(case: str) -> Non
     parent's gearte modules and unpickles every analysis with the numba stand-in
     (``_numba_stand_in``), importing nothing of numba, and the page it renders is the page
     drawn in one process from the whole result."""
-    import pickle
-
-    from gearte.report.background import _analysis_bytes, _final_frame
     from gearte.report.html import render_report
-    from gearte.studies import RunOptions, run_case
 
-    result = run_case(case, RunOptions(progress=False, samples=8))
-    sent = {id(a): (a, i, _analysis_bytes(a)) for i, a in enumerate(result.analyses)}
-    final = pickle.loads(_final_frame(result, sent)[8:])
-    modules = sorted(m for m in sys.modules if m.startswith("gearte.") and m != "gearte.__main__")
-    data = [case, modules, pickle.dumps(result.case), [v[2] for v in sent.values()], final]
-    p = subprocess.run(
-        [sys.executable, "-c", _STAND_IN],
-        input=pickle.dumps(data),
-        capture_output=True,
-        timeout=300,
-        check=False,
-    )
-    assert p.returncode == 0, p.stderr.decode()[-3000:]
-    numba, html = p.stdout.decode().split("\n", 1)
-    assert numba == "[]"  # not one numba submodule: the stand-in only
+    result, numba, html = _report_side(case, 8, stand_in=True, preload=True)
+    assert numba == "True []"  # the stand-in only, not one numba submodule
     assert html.count("data:image/png;base64,") >= 5
-    assert _page(html.removesuffix("\n")) == _page(render_report(result))
+    assert _page(html) == _page(render_report(result))
 
 
 def _page(html: str) -> str:
