@@ -19,6 +19,7 @@ report figure gets in one place.
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
@@ -283,34 +284,33 @@ def polish(fig: Any) -> Any:
 
 
 _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
-_PLAIN_LOG: list[Any] = []  # the formatter class, made on first use (matplotlib imports lazily)
 
 
+@functools.cache
 def _plain_log_formatter() -> Any:
     """matplotlib's base-10 log tick formatter with the labels as plain text: ``10⁻³``,
-    ``2×10⁻³`` (Unicode superscripts) instead of mathtext (``$\\mathdefault{10^{-3}}$``).
+    ``2×10⁻³`` (Unicode superscripts) instead of mathtext (``$\\mathdefault{10^{-3}}$``);
+    the class is made on first use (matplotlib is imported lazily).
 
     Which ticks are labelled (decades, and minor ticks where the axis spans less than a decade
     or so) is matplotlib's :class:`~matplotlib.ticker.LogFormatter` logic, unchanged; only the
     text differs. Mathtext needs its parser, built on the first such label of a process
     (~0.15-0.3 s CPU), and lays out each label in pieces."""
-    if not _PLAIN_LOG:
-        import math
+    import math
 
-        from matplotlib.ticker import LogFormatter
+    from matplotlib.ticker import LogFormatter
 
-        class PlainLogFormatter(LogFormatter):
-            def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
-                fx = math.log10(x)
-                exponent = round(fx)
-                if abs(fx - exponent) < 1e-10:  # matplotlib's _is_close_to_int
-                    return "10" + str(exponent).translate(_SUPERSCRIPT)
-                exponent = math.floor(fx)
-                coeff = round(10.0 ** (fx - exponent))
-                return f"{coeff}×10" + str(exponent).translate(_SUPERSCRIPT)
+    class PlainLogFormatter(LogFormatter):
+        def _num_to_string(self, x: float, vmin: float, vmax: float) -> str:
+            fx = math.log10(x)
+            exponent = round(fx)
+            if abs(fx - exponent) < 1e-10:  # matplotlib's _is_close_to_int
+                return "10" + str(exponent).translate(_SUPERSCRIPT)
+            exponent = math.floor(fx)
+            coeff = round(10.0 ** (fx - exponent))
+            return f"{coeff}×10" + str(exponent).translate(_SUPERSCRIPT)
 
-        _PLAIN_LOG.append(PlainLogFormatter)
-    return _PLAIN_LOG[0]
+    return PlainLogFormatter
 
 
 def _plain_log_labels(fig: Any) -> None:
