@@ -36,14 +36,15 @@ from typing import Any
 __all__ = ["ReportWorker", "warm_up_plotting"]
 
 
-def warm_up_plotting(case: Any = None) -> None:
+def warm_up_plotting(case: Any = None) -> Any:
     """Import what building, rendering and the HTML page need, and draw one small figure with
     text to PNG (loads the font and fills matplotlib's text caches); with ``case`` (what
     :func:`gearte.io.case_file.load_case` takes), first import its study kind and plotting
     module (what unpickling its result and drawing its figures need; the case is not validated
     here). A case whose kind cannot be read is ignored here (unpickling imports what it needs).
     No figure needs matplotlib's mathtext parser (log axes get plain-text tick labels,
-    :func:`gearte.plotting.display.polish`), so the warm-up does not build it."""
+    :func:`gearte.plotting.display.polish`), so the warm-up does not build it. Returns the
+    case's plotting module (``None`` without a case or where it cannot be read)."""
     import jinja2  # noqa: F401
     from matplotlib.backends import backend_agg  # noqa: F401
 
@@ -56,8 +57,7 @@ def warm_up_plotting(case: Any = None) -> None:
 
     report_template()  # compiled now, not after the result
 
-    if case is not None:
-        _plotting_module(case)
+    module = _plotting_module(case) if case is not None else None
     fig, ax = new_figure(figsize=(2.0, 1.5))
     ax.plot([1.0, 2.0], [1.0, 100.0], label="x")
     ax.set_xlabel("0123456789 [mm]")
@@ -65,6 +65,7 @@ def warm_up_plotting(case: Any = None) -> None:
     ax.set_title("Warm-up")
     ax.legend()
     figure_to_png_base64(fig, dpi=50)  # the report's own path: layout, drawing, PNG
+    return module
 
 
 def _plotting_module(case: Any) -> Any:
@@ -416,11 +417,11 @@ def _serve(req: int, resp: int, parent: int, case: Any) -> None:
         t0 = time.perf_counter()
         _numba_stand_in()
         _no_setter_docstrings()
-        warm_up_plotting(case)
+        plotting = warm_up_plotting(case)
         _fewer_collections()
         warm = time.perf_counter() - t0
         # a kind whose results unpickle without numba: not the parent's numba-using modules
-        numba_free = bool(getattr(_plotting_module(case), "NUMBA_FREE_RESULTS", False))
+        numba_free = bool(getattr(plotting, "NUMBA_FREE_RESULTS", False))
         got = _Report(preload=not numba_free).serve(req)
         if got is None:
             return
