@@ -412,7 +412,7 @@ def _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, F, kt, q, H, grad
         H[a, a] += reg
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _newton(
     exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, F, d, kt, wm, wv,
     wc, tol, maxit,
@@ -593,7 +593,7 @@ def _log_update(lf, f, r):
 def _solve_batch(
     K0s, us, regs, cidx, cvals, nidx, nvals, kn, cn, group, ngroups, law, coefs, kstart, Hs, ENs,
     GAPs, step_g, step_T, start, rec, nrec, out_u, out_h, out_q, tol, maxit, exact, given_state,
-    given,
+    given, fd0,
 ):  # fmt: skip
     """All samples × steps. The system is the condensed one (:func:`condense`): stiffness
     ``K0s[g]``, load ``T us[g] − Hs[s, g]``; the output rotation is recovered as
@@ -606,6 +606,12 @@ def _solve_batch(
     A step's state is one vector (:func:`_state_parts`): displacements ``q`` (nd), contact
     forces and approaches (nc each), per-disc (ngroups) and per-contact (nc) stiffness — one
     copy where a step starts from another (each copy site is compiled code of its own).
+    ``fd0``: (2, nc) work array of the exact per-contact law's start (its forces and
+    approaches, kept for the fallback), or ``None`` where the batch does not solve that law
+    (another law, or ``exact=False``): numba then prunes the ``fd0 is not None`` branches
+    before typing, and that specialisation compiles neither :func:`_newton_mixed` nor the
+    fallback (issue 12: the per-disc law's cases compile less).
+
     Returns the output rotation, the recorded forces and the iterations per step, and the
     state of every step of the last sample (a one-sample batch's whole solution)."""
     S = Hs.shape[0]
@@ -627,7 +633,6 @@ def _solve_batch(
     kt = np.zeros(nc)
     f0 = np.zeros(nd)
     q0 = np.zeros(nd)
-    fd0 = np.zeros((2, nc))
     wm = np.zeros((2, nd, nd))
     wv = np.zeros((3, nd))
     wc = np.zeros((3, nc))
@@ -662,23 +667,25 @@ def _solve_batch(
                 qtol = 1e-13 * qmax
                 # exact (per-contact law only): _newton_mixed from the warm forces first; where
                 # it fails, Newton on Π with the exact law (_newton); the secant fixed point only
-                # where both fail. One call site of _newton for the exact-law retry and the fixed
-                # point; its law flag a run-time bool (a constant True/False would compile
-                # _newton and _energy once per literal value, docs/numba.md)
+                # where both fail. One call site of _newton (inlined) for the exact-law retry and
+                # the fixed point; its law flag a run-time bool (a constant True/False would
+                # compile _energy once per literal value, docs/numba.md). Where fd0 is None (no
+                # exact per-contact law in this batch) numba prunes the branches on it.
                 use_exact = law == LAW_SECANT_PER_CONTACT and exact
                 its, ok = 0, False
-                if use_exact:
-                    _copy(q, q0)
-                    _copy(force, fd0[0])
-                    _copy(approach, fd0[1])
-                    its, ok = _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval,
-                                            gc, coef, q, force, approach, kt, wm, wv, wc,
-                                            30)  # fmt: skip
-                    if not ok:
-                        _copy(q0, q)
-                        _copy(fd0[0], force)
-                        _copy(fd0[1], approach)
-                elif law != LAW_SECANT_PER_CONTACT:
+                if fd0 is not None:
+                    if use_exact:
+                        _copy(q, q0)
+                        _copy(force, fd0[0])
+                        _copy(approach, fd0[1])
+                        its, ok = _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval,
+                                                gc, coef, q, force, approach, kt, wm, wv, wc,
+                                                30)  # fmt: skip
+                        if not ok:
+                            _copy(q0, q)
+                            _copy(fd0[0], force)
+                            _copy(fd0[1], approach)
+                if law != LAW_SECANT_PER_CONTACT:
                     for c in range(nc):
                         kc[c] = k[group[c]]
                 outer = 0
@@ -687,19 +694,20 @@ def _solve_batch(
                                        gc, coef, kc, q, force, approach, kt, wm, wv, wc, qtol,
                                        maxit)  # fmt: skip
                     its += more
-                    if use_exact:
-                        # Newton on Π with the exact law, after _newton_mixed failed
-                        if ok:
-                            break
-                        use_exact = False
-                        its = 0
-                        _copy(q0, q)
-                        _copy(fd0[0], force)
-                        _copy(fd0[1], approach)
-                        for c in range(nc):  # the start's secant stiffness: the fixed point's start
-                            if force[c] > 0.0 and approach[c] > 0.0:
-                                kc[c] = force[c] / approach[c]
-                        continue
+                    if fd0 is not None:
+                        if use_exact:
+                            # Newton on Π with the exact law, after _newton_mixed failed
+                            if ok:
+                                break
+                            use_exact = False
+                            its = 0
+                            _copy(q0, q)
+                            _copy(fd0[0], force)
+                            _copy(fd0[1], approach)
+                            for c in range(nc):  # the start's secant stiffness: the fixed point's
+                                if force[c] > 0.0 and approach[c] > 0.0:  # start
+                                    kc[c] = force[c] / approach[c]
+                            continue
                     outer += 1
                     # force = kc d on the closed contacts (from the last energy evaluation)
                     if not ok or law == LAW_LINEAR:
@@ -949,6 +957,7 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
         np.asarray(step_g, dtype=np.int64), np.array(step_T, dtype=float), start, rec,
         int((rec >= 0).sum()), np.ascontiguousarray(cd.out_u), np.ascontiguousarray(out_h),
         np.ascontiguousarray(cd.out_q), float(tol), int(maxit), bool(exact), given_state, given,
+        np.zeros((2, nc)) if p.law == LAW_SECANT_PER_CONTACT and exact else None,
     )  # fmt: skip
     # step_T a fresh C array: solve_system passes a read-only broadcast ('A' layout), the yield
     # a contiguous one; each compiled _solve_batch again (~7 s CPU, gear_chain's first run)
