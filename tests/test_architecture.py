@@ -24,6 +24,7 @@ LAYERS: list[tuple[str, ...]] = [
     (
         "gearte._version",
         "gearte._blas",
+        "gearte._gc",
         "gearte.errors",
         "gearte.limits",
         "gearte.units",

@@ -168,8 +168,13 @@ _QUEUE: Any = None
 
 
 def _init_worker(queue: Any) -> None:
+    """Worker: keep the event queue; collect the young generation less often (it compiles,
+    :mod:`gearte._gc`)."""
     global _QUEUE
     _QUEUE = queue
+    from gearte._gc import set_fewer_collections
+
+    set_fewer_collections()
 
 
 def _warm_chain(chain: list[tuple[str, str]]) -> None:

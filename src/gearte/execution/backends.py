@@ -254,13 +254,16 @@ def _worker_init() -> None:
     whole process group; the main process stops the work and shuts the pool down, and workers
     must not print a ``KeyboardInterrupt`` traceback each. Then load SciPy's BLAS modules for
     numba (:mod:`gearte._blas`): a worker's first kernel would import all of ``scipy.linalg``
-    (~0.3 s CPU per worker)."""
+    (~0.3 s CPU per worker), and collect the young generation less often
+    (:mod:`gearte._gc`: a worker may compile the kernels on a cold cache)."""
     import signal
 
     from gearte._blas import preload_scipy_blas
+    from gearte._gc import set_fewer_collections
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     preload_scipy_blas()
+    set_fewer_collections()
 
 
 def _shutdown_pool(pool: cf.Executor, timeout_s: float) -> None:

@@ -157,13 +157,9 @@ def _numba_stand_in() -> None:
     sys.modules["numba"] = stand_in
 
 
-#: Allocations between two young-generation collections of the report process (Python: 700).
-GC_THRESHOLD0 = 50_000
-
-
 def _fewer_collections() -> None:
     """Move everything imported so far out of the collector's sight (``gc.freeze``) and let the
-    young generation grow to :data:`GC_THRESHOLD0` objects before it is collected.
+    young generation grow to :data:`gearte._gc.GC_THRESHOLD0` objects before it is collected.
 
     Building and drawing matplotlib figures allocates millions of small containers, and the
     collector's passes over them took ~15 % of the report process's figure CPU
@@ -173,8 +169,10 @@ def _fewer_collections() -> None:
     draws one report and exits."""
     import gc
 
+    from gearte._gc import set_fewer_collections
+
     gc.freeze()
-    gc.set_threshold(GC_THRESHOLD0, 20, 100)
+    set_fewer_collections()
 
 
 def _die_with_parent() -> None:
