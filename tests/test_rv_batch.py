@@ -133,3 +133,52 @@ def test_solve_positions_batched_equals_the_per_position_solver(law_name, cleara
         np.testing.assert_allclose(a.contact_stiffness, b.contact_stiffness, rtol=1e-9)
     twin = solve_positions(system, T, law, compiled=False)
     np.testing.assert_allclose(twin.q, solve_positions(system, T, law).q, rtol=1e-12, atol=1e-18)
+
+
+@pytest.mark.parametrize("law_name", ["line_contact", "hu2020"], ids=["per_contact", "per_disc"])
+def test_solve_system_restart_equals_one_call_per_sweep(law_name):
+    """``solve_system(..., restart=L)`` (the TE's refinement windows in one kernel call): every
+    array of the solution bit for bit that of one ``solve_system`` call per sweep of ``L``
+    positions, each warm-started from its row of ``q0``/``k0`` — the per-contact law's secant
+    stiffnesses included (their "last loaded" does not reach across sweeps)."""
+    from gearte.models.rv_load_sharing import assemble, contact_law, output_positions, solver_law
+    from gearte.solvers.rv_batch import solve_system
+
+    red = _reducer(4.0)
+    coarse_sys = assemble(red, output_positions(6))
+    law = contact_law(red, law_name)
+    T = red.rated_torque
+    coarse = solve_system(coarse_sys, T, solver_law(red, coarse_sys, law))
+    L, near = 5, [1, 4, 2]
+    thetas = [coarse_sys.theta[n] + np.linspace(0.0, 0.02, L) for n in near]
+    whole = assemble(red, np.concatenate(thetas))
+    a = solve_system(
+        whole,
+        T,
+        solver_law(red, whole, law),
+        q0=coarse.q[near],
+        k0=coarse.contact_stiffness[near],
+        restart=L,
+    )
+    for i, (th, n) in enumerate(zip(thetas, near, strict=True)):
+        one = assemble(red, th)
+        b = solve_system(
+            one, T, solver_law(red, one, law), q0=coarse.q[n], k0=coarse.contact_stiffness[n]
+        )
+        rows = slice(i * L, (i + 1) * L)
+        for name in ("q", "contact_force", "contact_stiffness", "iterations", "pin_stiffness"):
+            np.testing.assert_array_equal(getattr(a, name)[rows], getattr(b, name), err_msg=name)
+
+
+def test_solve_system_restart_checks_its_inputs():
+    from gearte.errors import ParameterError
+    from gearte.models.rv_load_sharing import assemble, output_positions, solver_law
+    from gearte.solvers.rv_batch import solve_system
+
+    red = _reducer()
+    system = assemble(red, output_positions(6))
+    law = solver_law(red, system, None)
+    with pytest.raises(ParameterError, match="restart"):
+        solve_system(system, red.rated_torque, law, restart=4)  # 6 positions: not a multiple
+    with pytest.raises(ParameterError, match="q0 and k0"):
+        solve_system(system, red.rated_torque, law, restart=3)

@@ -60,7 +60,7 @@ from gearte.models.contact_law import (
     log_law_coefficients,
     max_contact_pressure,
 )
-from gearte.solvers.rv_batch import solve_positions
+from gearte.solvers.rv_batch import solve_positions, solve_system
 from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
     ContactLaw,
@@ -858,9 +858,35 @@ class TransmissionError:
         return float(np.max(x) - np.min(x))
 
 
-def _start(sol: LoadSharing, p: int) -> tuple[np.ndarray, np.ndarray]:
-    """Warm start (displacements, per-disc stiffness) from position ``p`` of a solution."""
-    return sol.q[p], sol.contact_stiffness[p]
+def _sweeps(
+    reducer: RVReducer,
+    torque: float,
+    law: PinContactLaw | ContactLaw,
+    system: RVSystem,
+    coarse: LoadSharing,
+    near: list[int],
+    length: int,
+) -> np.ndarray:
+    """Output angle error [rad] at the positions of ``system``: consecutive sweeps of
+    ``length`` positions, sweep ``i`` warm-started from position ``near[i]`` of ``coarse``.
+
+    The same values as ``load_sharing(reducer, torque, law=law, system=<sweep i>,
+    start=(coarse.q[near[i]], coarse.contact_stiffness[near[i]])).output_error`` for each
+    sweep, in one kernel call (:func:`gearte.solvers.rv_batch.solve_system`'s ``restart``): the
+    TE's refinement windows (the compensation evaluates ~40 TEs of six windows each)."""
+    slaw = solver_law(reducer, system, law)
+    try:
+        sol = solve_system(
+            system,
+            torque,
+            slaw,
+            q0=coarse.q[near],
+            k0=coarse.contact_stiffness[near],
+            restart=length,
+        )
+    except ConvergenceError as exc:  # say at which torque (the input the user can change)
+        raise ConvergenceError(f"load sharing at torque = {torque:g} N·mm: {exc}") from None
+    return sol.q[:, system.layout.output_rotation]
 
 
 def transmission_error(
@@ -923,23 +949,15 @@ def transmission_error(
         # solution nearest its first angle: a window warm-started from the end of the previous
         # one (far away) or cold needs > 100 Newton steps when the parts float in measured
         # bearing clearances at the small torque (docs/metrology.md)
-        for c in sorted(centres):
-            fine = system.theta[c] + offs
-            near = int(np.argmin(np.abs(np.angle(np.exp(1j * (system.theta - fine[0]))))))
-            fsys = assemble(reducer, fine)
-            ft = load_sharing(
-                reducer, torque, law=law, system=fsys, start=_start(loaded, near)
-            ).output_error
-            fg = load_sharing(
-                reducer,
-                zero_load_fraction * torque,
-                law=law,
-                system=fsys,
-                start=_start(unloaded, near),
-            ).output_error
-            all_t.append(ft)
-            all_g.append(fg)
-            all_e.append(ft - fg)
+        # (all windows in one system and one kernel call per torque: _sweeps)
+        fine = [system.theta[c] + offs for c in sorted(centres)]
+        near = [int(np.argmin(np.abs(np.angle(np.exp(1j * (system.theta - f[0])))))) for f in fine]
+        fsys = assemble(reducer, np.concatenate(fine))
+        ft = _sweeps(reducer, torque, law, fsys, loaded, near, mesh_samples)
+        fg = _sweeps(reducer, zero_load_fraction * torque, law, fsys, unloaded, near, mesh_samples)
+        all_t.append(ft)
+        all_g.append(fg)
+        all_e.append(ft - fg)
     pp = TransmissionError.peak_to_peak
     return TransmissionError(
         theta=system.theta,

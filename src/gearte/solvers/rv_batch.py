@@ -923,8 +923,9 @@ def _condensed(problem: BatchProblem) -> Condensed:
 def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, compiled,
          first=None):  # fmt: skip
     """The kernel's raw outputs for the inputs of :func:`solve_batch` (``rec``: index of each
-    step among the recorded ones, −1 if not recorded); ``first``: an optional start state
-    ``(q condensed, k per disc, kc per contact)`` of step 0."""
+    step among the recorded ones, −1 if not recorded); ``first``: optional start states
+    ``(steps, q condensed, k per disc, kc per contact)`` (one row per step named) of the steps
+    that start a sweep."""
     p = problem
     cd = _condensed(p)
     coef3 = np.ascontiguousarray(
@@ -944,9 +945,10 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
     given = np.zeros(K, dtype=np.bool_)
     given_state = np.zeros((K, parts[-1].stop))
     if first is not None and K:
-        given[0] = True
-        q_, k_, kc_ = first
-        given_state[0, parts[0]], given_state[0, parts[3]], given_state[0, parts[4]] = q_, k_, kc_
+        at, q_, k_, kc_ = first
+        given[at] = True
+        given_state[at, parts[0]], given_state[at, parts[3]] = q_, k_
+        given_state[at, parts[4]] = kc_
     args = (
         cd.K, cd.u, cd.reg, cd.contacts.index, np.ascontiguousarray(cd.contacts.value),
         cd.bearings.index, np.ascontiguousarray(cd.bearings.value),
@@ -1039,6 +1041,7 @@ def solve_system(
     tol: float = 1e-9,
     maxit: int = NEWTON_MAXIT,
     compiled: bool = True,
+    restart: int | None = None,
 ):
     """:func:`gearte.solvers.rv_equilibrium.solve_positions` through the batched kernel.
 
@@ -1071,6 +1074,11 @@ def solve_system(
         :data:`gearte.solvers.rv_equilibrium.NEWTON_MAXIT`).
     compiled : bool
         ``False`` runs the plain-Python twin [-].
+    restart : int, optional
+        The positions are consecutive sweeps of ``restart`` positions each (``P`` a multiple
+        of it), sweep ``i`` starting from row ``i`` of ``q0`` (W, nd) and ``k0`` (W, ngroups)
+        — the same solutions as one call per sweep, in one kernel call (the TE's refinement
+        windows). Default: one sweep.
 
     Raises
     ------
@@ -1086,11 +1094,19 @@ def solve_system(
     cd = _condensed(problem)
     nd, ng = problem.unit_load.size, problem.ngroups
     group = problem.group
-    kg0 = np.full(ng, law.stiffness) if k0 is None else np.asarray(k0, dtype=float)
+    L = max(P, 1) if restart is None else int(restart)
+    if restart is not None:
+        if L != restart or L < 1 or P % L:
+            raise ParameterError("restart", restart, f"must divide the {P} positions")
+        if q0 is None or k0 is None:
+            raise ParameterError("restart", restart, "needs q0 and k0, one row per sweep")
+    W = 1 if restart is None else P // L
+    kg0 = np.full((W, ng), law.stiffness) if k0 is None else np.asarray(k0, dtype=float)
+    kg0 = kg0.reshape(W, ng)
     first = None
     if q0 is not None or k0 is not None:
-        qs = np.zeros(nd) if q0 is None else np.asarray(q0, dtype=float)
-        first = (qs[cd.keep], kg0, kg0[group])
+        qs = np.zeros((W, nd)) if q0 is None else np.asarray(q0, dtype=float).reshape(W, nd)
+        first = (np.arange(W) * L, qs[:, cd.keep], kg0, kg0[:, group])
     steps = np.arange(P)
     exact = problem.law == LAW_SECANT_PER_CONTACT
     _, _, iters, Q, F, _, KG, KC = _run(problem, h, en, gap, steps, torque, steps - 1,
@@ -1111,17 +1127,21 @@ def solve_system(
         q[:, cd.free] = (np.matmul(cd.Kffinv, f0[:, cd.free, None])
                          - np.matmul(cd.KffKfc, Q[..., None]))[..., 0]  # fmt: skip
     if exact:
+        # each contact's last loaded secant within its sweep (before the sweep's first loaded
+        # step: the sweep's start stiffness); seg: the first step of each step's sweep
+        sweep = steps // L
+        seg = sweep * L
         loaded = F > 0.0
         a0, a1 = problem.coef[..., 0], problem.coef[..., 1]
         sec = np.where(loaded, 1.0 / (a0 - a1 * np.log(np.where(loaded, F, 1.0))), 0.0)
-        last = np.maximum.accumulate(np.where(loaded, steps[:, None], -1), axis=0)
-        KC = np.where(last >= 0, sec[np.maximum(last, 0), np.arange(F.shape[1])],
-                      kg0[group][None])  # fmt: skip
+        last = np.maximum.accumulate(np.where(loaded, steps[:, None], seg[:, None] - 1), axis=0)
+        KC = np.where(last >= seg[:, None], sec[np.maximum(last, 0), np.arange(F.shape[1])],
+                      kg0[:, group][sweep])  # fmt: skip
         KG = np.empty((P, ng))
         for g in range(ng):
             kg = np.max(sec[:, group == g], axis=1, initial=0.0)
-            last = np.maximum.accumulate(np.where(kg > 0.0, steps, -1))
-            KG[:, g] = np.where(last >= 0, kg[np.maximum(last, 0)], kg0[g])
+            last = np.maximum.accumulate(np.where(kg > 0.0, steps, seg - 1))
+            KG[:, g] = np.where(last >= seg, kg[np.maximum(last, 0)], kg0[sweep, g])
     return EquilibriumSolution(q, F, KG, iters, KC)
 
 
