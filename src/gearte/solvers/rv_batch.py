@@ -270,13 +270,17 @@ def _law_force_start(d, coef0, coef1, fstar):
 
 
 @njit(cache=True, nogil=True)
-def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, Fp, dp, F, d, kt):
+def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, Fp, dp, F, d, kt,
+            exact_law):  # fmt: skip
     """Π at ``q``; fills the approaches ``d``, contact forces ``F`` and tangent stiffnesses
     ``kt`` of every contact (0 where open).
 
     ``exact``: the log law (forces from the known pairs ``Fp``, ``dp``;
     ``φ(d) = ∫F dd = F d/2 − a1 F²/4``, tangent ``1/δ'(F)``; +inf beyond the law's range),
-    else the fixed stiffnesses ``kc`` (``φ = kc d²/2``).
+    else the fixed stiffnesses ``kc`` (``φ = kc d²/2``). ``exact_law``: ``None`` where the
+    batch solves no exact per-contact law (``exact`` is then always False: numba prunes that
+    branch, and :func:`_law_force` is not compiled for the per-disc and linear laws); any
+    array otherwise (:func:`_solve_batch`'s ``fd0``).
     """
     nd = q.size
     e = 0.0
@@ -290,14 +294,17 @@ def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, 
         dc = d[c] - gc[c]
         d[c] = dc
         if dc > 0.0:
-            if exact:
-                f = _law_force(dc, coef[c, 0], coef[c, 1], coef[c, 2], Fp[c], dp[c])
-                if f < 0.0:
-                    return np.inf
-                F[c] = f
-                kt[c] = 1.0 / (dc / f - coef[c, 1])  # 1/δ'(F), δ' = a0 − a1 ln F − a1
-                e += 0.5 * f * dc - 0.25 * coef[c, 1] * f * f
-            else:
+            fixed = True
+            if exact_law is not None:
+                if exact:
+                    fixed = False
+                    f = _law_force(dc, coef[c, 0], coef[c, 1], coef[c, 2], Fp[c], dp[c])
+                    if f < 0.0:
+                        return np.inf
+                    F[c] = f
+                    kt[c] = 1.0 / (dc / f - coef[c, 1])  # 1/δ'(F), δ' = a0 − a1 ln F − a1
+                    e += 0.5 * f * dc - 0.25 * coef[c, 1] * f * f
+            if fixed:
                 F[c] = kc[c] * dc
                 kt[c] = kc[c]
                 e += 0.5 * kc[c] * dc * dc
@@ -415,7 +422,7 @@ def _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, F, kt, q, H, grad
 @njit(cache=True, nogil=True, inline="always")
 def _newton(
     exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, F, d, kt, wm, wv,
-    wc, tol, maxit,
+    wc, tol, maxit, exact_law,
 ):  # fmt: skip
     """Active-set Newton with a backtracking line search on Π (:func:`_energy`), in place.
 
@@ -427,7 +434,8 @@ def _newton(
     the law (exact only); on return ``q`` the minimiser and ``F``, ``d``, ``kt`` its forces,
     approaches and tangents. ``wm`` (2, nd, nd), ``wv`` (3, nd), ``wc`` (3, nc): work arrays
     (three arrays, not a tuple of eight: each array argument is several flattened arguments of
-    the compiled function, docs/numba.md). Returns (iterations, ok).
+    the compiled function, docs/numba.md); ``exact_law``: as :func:`_energy`'s. Returns
+    (iterations, ok).
     """
     nd = q.size
     nc = gc.size
@@ -436,7 +444,7 @@ def _newton(
     grad, dq, qn = wv[0], wv[1], wv[2]
     Fn, dn, ktn = wc[0], wc[1], wc[2]
     e0 = _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, F, d, Fn,
-                 dn, ktn)  # fmt: skip
+                 dn, ktn, exact_law)  # fmt: skip
     if not np.isfinite(e0):
         return 0, False
     _copy(Fn, F)
@@ -453,7 +461,7 @@ def _newton(
         e1 = e0
         for _ in range(60):
             e1 = _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, qn, F,
-                         d, Fn, dn, ktn)  # fmt: skip
+                         d, Fn, dn, ktn, exact_law)  # fmt: skip
             if e1 <= e0 + 1e-12 * abs(e0):
                 decreased = True
                 break
@@ -692,7 +700,7 @@ def _solve_batch(
                 while not ok and outer < 200:
                     more, ok = _newton(use_exact, K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval,
                                        gc, coef, kc, q, force, approach, kt, wm, wv, wc, qtol,
-                                       maxit)  # fmt: skip
+                                       maxit, fd0)  # fmt: skip
                     its += more
                     if fd0 is not None:
                         if use_exact:
