@@ -403,30 +403,3 @@ def test_plain_log_labels() -> None:
     assert isinstance(b.yaxis.get_major_formatter(), ScalarFormatter)
     assert isinstance(b.yaxis.get_minor_formatter(), _plain_log_formatter())
     assert not isinstance(a.xaxis.get_major_formatter(), LogFormatterSciNotation)
-
-
-def test_render_all_then_builds_beside_the_forked_helpers(cycloid_result) -> None:
-    """``render_all(built, then=build)`` (the report process's last step): the figures of
-    ``built`` and then those ``build`` makes once the helpers are forked, the same pixels in the
-    same order as drawing them all in one process; a ``build`` that fails raises after the
-    helpers were reaped."""
-    from gearte.plotting import figures_of
-    from gearte.report.html import render_all
-
-    first = figures_of(cycloid_result, {"geometry", "tooth_contact"})
-    rest = ["geometric_te"]
-    got = render_all(first, workers=2, then=lambda: figures_of(cycloid_result, rest), then_cost=3)
-    want = _pngs(
-        figures_of(cycloid_result, {"geometry", "tooth_contact"}) + figures_of(cycloid_result, rest)
-    )
-    assert [(r.analysis, r.title, r.png) for r in got] == want
-
-    def fails() -> list:
-        raise RuntimeError("build failed")
-
-    with pytest.raises(RuntimeError, match="build failed"):
-        render_all(figures_of(cycloid_result, {"geometry", "tooth_contact"}), workers=2, then=fails)
-    try:  # no helper left behind: none to reap (other tests' children may still run: 0)
-        assert os.waitpid(-1, os.WNOHANG)[0] == 0
-    except ChildProcessError:
-        pass

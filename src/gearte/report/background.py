@@ -157,13 +157,6 @@ def _numba_stand_in() -> None:
     sys.modules["numba"] = stand_in
 
 
-#: What the report process expects to spend, in :func:`gearte.report.html._cost`'s units, on
-#: building and drawing the figures of each analysis not built when the final result comes
-#: (about one figure of two axes and its building): it takes that much less of the built
-#: figures when it shares them out to its forked helpers.
-_REST_COST = 3.0
-
-
 def _fewer_collections() -> None:
     """Move everything imported so far out of the collector's sight (``gc.freeze``) and let the
     young generation grow to :data:`gearte._gc.GC_THRESHOLD0` objects before it is collected.
@@ -309,20 +302,14 @@ class _Report:
                     self.todo.append(msg[1])
 
     def step(self) -> None:
-        """One piece of early work: build the figures of the next streamed analysis, else draw
-        the next built figure.
-
-        Building first: what is left when the final result comes is then drawing only, which
-        :meth:`finish` shares out to forked helpers, whereas building is done here, one analysis
-        after the other (hu2020_rv80e_initial_reducer: ~0.12 s of building after its last
-        analysis, on one core, when drawing came first)."""
+        """One piece of early work: draw the next built figure, else build the figures of the
+        next streamed analysis."""
         from gearte.report.html import render_all
 
-        if not self.todo:
-            for ref, figs in self.built.items():
-                if figs:
-                    self.drawn[ref] += render_all([figs.pop(0)], workers=1)
-                    return
+        for ref, figs in self.built.items():
+            if figs:
+                self.drawn[ref] += render_all([figs.pop(0)], workers=1)
+                return
         ref = self.todo.pop(0)
         from gearte.plotting import figures_of
         from gearte.results import StudyResult
@@ -356,28 +343,16 @@ class _Report:
         t0 = time.perf_counter()
         names = [a.name for a in analyses]
         rest = [n for n in names if n not in early]
-        building: list[float] = []
-
-        def build() -> list[Any]:
-            """The figures of the analyses not built yet (run once the helpers that draw the
-            built ones are forked: building overlaps with their drawing)."""
-            b0 = time.perf_counter()
-            if not early:
-                figs = figures_for(result)
-            elif set(rest) <= self_contained(result.kind) or others_read_alone(result.kind):
-                figs = figures_of(result, rest) if rest else []
-            else:  # a figure of another analysis may read those built already: build all,
-                figs = [f for f in figures_for(result) if f.analysis not in early]  # skip them
-            building.append(time.perf_counter() - b0)
-            return figs
-
+        if not early:
+            figs = figures_for(result)
+        elif set(rest) <= self_contained(result.kind) or others_read_alone(result.kind):
+            figs = figures_of(result, rest)
+        else:  # a figure of another analysis may read those built already: build all, skip them
+            figs = [f for f in figures_for(result) if f.analysis not in early]
         left = [f for n in names for f in early.get(n, ((), ()))[1]]  # built, not drawn yet
-        if left:  # draw those in forked helpers while this process builds the rest
-            rendered = render_all(left, then=build, then_cost=_REST_COST * len(rest))
-        else:
-            rendered = render_all(build())
+        t1 = time.perf_counter()
+        rendered = render_all(left + figs)
         t2 = time.perf_counter()
-        t1 = t0 + sum(building)  # "figures": building them; "render": the rest of the wall time
         now = {id(f): r for f, r in zip(left, rendered, strict=False)}
         drawn = [
             r

@@ -17,7 +17,6 @@ import json
 import os
 import pickle
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import resources
 from typing import Any
@@ -134,12 +133,7 @@ def _cost(f: Any) -> float:
 
 
 def render_all(
-    figs: list[Any],
-    workers: int | None = None,
-    *,
-    polished: bool = False,
-    then: Callable[[], list[Any]] | None = None,
-    then_cost: float = 0.0,
+    figs: list[Any], workers: int | None = None, *, polished: bool = False
 ) -> list[RenderedFigure]:
     """Render the :class:`~gearte.plotting.Figure` objects ``figs`` to PNG, in order, in
     ``workers`` forked processes (default: the cores this process may use) where that can help.
@@ -153,44 +147,17 @@ def render_all(
     polished : bool
         The figures are already polished (:func:`gearte.plotting.display.polish`); by default
         each is polished before it is drawn.
-    then : callable, optional
-        Builds more figures, rendered in this process after the helpers are forked (building
-        overlaps with their drawing) and returned after those of ``figs``.
-    then_cost : float
-        What ``then``'s figures are expected to cost this process (:func:`_cost`'s units): it
-        takes that much less of ``figs``.
     """
-    return _render_all(
-        figs,
-        _workers() if workers is None else workers,
-        polished=polished,
-        then=then,
-        then_cost=then_cost,
-    )
+    return _render_all(figs, _workers() if workers is None else workers, polished=polished)
 
 
-def _render_all(
-    figs: list[Any],
-    workers: int,
-    *,
-    polished: bool = False,
-    then: Callable[[], list[Any]] | None = None,
-    then_cost: float = 0.0,
-) -> list[RenderedFigure]:
-    """Render ``figs`` in order, in ``workers`` processes (forked) where that can help.
-
-    ``then``: builds more figures, rendered after ``figs`` (and returned after them, in
-    order). It runs in this process once the helpers are forked, so that building them overlaps
-    with the helpers' drawing; ``then_cost`` (in :func:`_cost`'s units) is what this process is
-    expected to spend on them, and it takes that much less of ``figs``."""
+def _render_all(figs: list[Any], workers: int, *, polished: bool = False) -> list[RenderedFigure]:
+    """Render ``figs`` in order, in ``workers`` processes (forked) where that can help."""
     workers = min(workers, len(figs))
     if workers < 2 or not hasattr(os, "fork"):
-        out = [_render_one(f, polished) for f in figs]
-        return out + [_render_one(f, polished) for f in (then() if then is not None else [])]
-    # share the figures out, largest first, to the least loaded worker (this process, worker
-    # 0, starts with what it will build and draw after forking)
+        return [_render_one(f, polished) for f in figs]
+    # share the figures out, largest first, to the least loaded worker
     load = [0.0] * workers
-    load[0] = then_cost
     share: list[list[int]] = [[] for _ in range(workers)]
     for i in sorted(range(len(figs)), key=lambda i: -_cost(figs[i])):
         w = load.index(min(load))
@@ -213,20 +180,15 @@ def _render_all(
                 os._exit(code)
         os.close(w)
         children.append((pid, r, idx))
-    try:
-        done: dict[int, RenderedFigure] = {i: _render_one(figs[i], polished) for i in share[0]}
-        more = [_render_one(f, polished) for f in (then() if then is not None else [])]
-    finally:  # the helpers are always read and reaped (then() may raise)
-        got_all = []
-        for pid, r, _idx in children:
-            with os.fdopen(r, "rb") as fh:
-                data = fh.read()
-            _, status = os.waitpid(pid, 0)
-            got_all.append(pickle.loads(data) if status == 0 and data else None)
-    for (_pid, _r, idx), got in zip(children, got_all, strict=True):
+    done: dict[int, RenderedFigure] = {i: _render_one(figs[i], polished) for i in share[0]}
+    for pid, r, idx in children:
+        with os.fdopen(r, "rb") as fh:
+            data = fh.read()
+        _, status = os.waitpid(pid, 0)
+        got = pickle.loads(data) if status == 0 and data else None
         for k, i in enumerate(idx):
             done[i] = got[k] if got else _render_one(figs[i], polished)
-    return [done[i] for i in range(len(figs))] + more
+    return [done[i] for i in range(len(figs))]
 
 
 def _grouped(rows: list[Any]) -> list[list[Any]]:
