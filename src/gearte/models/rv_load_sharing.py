@@ -803,13 +803,22 @@ def load_sharing(
     check_reducer_torque(reducer, torque)
     if system is None:
         system = assemble(reducer, output_positions(360) if theta is None else theta)
-    slaw = solver_law(reducer, system, law)
     q0, k0 = (None, None) if start is None else start
-    try:
-        sol = solve_positions(system, torque, slaw, compiled=compiled, q0=q0, k0=k0)
-    except ConvergenceError as exc:  # say at which torque (the input the user can change)
-        raise ConvergenceError(f"load sharing at torque = {torque:g} N·mm: {exc}") from None
+    slaw, sol = _equilibrium(
+        reducer, system, torque, law, solve_positions, compiled=compiled, q0=q0, k0=k0
+    )
     return _postprocess(reducer, system, sol, torque, slaw.name)
+
+
+def _equilibrium(reducer, system, torque, law, solve, **kwargs):
+    """``(solver law, solution)``: ``solve(system, torque, <solver law>, **kwargs)``
+    (:func:`~gearte.solvers.rv_batch.solve_positions` or ``solve_system``), its
+    :class:`ConvergenceError` saying at which torque (the input the user can change)."""
+    slaw = solver_law(reducer, system, law)
+    try:
+        return slaw, solve(system, torque, slaw, **kwargs)
+    except ConvergenceError as exc:
+        raise ConvergenceError(f"load sharing at torque = {torque:g} N·mm: {exc}") from None
 
 
 def mesh_period(reducer: RVReducer) -> float:
@@ -874,18 +883,16 @@ def _sweeps(
     start=(coarse.q[near[i]], coarse.contact_stiffness[near[i]])).output_error`` for each
     sweep, in one kernel call (:func:`gearte.solvers.rv_batch.solve_system`'s ``restart``): the
     TE's refinement windows (the compensation evaluates ~40 TEs of six windows each)."""
-    slaw = solver_law(reducer, system, law)
-    try:
-        sol = solve_system(
-            system,
-            torque,
-            slaw,
-            q0=coarse.q[near],
-            k0=coarse.contact_stiffness[near],
-            restart=length,
-        )
-    except ConvergenceError as exc:  # say at which torque (the input the user can change)
-        raise ConvergenceError(f"load sharing at torque = {torque:g} N·mm: {exc}") from None
+    _, sol = _equilibrium(
+        reducer,
+        system,
+        torque,
+        law,
+        solve_system,
+        q0=coarse.q[near],
+        k0=coarse.contact_stiffness[near],
+        restart=length,
+    )
     return sol.q[:, system.layout.output_rotation]
 
 
