@@ -40,7 +40,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("gearte.runners",),
     ("gearte.drives",),
     ("gearte.results", "gearte.io"),
-    ("gearte.studies",),
+    ("gearte.studies", "gearte.families"),
     ("gearte.plotting",),
     ("gearte.report",),
     ("gearte.sweep", "gearte.export"),

@@ -13,7 +13,7 @@ import gearte
 from gearte.cases import case_path
 from gearte.errors import CaseFileError, ParameterError
 from gearte.io.case_file import load_case_dict
-from gearte.runners.chain_yield import ChainStage, GearChainYield, StageTerm
+from gearte.runners.chain_yield import ChainStage, GearChainYield, PairLostMotion, StageTerm
 from gearte.studies import RunOptions
 from gearte.units import rad_to_arcmin
 
@@ -98,7 +98,9 @@ def test_chain_yield_unknown_tolerance_key_is_an_error_naming_it():
 
 def test_chain_yield_model_interfering_pair_has_zero_lost_motion_not_negative():
     """A drawn backlash below zero (parts interfere) is no lost motion (eq. 14 on max(jn, 0))."""
-    st = ChainStage("p", "p", 2.0, (StageTerm("p.x", 1.0),), 100.0, math.radians(20))
+    st = ChainStage(
+        "p", "p", 2.0, PairLostMotion((StageTerm("p.x", 1.0),), 100.0, math.radians(20))
+    )
     model = GearChainYield([st], {}, 500.0)
     out = model({"p.x": np.array([-10.0, 10.0])})
     lm = out["p.lost_motion [arcmin]"]

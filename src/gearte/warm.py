@@ -39,16 +39,13 @@ __all__ = [
 ]
 
 WARM_CASES: dict[str, tuple[str, ...]] = {
-    "cycloid_stage": ("hu2020_rv80e_initial",),
-    "gear_pair": ("jiang2024_spur_pair",),
     "gear_chain": (),
-    "planetary": ("wang2013_2kh_eq9",),
-    "rv_reducer": ("hu2020_rv80e_initial_reducer", "han2023_rv110e_yield"),
     "rv_bench": (),
     "rv_lot": (),
     "rv_serial": ("synthetic_rv110e_serial",),
 }
-"""Per study kind, the bundled cases whose analyses together call every kernel of the kind that
+"""Per study kind that is not a drive family (the families add theirs,
+:func:`_add_families`), the bundled cases whose analyses together call every kernel of the kind that
 no earlier warm-up case compiles (measured with ``bench_compile.py --coverage`` on 2026-11-25:
 after these, every other bundled case compiles nothing — e.g. ``rv_bench`` and ``rv_lot`` use
 the RV reducer's kernels, ``gear_chain`` those of its stages' kinds)."""
@@ -82,16 +79,34 @@ WARM_CHAINS: tuple[tuple[str, ...], ...] = (
 process at a time, longest first; a chain's cases share kernels."""
 
 BENCH_CASES: dict[str, str] = {
-    "cycloid_stage": "hu2020_rv80e_initial",
-    "gear_pair": "jiang2024_spur_pair",
     "gear_chain": "robot_joint_spur_rv",
-    "planetary": "wang2013_2kh_eq9",
-    "rv_reducer": "hu2020_rv80e_initial_reducer",
     "rv_bench": "synthetic_rv_bench",
     "rv_lot": "synthetic_rv110e_lot",
     "rv_serial": "synthetic_rv110e_serial",
 }
 """One bundled case per kind: the first run of a kind that ``bench_compile.py`` measures."""
+
+
+def _add_families() -> None:
+    """The drive families' own warm-up and benchmark cases (``FAMILY.warm_cases``,
+    ``FAMILY.bench_case``, :mod:`gearte.families`): the kinds above are the studies that are not
+    one drive. A family whose warm-up cases share no chain above runs them as a chain of its
+    own."""
+    from gearte.families import families
+
+    global WARM_CHAINS
+    chained = {c for chain in WARM_CHAINS for c in chain}
+    for kind, fam in families().items():
+        WARM_CASES.setdefault(kind, tuple(fam.warm_cases))
+        if fam.bench_case is not None:
+            BENCH_CASES.setdefault(kind, fam.bench_case)
+        new = tuple(c for c in fam.warm_cases if c not in chained)
+        if new:
+            WARM_CHAINS = (*WARM_CHAINS, new)
+            chained.update(new)
+
+
+_add_families()
 
 WARM_SAMPLES = 256
 """Monte-Carlo sample count of the warm-up runs (enough to call every kernel once)."""

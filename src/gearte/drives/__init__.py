@@ -1,7 +1,8 @@
 """Drives that compose: one small interface that every drive gearte models answers.
 
 A *drive* is one reduction stage with an input and an output shaft: a spur pair, a bevel pair, a
-2K-H planetary set, a cycloid–pin stage or a whole RV reducer. Whatever its inner model, it answers
+2K-H planetary set, a cycloid–pin stage, a whole RV reducer — any registered drive family
+(:mod:`gearte.families`). Whatever its inner model, it answers
 the same few questions, so that a chain, a sweep or a Monte-Carlo study can use any drive without
 knowing which one it is (docs/drives.md)::
 
@@ -29,10 +30,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["Drive", "LostMotionSpread", "DRIVE_KINDS"]
-
-#: The ``kind`` names a drive reports.
-DRIVE_KINDS = ("spur_pair", "bevel_pair", "planetary", "cycloid_stage", "rv_reducer")
+__all__ = ["Drive", "LostMotionSpread"]
 
 
 @dataclass(frozen=True)
@@ -67,7 +65,8 @@ class Drive(Protocol):
 
     @property
     def kind(self) -> str:
-        """One of :data:`DRIVE_KINDS`."""
+        """What it is (``"spur_pair"``, ``"rv_reducer"``, ...: its family's ``drive_kinds``,
+        :mod:`gearte.families`)."""
         ...
 
     @property

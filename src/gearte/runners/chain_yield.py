@@ -8,9 +8,12 @@ Each stage of a ``gear_chain`` is one of
   (tooth thicknesses, centre distance, bearing clearance [µm]; eccentricities and run-outs as a
   magnitude [µm] with a uniform direction, entering as ``r sin φ``), then turned into the return
   error at the driven gear by eq. (14)/(29), ``Δφ = 2 max(jn, 0) / (d cos α)``;
-* a **lost-motion stage** (any other drive, a stage given by its lost motion or backlash
-  values, or a pair whose whole law the user gives): its lost motion [arcmin at the stage
-  output, key: the stage name] is itself the drawn error.
+* a **drive stage** of any other family with tolerances of its own (a cycloid stage's nine
+  component errors, a strain-wave gear's errors): its family's model of its lost motion from its
+  own drawn errors (:class:`gearte.families.StageYield`), keys ``<stage slug>.<error>``;
+* a **lost-motion stage** (a drive without tolerances of its own, a stage given by its lost
+  motion or backlash values, or a stage whose whole law the user gives): its lost motion
+  [arcmin at the stage output, key: the stage name] is itself the drawn error.
 
 The joint's lost motion is Jiang et al. (2024) eq. (30), ``Δφ_joint = Σₖ Δφₖ / Πⱼ₍ⱼ>ₖ₎ iⱼ``,
 sample by sample (the distribution, not only the sum of maxima), and the end-effector error
@@ -27,13 +30,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from gearte.errors import ParameterError
 from gearte.units import arcmin_to_rad, rad_to_arcmin, um_to_mm
 
-__all__ = ["StageTerm", "ChainStage", "GearChainYield", "stack_terms"]
+__all__ = ["StageTerm", "ChainStage", "PairLostMotion", "GearChainYield", "stack_terms"]
 
 
 @dataclass(frozen=True)
@@ -56,6 +60,39 @@ class StageTerm:
     radial: bool = False
 
 
+class PairLostMotion:
+    """A pair's return error from its drawn backlash-stack contributors (picklable).
+
+    Parameters
+    ----------
+    terms : tuple of StageTerm
+        The stack's contributors (keys [µm]).
+    diameter : float
+        Driven-gear pitch (bevel: mean) diameter d [mm] of eq. (14)/(29).
+    pressure_angle : float
+        Pressure angle α [rad].
+
+    Notes
+    -----
+    ``jn = Σ ∂jn/∂x · x`` (a radial term as ``r sin φ`` when its direction is drawn), then
+    ``Δφ = 2 max(jn, 0) / (d cos α)`` (Jiang et al. 2024 eq. 14/29) [rad].
+    """
+
+    def __init__(self, terms: Sequence[StageTerm], diameter: float, pressure_angle: float) -> None:
+        self.terms = tuple(terms)
+        self.diameter = float(diameter)
+        self.pressure_angle = float(pressure_angle)
+
+    def __call__(self, errors: Mapping[str, np.ndarray], n: int) -> np.ndarray:
+        jn = np.zeros(n)
+        for t in self.terms:
+            x = um_to_mm(np.asarray(errors[t.key], dtype=float))
+            if t.radial and f"{t.key}_phase_rad" in errors:
+                x = x * np.sin(np.asarray(errors[f"{t.key}_phase_rad"], dtype=float))
+            jn += t.sensitivity * x
+        return 2.0 * np.maximum(jn, 0.0) / (self.diameter * np.cos(self.pressure_angle))
+
+
 @dataclass(frozen=True)
 class ChainStage:
     """One stage of the chain as the yield model sees it.
@@ -68,21 +105,38 @@ class ChainStage:
         Key prefix of its errors.
     ratio : float
         Reduction ratio [-], > 0.
-    terms : tuple of StageTerm
-        Backlash stage: the stack's contributors. Empty: a lost-motion stage whose error key is
-        its name [arcmin at its output].
-    diameter : float
-        Driven-gear pitch (bevel: mean) diameter d [mm] of eq. (14)/(29) (backlash stage).
-    pressure_angle : float
-        Pressure angle α [rad] (backlash stage).
+    model : callable, optional
+        The drive's own lost motion from its drawn errors, ``model(errors, n)`` → [rad] at the
+        stage output (:class:`gearte.families.StageYield`; a pair: :class:`PairLostMotion`).
+        ``None``: a lost-motion stage whose error key is its name [arcmin at its output].
     """
 
     name: str
     slug: str
     ratio: float
-    terms: tuple[StageTerm, ...] = ()
-    diameter: float = 0.0
-    pressure_angle: float = 0.0
+    model: Any = None
+
+
+class _Drawn(Mapping):
+    """The drawn errors, with the nominal value of a key the batch does not draw (``in`` still
+    says whether it was drawn: a direction ``<key>_phase_rad`` counts only when drawn)."""
+
+    def __init__(self, errors: Mapping[str, np.ndarray], nominal: Mapping[str, float], n: int):
+        self.errors, self.nominal, self.n = errors, nominal, n
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        if key in self.errors:
+            return np.asarray(self.errors[key], dtype=float)
+        return np.full(self.n, self.nominal.get(key, 0.0))
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.errors
+
+    def __iter__(self):
+        return iter(self.errors)
+
+    def __len__(self) -> int:
+        return len(self.errors)
 
 
 def stack_terms(slug: str, stack) -> tuple[tuple[StageTerm, ...], dict[str, tuple]]:
@@ -163,26 +217,16 @@ class GearChainYield:
             "end_effector_error [mm]",
         )
 
-    def _get(self, errors: Mapping[str, np.ndarray], key: str, n: int) -> np.ndarray:
-        if key in errors:
-            return np.asarray(errors[key], dtype=float)
-        return np.full(n, self.nominal.get(key, 0.0))
-
     def __call__(self, errors: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         n = next((int(np.shape(v)[0]) for v in errors.values()), 1)
+        drawn = _Drawn(errors, self.nominal, n)
         out: dict[str, np.ndarray] = {}
         joint = np.zeros(n)
         for st, f in zip(self.stages, self.factors, strict=True):
-            if st.terms:
-                jn = np.zeros(n)
-                for t in st.terms:
-                    x = um_to_mm(self._get(errors, t.key, n))
-                    if t.radial and f"{t.key}_phase_rad" in errors:
-                        x = x * np.sin(np.asarray(errors[f"{t.key}_phase_rad"], dtype=float))
-                    jn += t.sensitivity * x
-                lm = 2.0 * np.maximum(jn, 0.0) / (st.diameter * np.cos(st.pressure_angle))
+            if st.model is not None:
+                lm = np.maximum(np.asarray(st.model(drawn, n), dtype=float), 0.0)
             else:
-                lm = np.maximum(arcmin_to_rad(self._get(errors, st.name, n)), 0.0)
+                lm = np.maximum(arcmin_to_rad(drawn[st.name]), 0.0)
             out[f"{st.slug}.lost_motion [arcmin]"] = np.asarray(rad_to_arcmin(lm), dtype=float)
             joint += lm * f
         out["joint_lost_motion [arcmin]"] = np.asarray(rad_to_arcmin(joint), dtype=float)

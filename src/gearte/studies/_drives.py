@@ -1,36 +1,32 @@
 """Drives described in case files: the one place that turns a kind's sections into a drive.
 
-A ``gear_chain`` stage (and anything else that composes drives) names a drive by its study kind
-and gives it either as a case file of that kind or inline, with the same sections that kind's
-case file has (``[reducer]``… for ``rv_reducer``, ``[stage]``/``[errors]`` for
-``cycloid_stage``, ``[gearset]``/``[errors]`` for ``planetary``, ``[pair]`` for ``gear_pair``).
-Those sections are validated by that kind's own ``Case`` schema, and the drive is built from the
-validated case by :func:`drive_from_case` — so a change of a kind's schema touches that kind's
-module and, at most, this file.
+A ``gear_chain`` stage (and anything else that composes drives) names a drive by its family
+(:mod:`gearte.families`, the family's study kind) and gives it either as a case file of that kind
+or inline, with the sections its family declares (``FAMILY.sections``: ``[reducer]``… for
+``rv_reducer``, ``[pair]`` for ``gear_pair``, ...). Those sections are validated by that kind's
+own ``Case`` schema, and the drive is built from the validated case by its family's ``drive``
+(:func:`drive_from_case`) — nothing here names a family.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
-from pydantic import ConfigDict, Field, PrivateAttr, ValidationInfo, model_validator
+from pydantic import (
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from gearte.drives import Drive
-from gearte.errors import ParameterError
+from gearte.families import family_kinds, get_family
 from gearte.io.schema import StrictModel
 
-__all__ = ["DRIVE_CASE_KINDS", "DriveSpec", "drive_from_case"]
-
-#: Study kinds whose case describes one drive, with the sections that describe it.
-DRIVE_CASE_KINDS: dict[str, tuple[str, ...]] = {
-    "gear_pair": ("pair",),
-    "planetary": ("gearset", "errors"),
-    "cycloid_stage": ("stage", "errors"),
-    "rv_reducer": ("reducer", "analyses"),
-}
-
-DriveKind = Literal["gear_pair", "planetary", "cycloid_stage", "rv_reducer"]
+__all__ = ["DriveSpec", "drive_from_case"]
 
 
 def _lines(exc: Exception) -> str:
@@ -68,7 +64,10 @@ class DriveSpec(StrictModel):
 
     model_config = ConfigDict(**{**StrictModel.model_config, "extra": "allow"})
 
-    kind: DriveKind = Field(description="Study kind of the drive: " + ", ".join(DRIVE_CASE_KINDS))
+    kind: str = Field(
+        description="Study kind of the drive, a registered drive family (gearte.families): "
+        + ", ".join(family_kinds())
+    )
     case: str | None = Field(
         default=None,
         min_length=1,
@@ -76,6 +75,13 @@ class DriveSpec(StrictModel):
     )
     _case: Any = PrivateAttr(default=None)
     _source: str = PrivateAttr(default="inline")
+
+    @field_validator("kind")
+    @classmethod
+    def _registered(cls, v: str) -> str:
+        if v not in family_kinds():
+            raise ValueError(f"unknown drive kind {v!r}; drive families: {list(family_kinds())}")
+        return v
 
     @model_validator(mode="after")
     def _validate_sections(self, info: ValidationInfo) -> DriveSpec:
@@ -86,7 +92,7 @@ class DriveSpec(StrictModel):
         from gearte.studies import get_kind
 
         extra = dict(self.model_extra or {})
-        wanted = DRIVE_CASE_KINDS[self.kind]
+        wanted = get_family(self.kind).sections
         if self.case is not None:
             if extra:
                 raise ValueError(
@@ -141,82 +147,19 @@ class DriveSpec(StrictModel):
 
 
 def drive_from_case(case: Any, *, name: str | None = None) -> Drive:
-    """The :class:`~gearte.drives.Drive` a validated case of a drive kind describes.
+    """The :class:`~gearte.drives.Drive` a validated case of a drive family describes (its
+    family's ``drive``, :mod:`gearte.families`).
 
     Parameters
     ----------
     case : Case
-        A validated ``gear_pair``, ``planetary``, ``cycloid_stage`` or ``rv_reducer`` case.
+        A validated case of a registered drive family (``gear_pair``, ``rv_reducer``, ...).
     name : str, optional
         Label of the drive; default: the case name.
     """
     kind = case.case.kind
-    label = name or case.case.name or kind
-    if kind == "gear_pair":
-        from gearte.drives.gear_pair import GearPairDrive
-
-        spec = case.pair
-        return GearPairDrive(
-            spec.build(), name=label, face_width=getattr(spec, "face_width_mm", None)
+    if kind not in family_kinds():
+        raise ValueError(
+            f"case kind {kind!r} does not describe one drive; drive kinds: {list(family_kinds())}"
         )
-    if kind == "planetary":
-        from gearte.drives.planetary import PlanetaryDrive
-        from gearte.studies.planetary import build_terms
-
-        terms, mags, angs = build_terms(case)
-        return PlanetaryDrive(case.gearset.build(), terms, mags, angs, name=label)
-    if kind == "cycloid_stage":
-        from gearte.drives.cycloid_stage import CycloidStageDrive
-        from gearte.studies.cycloid_stage import build_stage
-
-        return CycloidStageDrive(
-            build_stage(case.stage),
-            case.errors.means_mm(),
-            case.errors.tolerances_mm(),
-            name=label,
-        )
-    if kind == "rv_reducer":
-        from gearte.drives.rv_reducer import RVDrive
-        from gearte.studies.rv_reducer import build_reducer, first_stage_terms
-        from gearte.units import deg_to_rad
-
-        red = build_reducer(case.reducer)
-        if getattr(red, "rated_torque", None) is None:
-            raise ParameterError(
-                "reducer.rated_torque_Nm",
-                None,
-                "an RV drive's lost motion and stiffness come from the catalogue virtual test, "
-                "which needs the rated torque",
-            )
-        law_name = getattr(case.reducer, "contact_law", None)  # the case's pin-contact law
-        law = None
-        if law_name is not None:
-            from gearte.models.rv_load_sharing import contact_law
-
-            law = contact_law(red, law_name)
-        cat = getattr(case.analyses, "catalogue", None)
-        free = 0.0  # the first stage's backlash at the output (first_stage_backlash = additive)
-        fs_terms = first_stage_terms(case.reducer.first_stage)
-        if fs_terms is not None and getattr(cat, "first_stage_backlash", "additive") == "additive":
-            import numpy as np
-
-            from gearte.models.rv_first_stage import output_free_angle
-            from gearte.units import um_to_mm
-
-            mid = um_to_mm(np.asarray(fs_terms["backlash_um"]["mid"], dtype=float))
-            free = float(output_free_angle(mid, fs_terms["r_sun"], float(red.ratio)))
-        if cat is None:
-            return RVDrive(red, name=label, law=law, first_stage_free_angle=free)
-        return RVDrive(
-            red,
-            name=label,
-            position=float(deg_to_rad(cat.position_deg)),
-            turning_points=tuple(cat.torque_sweep),
-            steps_per_segment=cat.steps_per_segment,
-            lost_motion_fraction=cat.lost_motion_fraction,
-            law=law,
-            first_stage_free_angle=free,
-        )
-    raise ValueError(
-        f"case kind {kind!r} does not describe one drive; drive kinds: {list(DRIVE_CASE_KINDS)}"
-    )
+    return get_family(kind).drive(case, name or case.case.name or kind)

@@ -10,12 +10,12 @@ gives its return error in one of three ways:
   elsewhere (measured, or the paper's 3DCS simulation, Tables 4 and 8) → eq. (14)/(29);
 * ``[chain.stages.pair]``: the pair's data and tolerances (same tables as the ``gear_pair``
   kind) → gearte's backlash stack, min/mean/max at ``analysis.confidence`` → eq. (14)/(29);
-* ``[chain.stages.drive]``: any drive gearte models — ``kind`` = ``"rv_reducer"``,
-  ``"cycloid_stage"``, ``"planetary"`` or ``"gear_pair"`` and either ``case = "<file>"`` (a case
-  file of that kind, relative to this one) or that kind's sections inline
-  (``[chain.stages.drive.reducer]`` …). Its lost motion (and its spread where it has a tolerance
-  stack) and its torsional stiffness come from that drive's own model through the drive interface
-  (:mod:`gearte.drives`); a drive whose model has no lost motion (``planetary``) takes
+* ``[chain.stages.drive]``: any registered drive family (:mod:`gearte.families`: ``kind`` =
+  ``"rv_reducer"``, ``"cycloid_stage"``, ``"planetary"``, ``"gear_pair"``, ...) and either
+  ``case = "<file>"`` (a case file of that kind, relative to this one) or the family's sections
+  inline (``[chain.stages.drive.reducer]`` …). Its lost motion (and its spread where it has a
+  tolerance stack) and its torsional stiffness come from that drive's own model through the drive
+  interface (:mod:`gearte.drives`); a family whose model has no lost motion (``planetary``) takes
   ``lost_motion_max_arcmin`` beside it.
 
 Optional ``[shim]``: shim thickness under both gears of a bevel stage for a target minimum
@@ -28,9 +28,10 @@ Optional ``[compensation]``: stages compensated by their mean return error when 
 reverses; motor offset (eq. 33), residual per stage, joint and end error after it. It acts on
 the chain after the shim when there is one (the paper's order).
 
-Optional ``[analyses.yield]``: each stage's lost motion drawn from its distribution (its model's
-tolerance stack, or its min/mean/max, or constant), combined at the joint by eq. (30) by
-Monte-Carlo — the joint's distribution, yield, Cpk and contributions (``gearte.studies._yield``).
+Optional ``[analyses.yield]``: each stage's lost motion from its own drawn tolerances (its
+family's errors: a pair's backlash stack, a cycloid stage's component errors, ...), or drawn from
+its min/mean/max, or constant, combined at the joint by eq. (30) by Monte-Carlo — the joint's
+distribution, yield, Cpk and contributions per tolerance (``gearte.studies._yield``).
 
 Analyses: one group per stage (``<stage>_backlash`` …, see ``gear_pair``), ``chain``
 (``joint_lost_motion_max [arcmin]``, ``end_effector_error_max [mm]``), ``shim``
@@ -209,7 +210,9 @@ class StageSpec(StrictModel):
         return self
 
     def _drive_has_lost_motion(self) -> bool:
-        return self.drive is not None and self.drive.kind != "planetary"
+        from gearte.families import get_family
+
+        return self.drive is not None and get_family(self.drive.kind).lost_motion
 
     def _check_drive(self, lost_given: bool, other: bool) -> None:
         """A drive stage: ratio as the drive's; lost motion given only where unmodelled."""
@@ -626,84 +629,65 @@ def _stage_tolerances(case: Case, stages, drives: dict, backlash: dict) -> dict:
     return out
 
 
-def _yield_setup(case: Case, sec: YieldSection, pairs: dict, defaults: dict):
+def _yield_setup(case: Case, sec: YieldSection, own: dict, defaults: dict):
     """What the chain's yield model and its inputs are built from, nothing evaluated: the
     :class:`~gearte.runners.chain_yield.GearChainYield`, the error keys' units and nominals, the
-    tolerances the stages imply (``defaults`` from :func:`_stage_tolerances`, updated: a pair
-    stage's law is replaced by its stack's contributors) and the grade reading.
+    tolerances the stages imply (``defaults`` from :func:`_stage_tolerances`, updated: a stage
+    that draws its own tolerances has its law replaced by its family's errors) and the grade
+    reading.
 
-    ``pairs``: stage name → its gear pair (a ``[pair]`` stage's or a ``gear_pair`` drive's),
-    :func:`_stage_pairs`. :func:`_chain_yield` runs it; :func:`preflight` checks it.
+    ``own``: stage name → its :class:`~gearte.families.StageYield` (:func:`_own_tolerances`).
+    :func:`_chain_yield` runs it; :func:`preflight` checks it.
     """
-    from gearte.models.backlash import SpurPair
-    from gearte.runners.chain_yield import ChainStage, GearChainYield, stack_terms
-    from gearte.studies._yield import GradeTolerance, ToleranceEntry
-    from gearte.tolerance.iso1328 import radial_composite_tolerances
+    from gearte.runners.chain_yield import ChainStage, GearChainYield
 
     units = {s.name: "arcmin" for s in case.chain.stages}
     nominal = {k: float(t.nominal_arcmin or 0.0) for k, t in defaults.items()}
     chain: list[ChainStage] = []
-    drawn: dict[str, tuple[Any, str]] = {}
+    graders: dict[str, Any] = {}
     for s in case.chain.stages:
-        slug = _slug(s.name)
-        pair = pairs.get(s.name)
-        if pair is None or s.name in sec.tolerances:
-            chain.append(ChainStage(s.name, slug, s.ratio))
+        sy = own.get(s.name)
+        if sy is None or s.name in sec.tolerances:
+            chain.append(ChainStage(s.name, _slug(s.name), s.ratio))
             continue
         del units[s.name]
         defaults.pop(s.name, None)
         nominal.pop(s.name, None)
-        terms, laws = stack_terms(slug, pair.backlash_stack())
-        chain.append(
-            ChainStage(s.name, slug, s.ratio, terms, pair.output_diameter, pair.pressure_angle)
-        )
-        for key, (kind, tol, mu) in laws.items():
-            units[key], nominal[key] = "um", mu
-            defaults[key] = ToleranceEntry(
-                kind=kind,
-                tolerance_um=tol,
-                nominal_um=mu,
-                sigmas=6.0 if kind == "rayleigh" else None,
-                phase=kind == "rayleigh",
-            )
-            drawn[key] = (pair, "driving" if ".driving_gear" in key else "driven")
+        chain.append(ChainStage(s.name, _slug(s.name), s.ratio, sy.model))
+        for key, law in sy.laws.items():
+            units[key], nominal[key] = sy.units[key], float(sy.nominal[key])
+            defaults[key] = law
+            if sy.grade_um is not None:
+                graders[key] = sy.grade_um
 
-    def grade_um(key: str, grade: int) -> GradeTolerance | None:
-        """A spur gear's eccentricity: its ISO 1328-2 total radial composite tolerance F_i″."""
-        if not key.endswith("_gear_eccentricity") or key not in drawn:
-            return None
-        pair, which = drawn[key]
-        if isinstance(pair, BevelPair):
-            from gearte.errors import ParameterError
-            from gearte.tolerance.iso1328 import BEVEL_GRADE_REASON
-
-            raise ParameterError(
-                f"analyses.yield.tolerances.{key}.grade", grade, BEVEL_GRADE_REASON
-            )
-        if not isinstance(pair, SpurPair):
-            return None
-        teeth = getattr(pair, which).teeth
-        f_i2 = radial_composite_tolerances(grade, pair.module, pair.module * teeth).F_i2
-        return GradeTolerance(
-            f_i2,
-            f"ISO 1328-2:1997 radial composite, grade {grade}, {which} gear: z = {teeth}, "
-            f"m = {pair.module:g} mm, d = {pair.module * teeth:g} mm: F_i″ = {f_i2:g} µm",
-        )
+    def grade_um(key: str, grade: int):
+        """The tolerance a grade implies for a key of a stage's own errors (its family's)."""
+        fn = graders.get(key)
+        return None if fn is None else fn(key, grade)
 
     model = GearChainYield(chain, nominal, case.chain.lever_length_mm)
     return model, chain, units, nominal, defaults, grade_um
 
 
-def _stage_pairs(case: Case, drives: dict, built: dict) -> dict:
-    """Stage name → its gear pair: a ``[pair]`` stage's (``built``: name → the built pair) or a
-    ``gear_pair`` drive's (``drives``: name → the built drive)."""
+def _own_tolerances(case: Case) -> dict:
+    """Stage name → its :class:`~gearte.families.StageYield`: a ``[pair]`` stage's backlash
+    stack, a ``[drive]`` stage's family's own tolerances (``None`` where its description has
+    none: a measured drive; such stages, and stages given by values, draw their lost motion
+    from :func:`_stage_tolerances`)."""
+    from gearte.families import get_family
+    from gearte.families.gear_pair import pair_stage_yield
+
     out = {}
     for s in case.chain.stages:
-        pair = built.get(s.name)
-        if pair is None:
-            pair = getattr(drives.get(s.name), "pair", None)
-        if pair is not None:
-            out[s.name] = pair
+        sy = None
+        if s.drive is not None:
+            fam = get_family(s.drive.kind)
+            if fam.chain_yield is not None and s.lost_motion_max_arcmin is None:
+                sy = fam.chain_yield(s.drive.validated_case, _slug(s.name))
+        elif s.pair is not None and s.lost_motion_max_arcmin is None:
+            sy = pair_stage_yield(s.pair, _slug(s.name))
+        if sy is not None:
+            out[s.name] = sy
     return out
 
 
@@ -722,18 +706,16 @@ def preflight(case: Case) -> None:
     """
     from gearte.studies._yield import yield_inputs
 
-    drives = {}
-    built = {}
     for st in case.chain.stages:
         if st.drive is not None:
-            drives[st.name] = st.drive.build(st.name)
+            st.drive.build(st.name)
         elif st.lost_motion_max_arcmin is None and st.pair is not None:
-            built[st.name] = st.pair.build()
+            st.pair.build()
     sec = case.analyses.yield_ if case.analyses is not None else None
     if sec is None:
         return
     model, _, units, nominal, defaults, grade_um = _yield_setup(
-        case, sec, _stage_pairs(case, drives, built), {}
+        case, sec, _own_tolerances(case), {}
     )
     yield_inputs(sec, units, nominal, defaults, grade_um=grade_um, quantities=model.quantities)
 
@@ -752,15 +734,12 @@ def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> A
 
     sec = case.analyses.yield_ if case.analyses is not None else None
     assert sec is not None
-    built = {k: v[3] for k, v in backlash.items() if v[3] is not None}
+    own = _own_tolerances(case)
     model, chain, units, nominal, defaults, grade_um = _yield_setup(
-        case,
-        sec,
-        _stage_pairs(case, drives, built),
-        _stage_tolerances(case, stages, drives, backlash),
+        case, sec, own, _stage_tolerances(case, stages, drives, backlash)
     )
 
-    radial = {t.key for st in chain for t in st.terms if t.radial}
+    radial = {k for s in chain if s.name in own for k in own[s.name].radial}
 
     def worst_case(errors) -> dict:
         """This chain with every drawn error held constant at the sample's value (a radial
@@ -805,6 +784,13 @@ def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> A
         "motion from their law (drive spread, min/mean/max, or constant); joint = Σ stage lost "
         "motion / downstream ratios (eq. 30), sample by sample."
     )
+    for st in case.chain.stages:
+        if st.drive is not None and st.name in own and st.drive.kind != "gear_pair":
+            res.notes.append(
+                f"{st.name}: a {st.drive.kind} drive, draws its own tolerances (keys "
+                f"{_slug(st.name)}.<error>, its family's laws) → its lost motion by its family's "
+                "model (gearte.families), sample by sample."
+            )
     return res
 
 

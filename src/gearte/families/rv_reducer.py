@@ -1,0 +1,95 @@
+"""Drive family ``rv_reducer``: a whole RV reducer (Han et al. 2023 load sharing, Hu et al. 2020
+contact) with its catalogue virtual test.
+
+Description: ``[reducer]`` (:class:`gearte.studies.rv_reducer.ReducerSection`) → the
+:class:`~gearte.models.rv_load_sharing.RVReducer` (:func:`gearte.studies.rv_reducer.build_reducer`);
+``[analyses]``'s ``catalogue`` options set the drive's virtual test. An RV reducer described with
+its given (measured) errors has no tolerance stack: in a chain's yield its lost motion is held at
+its model's value.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from gearte.families import DriveFamily
+
+__all__ = ["FAMILY", "to_object", "drive"]
+
+
+def to_object(case: Any) -> Any:
+    """The :class:`~gearte.models.rv_load_sharing.RVReducer` of a validated ``rv_reducer`` case."""
+    from gearte.studies.rv_reducer import build_reducer
+
+    return build_reducer(case.reducer)
+
+
+def drive(case: Any, name: str) -> Any:
+    """The :class:`~gearte.drives.rv_reducer.RVDrive` of a validated case: its pin-contact law,
+    its first stage's backlash at the output (when additive) and the case's catalogue options.
+
+    Parameters
+    ----------
+    case : Case
+        The validated ``rv_reducer`` case.
+    name : str
+        Label of the drive (the chain stage's name).
+
+    Raises
+    ------
+    ParameterError
+        ``reducer.rated_torque_Nm`` missing (the catalogue virtual test needs it).
+    """
+    from gearte.drives.rv_reducer import RVDrive
+    from gearte.errors import ParameterError
+    from gearte.studies.rv_reducer import first_stage_terms
+    from gearte.units import deg_to_rad
+
+    red = to_object(case)
+    if getattr(red, "rated_torque", None) is None:
+        raise ParameterError(
+            "reducer.rated_torque_Nm",
+            None,
+            "an RV drive's lost motion and stiffness come from the catalogue virtual test, "
+            "which needs the rated torque",
+        )
+    law_name = getattr(case.reducer, "contact_law", None)  # the case's pin-contact law
+    law = None
+    if law_name is not None:
+        from gearte.models.rv_load_sharing import contact_law
+
+        law = contact_law(red, law_name)
+    cat = getattr(case.analyses, "catalogue", None)
+    free = 0.0  # the first stage's backlash at the output (first_stage_backlash = additive)
+    fs_terms = first_stage_terms(case.reducer.first_stage)
+    if fs_terms is not None and getattr(cat, "first_stage_backlash", "additive") == "additive":
+        import numpy as np
+
+        from gearte.models.rv_first_stage import output_free_angle
+        from gearte.units import um_to_mm
+
+        mid = um_to_mm(np.asarray(fs_terms["backlash_um"]["mid"], dtype=float))
+        free = float(output_free_angle(mid, fs_terms["r_sun"], float(red.ratio)))
+    if cat is None:
+        return RVDrive(red, name=name, law=law, first_stage_free_angle=free)
+    return RVDrive(
+        red,
+        name=name,
+        position=float(deg_to_rad(cat.position_deg)),
+        turning_points=tuple(cat.torque_sweep),
+        steps_per_segment=cat.steps_per_segment,
+        lost_motion_fraction=cat.lost_motion_fraction,
+        law=law,
+        first_stage_free_angle=free,
+    )
+
+
+FAMILY = DriveFamily(
+    kind="rv_reducer",
+    sections=("reducer", "analyses"),
+    to_object=to_object,
+    drive=drive,
+    drive_kinds=("rv_reducer",),
+    warm_cases=("hu2020_rv80e_initial_reducer", "han2023_rv110e_yield"),
+    bench_case="hu2020_rv80e_initial_reducer",
+)

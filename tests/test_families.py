@@ -1,0 +1,89 @@
+"""The drive-family registry (gearte.families): chains, yield and warm-up find the families there,
+and in a chain's yield every family draws its own tolerances."""
+
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+
+import gearte
+from gearte.cases import case_path
+from gearte.families import FAMILY_MODULES, families, family_kinds, get_family
+from gearte.io.case_file import load_case, load_case_dict
+from gearte.studies import RunOptions
+
+OPTS = RunOptions(progress=False)
+
+
+def test_every_registered_family_loads_and_is_a_study_kind_with_its_sections():
+    from gearte.io.kinds import available_kinds, get_kind
+
+    assert len(FAMILY_MODULES) == len(family_kinds())
+    for kind, fam in families().items():
+        assert fam.kind == kind
+        assert kind in available_kinds()
+        fields = get_kind(kind).Case.model_fields
+        for sec in fam.sections:
+            assert sec in fields, f"{kind}: section {sec!r} is not in its Case"
+        if fam.bench_case is not None:
+            assert load_case(fam.bench_case).case.kind == kind
+
+
+def test_unknown_family_is_an_error_naming_the_registered_ones():
+    with pytest.raises(KeyError, match="registered"):
+        get_family("harmonic_flux_capacitor")
+    data = tomllib.loads(case_path("robot_joint_spur_rv").read_text())
+    data["chain"]["stages"][1]["drive"]["kind"] = "nope"
+    with pytest.raises(gearte.errors.CaseFileError, match="drive families"):
+        load_case_dict(data)
+
+
+def test_cycloid_family_description_round_trips_through_its_sections():
+    """``to_sections`` then ``to_object`` gives the same CycloidStage (one function each way)."""
+    fam = get_family("cycloid_stage")
+    case = load_case("hu2020_rv80e_initial")
+    stage = fam.to_object(case)
+    assert fam.to_sections is not None
+    data = {"case": {"kind": "cycloid_stage"}, **fam.to_sections(stage)}
+    assert fam.to_object(load_case_dict(data)) == stage
+
+
+def _spur_and_cycloid() -> dict:
+    """robot_joint_spur_rv_yield's spur pair (Jiang 2024) driving the cycloid stage of
+    hu2020_rv80e_initial (its illustrative component-error bands), inline."""
+    chain = tomllib.loads(case_path("robot_joint_spur_rv_yield").read_text())
+    cyc = tomllib.loads(case_path("hu2020_rv80e_initial").read_text())
+    chain["chain"]["stages"][1] = {
+        "name": "cycloid stage",
+        "ratio": 39.0,
+        "drive": {"kind": "cycloid_stage", "stage": cyc["stage"], "errors": cyc["errors"]},
+    }
+    chain["analyses"]["yield"].update(samples=2000, sobol_samples=256, bootstrap=0)
+    chain["analyses"]["yield"]["spec"] = {"joint_lost_motion [arcmin]": {"upper": 2.0}}
+    del chain["analyses"]["yield"]["tolerances"]
+    return chain
+
+
+def test_chain_yield_ranks_each_drives_own_tolerances_in_its_contributions():
+    """A spur pair and a cycloid stage in one chain: the yield draws the pair's backlash-stack
+    contributors and the cycloid stage's nine component errors (keys ``cycloid_stage.<factor>``),
+    never one normal law for the cycloid stage; both drives' errors appear in the ranking, and
+    the cycloid stage's drawn lost motion has the mean of its own model (Hu 2020 eq 16)."""
+    res = gearte.run_case(load_case_dict(_spur_and_cycloid(), name="spur_cycloid"), OPTS)
+    y = res["yield"].values
+    keys = set(y["tolerances"])
+    assert "cycloid stage" not in keys  # no single law for the stage
+    cyc = {k for k in keys if k.startswith("cycloid_stage.")}
+    assert "cycloid_stage.pin_circle_radius_error" in cyc
+    assert "cycloid_stage.cumulative_pitch_error" in cyc
+    assert any(k.startswith("spur_pair.") for k in keys)
+    share = y["linear_share"]
+    assert sum(share[k] for k in cyc) > 0.0
+    assert sum(share[k] for k in share if k.startswith("spur_pair.")) > 0.0
+    ranked = sorted(share, key=share.get, reverse=True)
+    assert any(k in cyc for k in ranked[:5])
+    q = y["quantities"]["cycloid_stage.lost_motion [arcmin]"]
+    own = res["cycloid_stage_drive"].values
+    assert q["mean"] == pytest.approx(own["lost_motion_mean [arcmin]"], rel=0.02)
+    assert any("draws its own tolerances" in n for n in res["yield"].notes)
