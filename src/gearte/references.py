@@ -33,6 +33,26 @@ REFERENCES: dict[str, str] = {
         "Considering Tooth Profile Modifications and Errors. Machines 11(6), 626. "
         "doi:10.3390/machines11060626"
     ),
+    "harmonicdrive2015": (
+        "Harmonic Drive AG (2015). CHA Servo Actuator manual 1018854 12/2015, section 4.2 "
+        "'Calculation of the torsion angle', equations 68.1-68.4 and worked example "
+        "(three-segment torsional stiffness K1/K2/K3 with limit torques T1/T2)."
+    ),
+    "harmonicdrive_csf": (
+        "Harmonic Drive LLC. CSF & CSG Series, cup type component sets and housed units: "
+        "engineering data (torsional stiffness tables 41-43, hysteresis loss, positioning "
+        "accuracy table 40)."
+    ),
+    "tuttle1992": (
+        "Tuttle T. D. (1992). Understanding and modeling the behavior of a harmonic drive gear "
+        "transmission. S.M. thesis, Massachusetts Institute of Technology; MIT Artificial "
+        "Intelligence Laboratory technical report, May 1992."
+    ),
+    "jia2021": (
+        "Jia H., Li J., Xiang G., Wang J., Xiao K., Han Y. (2021). Modeling and analysis of pure "
+        "kinematic error in harmonic drive. Mechanism and Machine Theory 155, 104122. "
+        "doi:10.1016/j.mechmachtheory.2020.104122"
+    ),
 }
 
 

@@ -47,6 +47,7 @@ FAMILY_MODULES: tuple[str, ...] = (
     "gearte.families.planetary",
     "gearte.families.cycloid_stage",
     "gearte.families.rv_reducer",
+    "gearte.families.strain_wave",
 )
 
 
