@@ -245,3 +245,15 @@ def test_wrist_chain_yield_draws_the_gears_own_tolerances():
 def test_both_cases_are_bundled():
     cases = list_cases()
     assert CASE in cases and "robot_wrist_strain_wave" in cases
+
+
+def test_family_labels_join_the_label_registry_when_its_module_is_imported():
+    """A family's own labels reach every process that reads its results (importing its
+    description module registers them; the report's background process unpickles the case)."""
+    import gearte.families.strain_wave  # noqa: F401
+    from gearte.labels import label_with_unit
+
+    assert (
+        label_with_unit("te_once_per_wg_revolution [arcsec]")
+        == "TE once per wave-generator revolution [arcsec]"
+    )

@@ -129,6 +129,16 @@ class DriveFamily:
     bench_case: str | None = None
     labels: Mapping[str, str] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        # its labels join the registry when its module is imported: in every process that reads
+        # one of its results (unpickling the case imports the family's description module),
+        # the report's background process included
+        if self.labels:
+            from gearte.labels import LABELS
+
+            for name, text in self.labels.items():
+                LABELS.setdefault(name, text)
+
 
 def family_kinds() -> tuple[str, ...]:
     """The registered families' kinds, in registration order (nothing imported)."""
@@ -154,11 +164,6 @@ def get_family(kind: str) -> DriveFamily:
     family = importlib.import_module(FAMILY_MODULES[kinds.index(kind)]).FAMILY
     if family.kind != kind:  # pragma: no cover - a registration error
         raise RuntimeError(f"{FAMILY_MODULES[kinds.index(kind)]}.FAMILY.kind is {family.kind!r}")
-    if family.labels:
-        from gearte.labels import LABELS
-
-        for name, text in family.labels.items():
-            LABELS.setdefault(name, text)
     _LOADED[kind] = family
     return family
 
