@@ -87,3 +87,31 @@ def test_chain_yield_ranks_each_drives_own_tolerances_in_its_contributions():
     own = res["cycloid_stage_drive"].values
     assert q["mean"] == pytest.approx(own["lost_motion_mean [arcmin]"], rel=0.02)
     assert any("draws its own tolerances" in n for n in res["yield"].notes)
+
+
+def _rv_cases() -> list[str]:
+    import tomllib
+
+    from gearte.cases import list_cases
+
+    return sorted(
+        n
+        for n, p in list_cases().items()
+        if tomllib.loads(p.read_text())["case"]["kind"] == "rv_reducer"
+    )
+
+
+@pytest.mark.parametrize("name", _rv_cases())
+def test_rv_cycloid_stage_is_built_once_whichever_description(name):
+    """The reducer's cycloid stage from its [reducer] section (stage_section → the
+    cycloid_stage kind's build_stage) equals the reducer object's own (rv_load_sharing's
+    cycloid_stage), and RVReducer.K1 is that stage's K1 (one K1)."""
+    from gearte.models.rv_load_sharing import cycloid_stage
+    from gearte.studies.cycloid_stage import build_stage
+    from gearte.studies.rv_reducer import build_reducer, stage_section
+
+    case = load_case(name)
+    red = build_reducer(case.reducer)
+    stage = build_stage(stage_section(case.reducer))
+    assert stage == cycloid_stage(red)
+    assert red.K1 == stage.K1

@@ -85,7 +85,7 @@ def short_width_coefficient(z_p: int, r_p: float, a: float, dr_p: float = 0.0) -
     ----------
     Hu et al. (2020) eq 3, doi:10.3390/app10020481.
     """
-    return a * z_p / (r_p + dr_p)
+    return _k1(z_p, r_p, a, dr_p, "ground")
 
 
 #: Where the papers differ on K1 (and the radii of the curvature formula): ``"ground"`` (Hu 2020

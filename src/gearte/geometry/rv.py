@@ -745,11 +745,16 @@ class RVReducer:
 
     @property
     def K1(self) -> float:  # noqa: N802 - paper symbol
-        """Short-width coefficient ``K1 = a z_p / (r_p + Δr_p)`` (Hu 2020 eq 2)."""
-        return (
-            self.cranks.eccentricity
-            * self.pins.count
-            / (self.pins.circle_radius + self.discs.shift_modification)
+        """Short-width coefficient ``K1 = a z_p / (r_p + Δr_p)`` (Hu 2020 eq 3): the cycloid
+        stage's own (:func:`gearte.geometry.cycloid.short_width_coefficient`, the K1 of
+        :class:`~gearte.geometry.cycloid.CycloidStage`)."""
+        from gearte.geometry.cycloid import short_width_coefficient
+
+        return short_width_coefficient(
+            self.pins.count,
+            self.pins.circle_radius,
+            self.cranks.eccentricity,
+            self.discs.shift_modification,
         )
 
     @property

@@ -6,11 +6,13 @@ and fails only in ``run`` (or gives a result no material could carry). These che
 value to the drive's size and refuse it at ``gearte validate``, naming the key and the value in
 the user's units.
 
-Torque against size (``cycloid_stage``, ``rv_reducer``): the torque a disc carries is turned into
-the force on the most loaded pin with Hu et al. (2020) eq 30 (all z_p/2 pins of the loaded flank
-share the torque: F = 4 T_c / (K1 z_c r_p), a lower bound of the real F_max) and into the largest
-Hertz line-contact pressure of that pin on the flank at its first-contact phase φ0 (Johnson eq
-4.45; :func:`gearte.models.contact_law.pin_pressure_estimate`, re-exported here). Above
+A study kind checks its case with a ``plausibility(case)`` function (found by name, as its
+``preflight``: :func:`implausible_values`), building its drive with its own builder. Torque against
+size (``cycloid_stage``, ``rv_reducer``, :func:`torque_problem`): the torque a disc carries is
+turned into the force on the most loaded pin with Hu et al. (2020) eq 30 (all z_p/2 pins of the
+loaded flank share the torque: F = 4 T_c / (K1 z_c r_p), a lower bound of the real F_max) and into
+the largest Hertz line-contact pressure of that pin on the flank at its first-contact phase φ0
+(Johnson eq 4.45; :func:`gearte.models.contact_law.pin_pressure_estimate`, re-exported here). Above
 :data:`MAX_CONTACT_PRESSURE_MPA` no steel carries the load even once (through-hardened bearing
 steel: about 4 000 MPa static line contact, ISO 76), so the torque is refused with the pressure and
 the torque read as N·mm beside it. A torque that is high but possible is left to the analyses (and
@@ -24,7 +26,6 @@ Johnson K. L. (1985). Contact Mechanics, eq 4.45. doi:10.1017/CBO9781139171731
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from gearte.errors import ParameterError
@@ -42,6 +43,7 @@ __all__ = [
     "implausible_values",
     "pin_pressure_estimate",
     "plausibility_problems",
+    "torque_problem",
 ]
 
 
@@ -55,9 +57,27 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def _torque_problem(
+def torque_problem(
     field: str, torque_Nm: float, stage: Any, share: float, E: float, nu: float
 ) -> tuple[str, float, str] | None:
+    """``(field, torque [N·m], reason)`` when ``torque_Nm`` on one disc's share of the stage
+    loads its most loaded pin beyond any steel (:data:`MAX_CONTACT_PRESSURE_MPA`), else ``None``.
+
+    Parameters
+    ----------
+    field : str
+        The key named in the message.
+    torque_Nm : float
+        The torque as given [N·m].
+    stage : CycloidStage
+        The stage (built by its kind's one builder).
+    share : float
+        Share of the torque one disc carries [-].
+    E : float
+        Young's modulus [MPa].
+    nu : float
+        Poisson's ratio [-].
+    """
     from gearte.models.contact_law import implausible_pin_pressure
     from gearte.units import Nm_to_Nmm
 
@@ -69,72 +89,6 @@ def _torque_problem(
         torque_Nm,
         f"{reason}; was it given in N·mm? ({torque_Nm:g} N·mm = {torque_Nm / 1000:g} N·m)",
     )
-
-
-def _cycloid_stage(case: Any) -> list[tuple[str, float, str]]:
-    tc = case.analyses.tooth_contact
-    if tc is None:
-        return []
-    from gearte.geometry.cycloid import CycloidStage
-    from gearte.units import arcmin_to_rad
-
-    st = case.stage
-    stage = CycloidStage(
-        z_p=st.pins,
-        r_p=st.pin_circle_radius_mm,
-        r_rp=st.pin_radius_mm,
-        a=st.eccentricity_mm,
-        b=st.face_width_mm,
-        dr_rp=st.equidistant_modification_mm,
-        dr_p=st.shifted_modification_mm,
-        rotation=float(arcmin_to_rad(st.rotation_modification_arcmin)),
-    )
-    field = "analyses.tooth_contact.torque_Nm"
-    got = _torque_problem(
-        field, tc.torque_Nm, stage, tc.disc_share, tc.youngs_modulus_MPa, tc.poisson_ratio
-    )
-    return [got] if got else []
-
-
-def _rv_reducer(case: Any) -> list[tuple[str, float, str]]:
-    from gearte.geometry.cycloid import CycloidStage
-
-    r = case.reducer
-    stage = CycloidStage(
-        z_p=r.pins.count,
-        r_p=r.pins.circle_radius_mm,
-        r_rp=r.pins.pin_radius_mm,
-        a=r.cranks.eccentricity_mm,
-        b=r.discs.face_width_mm,
-        dr_rp=r.discs.equidistant_modification_mm,
-        dr_p=r.discs.shift_modification_mm,
-    )
-    E, nu, share = r.discs.youngs_modulus_MPa, r.discs.poisson_ratio, 1.0 / r.discs.count
-    torques: list[tuple[str, float, float]] = []
-    if r.rated_torque_Nm is not None:
-        torques.append(("reducer.rated_torque_Nm", r.rated_torque_Nm, share))
-    if case.operation is not None:
-        torques.append(("operation.output_torque_Nm", case.operation.output_torque_Nm, share))
-    for name in type(case.analyses).model_fields:
-        sec = getattr(case.analyses, name)
-        value = getattr(sec, "torque_Nm", None)
-        if isinstance(value, int | float) and not isinstance(value, bool):
-            key = type(case.analyses).model_fields[name].alias or name
-            torques.append(
-                (f"analyses.{key}.torque_Nm", float(value), getattr(sec, "disc_share", share))
-            )
-    out = []
-    for field, value, s in torques:
-        got = _torque_problem(field, value, stage, s, E, nu)
-        if got:
-            out.append(got)
-    return out
-
-
-_CHECKS: dict[str, Callable[[Any], list[tuple[str, float, str]]]] = {
-    "cycloid_stage": _cycloid_stage,
-    "rv_reducer": _rv_reducer,
-}
 
 
 def implausible_values(kind: str, case: Any) -> list[tuple[str, float, str]]:
@@ -156,12 +110,17 @@ def implausible_values(kind: str, case: Any) -> list[tuple[str, float, str]]:
         Empty when every value is plausible, or when the drive itself cannot be built (the
         schema's own checks report that).
     """
-    check = _CHECKS.get(kind)
+    from gearte.io.kinds import get_kind
+
+    try:
+        check = getattr(get_kind(kind), "plausibility", None)
+    except KeyError:
+        return []
     if check is None:
         return []
     try:
-        return check(case)
-    except ParameterError:  # the geometry itself is refused: reported by the schema's checks
+        return list(check(case))
+    except (ParameterError, ValueError):  # the geometry itself is refused: the schema says so
         return []
 
 

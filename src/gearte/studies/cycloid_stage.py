@@ -264,6 +264,32 @@ def build_stage(stage: Stage):
     )
 
 
+def plausibility(case: Case) -> list[tuple[str, float, str]]:
+    """``(field, torque [N·m], reason)`` when the tooth contact's torque could not be carried by
+    any steel pin contact of this stage (:func:`gearte.io.plausibility.torque_problem`), the
+    stage built by :func:`build_stage`.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case (sections may be placeholders: gearte.io.plausibility).
+    """
+    from gearte.io.plausibility import torque_problem
+
+    tc = case.analyses.tooth_contact
+    if tc is None:
+        return []
+    got = torque_problem(
+        "analyses.tooth_contact.torque_Nm",
+        tc.torque_Nm,
+        build_stage(case.stage),
+        tc.disc_share,
+        tc.youngs_modulus_MPa,
+        tc.poisson_ratio,
+    )
+    return [got] if got else []
+
+
 def _geometry(st) -> AnalysisResult:
     from gearte.geometry.cycloid import min_convex_curvature_radius
     from gearte.units import rad_to_arcmin, rad_to_deg

@@ -1067,6 +1067,70 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
     return red
 
 
+def stage_section(sec: ReducerSection):
+    """The ``cycloid_stage`` kind's ``[stage]`` section of the reducer's cycloid–pin stage: the
+    one mapping of the RV description to the stage, built by that kind's one builder
+    (:func:`gearte.studies.cycloid_stage.build_stage`; the reducer object's own stage,
+    :func:`gearte.models.rv_load_sharing.cycloid_stage`, is the same:
+    tests/test_families.py).
+
+    Parameters
+    ----------
+    sec : ReducerSection
+        The validated ``[reducer]`` table.
+    """
+    from gearte.studies import cycloid_stage as cs
+
+    return cs.Stage(
+        pins=sec.pins.count,
+        cycloid_teeth=sec.pins.count - 1,
+        pin_circle_radius_mm=sec.pins.circle_radius_mm,
+        pin_radius_mm=sec.pins.pin_radius_mm,
+        eccentricity_mm=sec.cranks.eccentricity_mm,
+        face_width_mm=sec.discs.face_width_mm,
+        equidistant_modification_mm=sec.discs.equidistant_modification_mm,
+        shifted_modification_mm=sec.discs.shift_modification_mm,
+    )
+
+
+def plausibility(case: Case) -> list[tuple[str, float, str]]:
+    """``(field, torque [N·m], reason)`` for each torque of the case (rated, operation, an
+    analysis's ``torque_Nm``) that no steel pin contact of this stage could carry
+    (:func:`gearte.io.plausibility.torque_problem`), the stage built by the one builder
+    (:func:`stage_section`).
+
+    Parameters
+    ----------
+    case : Case
+        The validated case (sections may be placeholders: gearte.io.plausibility).
+    """
+    from gearte.io.plausibility import torque_problem
+    from gearte.studies.cycloid_stage import build_stage
+
+    r = case.reducer
+    stage = build_stage(stage_section(r))
+    E, nu, share = r.discs.youngs_modulus_MPa, r.discs.poisson_ratio, 1.0 / r.discs.count
+    torques: list[tuple[str, float, float]] = []
+    if r.rated_torque_Nm is not None:
+        torques.append(("reducer.rated_torque_Nm", r.rated_torque_Nm, share))
+    if case.operation is not None:
+        torques.append(("operation.output_torque_Nm", case.operation.output_torque_Nm, share))
+    for name in type(case.analyses).model_fields:
+        sec = getattr(case.analyses, name)
+        value = getattr(sec, "torque_Nm", None)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            key = type(case.analyses).model_fields[name].alias or name
+            torques.append(
+                (f"analyses.{key}.torque_Nm", float(value), getattr(sec, "disc_share", share))
+            )
+    out = []
+    for field, value, s in torques:
+        got = torque_problem(field, value, stage, s, E, nu)
+        if got:
+            out.append(got)
+    return out
+
+
 def build_stage_case(case: Case):
     """The ``cycloid_stage`` case of the reducer's cycloid–pin stage (same geometry, same errors).
 
@@ -1077,16 +1141,7 @@ def build_stage_case(case: Case):
     from gearte.studies import cycloid_stage as cs
 
     r, a = case.reducer, case.analyses
-    stage = cs.Stage(
-        pins=r.pins.count,
-        cycloid_teeth=r.pins.count - 1,
-        pin_circle_radius_mm=r.pins.circle_radius_mm,
-        pin_radius_mm=r.pins.pin_radius_mm,
-        eccentricity_mm=r.cranks.eccentricity_mm,
-        face_width_mm=r.discs.face_width_mm,
-        equidistant_modification_mm=r.discs.equidistant_modification_mm,
-        shifted_modification_mm=r.discs.shift_modification_mm,
-    )
+    stage = stage_section(r)
     tc = None
     if a.tooth_contact is not None:
         t = a.tooth_contact
