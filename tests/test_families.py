@@ -115,3 +115,24 @@ def test_rv_cycloid_stage_is_built_once_whichever_description(name):
     stage = build_stage(stage_section(case.reducer))
     assert stage == cycloid_stage(red)
     assert red.K1 == stage.K1
+
+
+@pytest.mark.parametrize("name", ["jiang2024_spur_pair", "jiang2024_bevel_pair"])
+def test_gear_pair_family_description_round_trips_through_its_section(name):
+    """to_sections then to_object gives the same pair (to the µm ↔ mm round trip)."""
+    import dataclasses
+
+    fam = get_family("gear_pair")
+    pair = fam.to_object(load_case(name))
+    assert fam.to_sections is not None
+    again = fam.to_object(load_case_dict({"case": {"kind": "gear_pair"}, **fam.to_sections(pair)}))
+    assert type(again) is type(pair)
+
+    def flat(x):
+        if dataclasses.is_dataclass(x):
+            return [v for f in dataclasses.fields(x) for v in flat(getattr(x, f.name))]
+        if isinstance(x, tuple):
+            return [v for y in x for v in flat(y)]
+        return [x]
+
+    assert flat(again) == pytest.approx(flat(pair), rel=1e-12, abs=1e-15)

@@ -12,12 +12,73 @@ from typing import Any
 
 from gearte.families import DriveFamily, StageYield
 
-__all__ = ["FAMILY", "to_object", "drive", "chain_yield", "pair_stage_yield"]
+__all__ = ["FAMILY", "to_object", "to_sections", "drive", "chain_yield", "pair_stage_yield"]
 
 
 def to_object(case: Any) -> Any:
     """The pair a validated ``gear_pair`` case's ``[pair]`` describes."""
     return case.pair.build()
+
+
+def to_sections(pair: Any) -> dict[str, Any]:
+    """The ``[pair]`` section that describes ``pair`` (a
+    :class:`~gearte.models.backlash.SpurPair` or :class:`~gearte.models.backlash.BevelPair`):
+    :func:`to_object` of it gives the pair back. Tolerances derived from grades or allowance
+    classes are written as the µm values they gave.
+
+    Parameters
+    ----------
+    pair : SpurPair or BevelPair
+        The pair [mm, rad].
+    """
+    from gearte.models.backlash import BevelPair
+    from gearte.units import mm_to_um, rad_to_deg
+
+    def um(x: float) -> float:
+        return float(mm_to_um(x))
+
+    def gear(g: Any) -> dict[str, Any]:
+        out: dict[str, Any] = {
+            "teeth": int(g.teeth),
+            "thickness_upper_um": um(g.thickness_upper),
+            "thickness_lower_um": um(g.thickness_lower),
+        }
+        if isinstance(pair, BevelPair):
+            out.update(
+                bearing_clearance_min_um=um(g.bearing_clearance[0]),
+                bearing_clearance_max_um=um(g.bearing_clearance[1]),
+                face_profile_tol_um=um(g.face_profile_tol),
+                seat_profile_tol_um=um(g.seat_profile_tol),
+            )
+        else:
+            out["radial_composite_tol_um"] = um(g.radial_composite_tol)
+        return out
+
+    sec: dict[str, Any] = {
+        "module_mm": float(pair.module),
+        "pressure_angle_deg": float(rad_to_deg(pair.pressure_angle)),
+        "min_backlash_limit_um": um(pair.min_backlash_limit),
+        "driving": gear(pair.driving),
+        "driven": gear(pair.driven),
+    }
+    if isinstance(pair, BevelPair):
+        sec.update(
+            type="bevel",
+            face_width_mm=float(pair.face_width),
+            shaft_angle_deg=float(rad_to_deg(pair.shaft_angle)),
+            shaft_distance_tol_um=um(pair.shaft_distance_tol),
+            shaft_angle_tol_um=um(pair.shaft_angle_tol),
+            composite_tol_um=um(pair.composite_tol),
+        )
+    else:
+        sec.update(
+            type="spur",
+            centre_distance_tol_um=um(pair.centre_distance_tol),
+            runout_um=um(pair.runout),
+            bearing_clearance_min_um=um(pair.bearing_clearance[0]),
+            bearing_clearance_max_um=um(pair.bearing_clearance[1]),
+        )
+    return {"pair": sec}
 
 
 def drive(case: Any, name: str) -> Any:
@@ -121,6 +182,7 @@ FAMILY = DriveFamily(
     kind="gear_pair",
     sections=("pair",),
     to_object=to_object,
+    to_sections=to_sections,
     drive=drive,
     chain_yield=chain_yield,
     drive_kinds=("spur_pair", "bevel_pair"),
