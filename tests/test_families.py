@@ -136,3 +136,22 @@ def test_gear_pair_family_description_round_trips_through_its_section(name):
         return [x]
 
     assert flat(again) == pytest.approx(flat(pair), rel=1e-12, abs=1e-15)
+
+
+@pytest.mark.slow
+def test_chain_yield_rv_stage_draws_its_cases_own_yield_tolerances():
+    """An RV drive whose case has [analyses.yield] (han2023_rv110e_yield) draws those tolerances
+    in the chain (keys rv_reducer.<family>, each sample one reducer through the catalogue virtual
+    test); its drawn lost motion centres on the drive's deterministic one (slow: RV tests)."""
+    d = tomllib.loads(case_path("robot_joint_spur_rv_yield").read_text())
+    d["chain"]["stages"][1]["drive"]["case"] = "han2023_rv110e_yield.toml"
+    d["analyses"]["yield"].update(samples=48, sobol_samples=0, bootstrap=0, chunk_size=48)
+    base = str(case_path("han2023_rv110e").parent)
+    res = gearte.run_case(load_case_dict(d, name="rv_chain", base_dir=base), OPTS)
+    keys = set(res["yield"].values["tolerances"])
+    assert "RV reducer" not in keys
+    assert {"rv_reducer.cam", "rv_reducer.disc_cumulative_pitch"} <= keys
+    q = res["yield"].values["quantities"]["rv_reducer.lost_motion [arcmin]"]
+    own = res["rv_reducer_drive"].values["lost_motion [arcmin]"]
+    assert q["sd"] > 0
+    assert q["mean"] == pytest.approx(own, abs=4 * q["sd"] / 48**0.5)

@@ -63,7 +63,8 @@ class StageYield:
     units : mapping
         Error key → the unit its values are drawn in (``"um"``, ``"deg"``, ``"arcmin"``).
     nominal : mapping
-        Error key → the value used where a batch does not draw it (in its unit).
+        Error key → the value used where a batch does not draw it (in its unit); a key left out
+        has nominal 0 unless its law gives one.
     model : callable
         ``model(errors, n)`` → the stage's lost motion [rad] at its output, an array of ``n``
         (``errors``: key → array of drawn values, in the keys' units). Picklable (a module-level
@@ -73,6 +74,9 @@ class StageYield:
     grade_um : callable, optional
         ``grade_um(key, grade)`` → :class:`gearte.studies._yield.GradeTolerance` or ``None``: the
         tolerance an accuracy grade implies for one of its keys.
+    families : mapping
+        Family key → its instance keys (``<slug>.cam`` → ``<slug>.cam.c1.d1`` …): a law on a
+        family applies to each instance, drawn independently.
     """
 
     laws: Mapping[str, Any]
@@ -81,6 +85,7 @@ class StageYield:
     model: Callable[[Mapping[str, Any], int], Any]
     radial: frozenset[str] = frozenset()
     grade_um: Callable[[str, int], Any] | None = None
+    families: Mapping[str, list[str]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -4,17 +4,22 @@ contact) with its catalogue virtual test.
 Description: ``[reducer]`` (:class:`gearte.studies.rv_reducer.ReducerSection`) → the
 :class:`~gearte.models.rv_load_sharing.RVReducer` (:func:`gearte.studies.rv_reducer.build_reducer`);
 ``[analyses]``'s ``catalogue`` options set the drive's virtual test. An RV reducer described with
-its given (measured) errors has no tolerance stack: in a chain's yield its lost motion is held at
-its model's value.
+its given (measured) errors only has no tolerances: in a chain's yield its lost motion is held at
+its model's value. One whose case has ``[analyses.yield]`` tolerances draws them in a chain's
+yield too (keys ``<stage slug>.<error key>``), each sample one assembled reducer through the
+catalogue virtual test (:class:`RVLostMotion`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
-from gearte.families import DriveFamily
+import numpy as np
 
-__all__ = ["FAMILY", "to_object", "drive"]
+from gearte.families import DriveFamily, StageYield
+
+__all__ = ["FAMILY", "to_object", "drive", "chain_yield", "RVLostMotion"]
 
 
 def to_object(case: Any) -> Any:
@@ -84,11 +89,71 @@ def drive(case: Any, name: str) -> Any:
     )
 
 
+class RVLostMotion:
+    """A chain stage's lost motion [rad] from its reducer's drawn errors (picklable).
+
+    Parameters
+    ----------
+    model : RVReducerYield or FirstStageBacklashYield
+        The reducer's own yield model (:func:`gearte.studies.rv_reducer._yield_model`).
+    prefix : str
+        ``"<stage slug>."``.
+    """
+
+    def __init__(self, model: Any, prefix: str) -> None:
+        self.model, self.prefix = model, prefix
+
+    def __call__(self, errors: Mapping[str, np.ndarray], n: int) -> np.ndarray:
+        from gearte.units import arcmin_to_rad
+
+        p = self.prefix
+        drawn = {k[len(p) :]: np.asarray(errors[k]) for k in errors if k.startswith(p)}
+        out = np.asarray(self.model(drawn)["lost_motion [arcmin]"], dtype=float)
+        if out.shape != (n,):  # nothing drawn: the reducer as described, every sample
+            out = np.full(n, float(out.reshape(-1)[0]))
+        return np.asarray(arcmin_to_rad(out), dtype=float)
+
+
+def chain_yield(case: Any, slug: str) -> StageYield | None:
+    """The reducer's own tolerances (its case's ``[analyses.yield]``, with the first stage's
+    backlash classes when additive) in a chain's yield; ``None`` without that section.
+
+    Parameters
+    ----------
+    case : Case
+        The validated ``rv_reducer`` case.
+    slug : str
+        The chain stage's key prefix.
+    """
+    sec = getattr(case.analyses, "yield_", None)
+    if sec is None:
+        return None
+    from gearte.studies.rv_reducer import _grade_um, _yield_keys, _yield_model
+
+    red = to_object(case)
+    model, _ = _yield_model(case, red, sec)
+    families, defaults, units = _yield_keys(case, red, sec)
+    laws = {**defaults, **sec.tolerances}
+    if not laws:
+        return None
+    p = f"{slug}."
+    grade = _grade_um(case)
+    return StageYield(
+        laws={p + k: v for k, v in laws.items()},
+        units={p + k: u for k, u in units.items()},
+        nominal={},
+        model=RVLostMotion(model, p),
+        grade_um=lambda key, g: grade(key[len(p) :], g),
+        families={p + k: [p + i for i in v] for k, v in families.items()},
+    )
+
+
 FAMILY = DriveFamily(
     kind="rv_reducer",
     sections=("reducer", "analyses"),
     to_object=to_object,
     drive=drive,
+    chain_yield=chain_yield,
     drive_kinds=("rv_reducer",),
     warm_cases=("hu2020_rv80e_initial_reducer", "han2023_rv110e_yield"),
     bench_case="hu2020_rv80e_initial_reducer",

@@ -645,6 +645,7 @@ def _yield_setup(case: Case, sec: YieldSection, own: dict, defaults: dict):
     nominal = {k: float(t.nominal_arcmin or 0.0) for k, t in defaults.items()}
     chain: list[ChainStage] = []
     graders: dict[str, Any] = {}
+    families: dict[str, list[str]] = {}
     for s in case.chain.stages:
         sy = own.get(s.name)
         if sy is None or s.name in sec.tolerances:
@@ -654,11 +655,14 @@ def _yield_setup(case: Case, sec: YieldSection, own: dict, defaults: dict):
         defaults.pop(s.name, None)
         nominal.pop(s.name, None)
         chain.append(ChainStage(s.name, _slug(s.name), s.ratio, sy.model))
+        units.update(sy.units)
+        families.update(sy.families)
         for key, law in sy.laws.items():
-            units[key], nominal[key] = sy.units[key], float(sy.nominal[key])
+            if key in sy.nominal:
+                nominal[key] = float(sy.nominal[key])
             defaults[key] = law
-            if sy.grade_um is not None:
-                graders[key] = sy.grade_um
+        if sy.grade_um is not None:
+            graders.update({key: sy.grade_um for key in sy.units})
 
     def grade_um(key: str, grade: int):
         """The tolerance a grade implies for a key of a stage's own errors (its family's)."""
@@ -666,7 +670,7 @@ def _yield_setup(case: Case, sec: YieldSection, own: dict, defaults: dict):
         return None if fn is None else fn(key, grade)
 
     model = GearChainYield(chain, nominal, case.chain.lever_length_mm)
-    return model, chain, units, nominal, defaults, grade_um
+    return model, chain, units, nominal, defaults, grade_um, families
 
 
 def _own_tolerances(case: Case) -> dict:
@@ -714,10 +718,18 @@ def preflight(case: Case) -> None:
     sec = case.analyses.yield_ if case.analyses is not None else None
     if sec is None:
         return
-    model, _, units, nominal, defaults, grade_um = _yield_setup(
+    model, _, units, nominal, defaults, grade_um, families = _yield_setup(
         case, sec, _own_tolerances(case), {}
     )
-    yield_inputs(sec, units, nominal, defaults, grade_um=grade_um, quantities=model.quantities)
+    yield_inputs(
+        sec,
+        units,
+        nominal,
+        defaults,
+        families=families,
+        grade_um=grade_um,
+        quantities=model.quantities,
+    )
 
 
 def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> AnalysisResult:
@@ -735,7 +747,7 @@ def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> A
     sec = case.analyses.yield_ if case.analyses is not None else None
     assert sec is not None
     own = _own_tolerances(case)
-    model, chain, units, nominal, defaults, grade_um = _yield_setup(
+    model, chain, units, nominal, defaults, grade_um, families = _yield_setup(
         case, sec, own, _stage_tolerances(case, stages, drives, backlash)
     )
 
@@ -775,6 +787,7 @@ def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> A
         worst_case=worst_case,
         references=["jiang2024"],
         defaults=defaults,
+        families=families,
         grade_um=grade_um,
     )
     res.notes.append(
@@ -787,7 +800,7 @@ def _chain_yield(case: Case, stages, drives: dict, backlash: dict, options) -> A
     for st in case.chain.stages:
         if st.drive is not None and st.name in own and st.drive.kind != "gear_pair":
             res.notes.append(
-                f"{st.name}: a {st.drive.kind} drive, draws its own tolerances (keys "
+                f"{st.name}: its {st.drive.kind} drive draws its own tolerances (keys "
                 f"{_slug(st.name)}.<error>, its family's laws) → its lost motion by its family's "
                 "model (gearte.families), sample by sample."
             )
