@@ -45,10 +45,11 @@ errors)::
 
 so a WG eccentricity alone averages out to first order (its square gives a twice-per-WG-turn
 term e²/(2h)); together with a lobe difference it gives the **once-per-WG-revolution** term
-``d e / h``; the ovalities give the **twice-per-WG-revolution** terms. Tuttle (1992, ch. 4)
-measured the kinematic error of a harmonic drive dominated by the twice-per-WG-revolution
-component with a smaller once-per-revolution one; Jia et al. (2021) attribute them to the WG's
-eccentricity and shape and to the splines' errors.
+``d e / h``; the ovalities give the **twice-per-WG-revolution** terms. Tuttle (1992) measured a
+harmonic drive's kinematic error at frequencies tied to the wave-generator speed; Jia et al.
+(2021) attribute its components to the WG's eccentricity and shape and to the splines' errors.
+This reading (ours, docs/strain-wave.md) gives those frequencies; its amplitudes are not fitted
+to a measurement.
 
 Units: mm, N·mm, rad; stiffness N·mm/rad.
 
@@ -107,7 +108,7 @@ def strain_wave_ratio(flexspline_teeth: int, circular_spline_teeth: int) -> floa
 
     References
     ----------
-    Tuttle (1992), MIT AI Laboratory technical report, §2 (harmonic-drive operation).
+    Tuttle (1992), MIT AI Laboratory technical report (harmonic-drive operation).
     """
     if not (isinstance(flexspline_teeth, int) and flexspline_teeth >= 2):
         raise ParameterError("flexspline_teeth", flexspline_teeth, "must be an integer >= 2")
@@ -442,7 +443,7 @@ def transmission_error(
     References
     ----------
     gearte's reading (docs/strain-wave.md) of the error sources of Jia et al. (2021),
-    doi:10.1016/j.mechmachtheory.2020.104122; frequencies as measured by Tuttle (1992).
+    doi:10.1016/j.mechmachtheory.2020.104122; Tuttle (1992) for the WG-speed frequencies.
     """
     th = np.asarray(wg_angle, dtype=float)
     k = math.tan(pressure_angle) / pitch_radius
