@@ -98,6 +98,8 @@ def _add_families() -> None:
     chained = {c for chain in WARM_CHAINS for c in chain}
     for kind, fam in families().items():
         WARM_CASES.setdefault(kind, tuple(fam.warm_cases))
+        if fam.warm_uses:
+            WARM_USES.setdefault(kind, tuple(fam.warm_uses))
         if fam.bench_case is not None:
             BENCH_CASES.setdefault(kind, fam.bench_case)
         new = tuple(c for c in fam.warm_cases if c not in chained)

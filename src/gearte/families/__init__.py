@@ -118,6 +118,9 @@ class DriveFamily:
     warm_cases, bench_case
         Bundled cases that compile its kernels (``gearte warm-cache``) and its first-run
         benchmark case (``benchmarks/bench_compile.py``).
+    warm_uses : tuple of str
+        A family without warm-up cases of its own: the kinds whose kernels it calls (warming it
+        warms those, :data:`gearte.warm.WARM_USES`).
     labels : mapping
         Readable labels of its own result names (added to :data:`gearte.labels.LABELS`).
     """
@@ -131,6 +134,7 @@ class DriveFamily:
     chain_yield: Callable[[Any, str], StageYield | None] | None = None
     drive_kinds: tuple[str, ...] = ()
     warm_cases: tuple[str, ...] = ()
+    warm_uses: tuple[str, ...] = ()
     bench_case: str | None = None
     labels: Mapping[str, str] = field(default_factory=dict)
 

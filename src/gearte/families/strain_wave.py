@@ -370,6 +370,7 @@ FAMILY = DriveFamily(
     chain_yield=chain_yield,
     drive_kinds=("strain_wave",),
     warm_cases=(),
+    warm_uses=("planetary",),  # its TE peak-to-peak calls trig_extremes' kernel
     bench_case="harmonicdrive_csf32_100",
     labels={
         "te_once_per_wg_revolution": "TE once per wave-generator revolution",
