@@ -101,6 +101,50 @@ class DataSection(StrictModel):
     torque_noise_fraction: float = Field(
         default=0.0, ge=0.0, le=0.05, description="torque sensor noise (std) as a fraction of T_r"
     )
+    columns: dict[str, str] = Field(
+        default_factory=dict,
+        description='gearte column -> the rig\'s column name, e.g. {forward_te = "TE CW"} '
+        "(beside the built-in aliases).",
+    )
+    units: dict[str, str] = Field(
+        default_factory=dict,
+        description="Unit of columns written without one: per gearte column, per group "
+        "(position, te, angle, torque) or per file column name.",
+    )
+    file_name_pattern: str | None = Field(
+        default=None,
+        description='Operating point in the TE file names, e.g. "{torque}Nm_{speed}rpm_{temp}C" '
+        "(torque [N*m], speed [rpm], oil temperature [°C]; {*} any text).",
+    )
+    te_convention: Literal["nominal_minus_output", "output_minus_nominal"] = Field(
+        default="nominal_minus_output",
+        description="The files' TE sign: gearte's nominal − output (a loaded reducer lags, "
+        "TE_forward > TE_backward), or output − nominal (negated on reading).",
+    )
+    reference: str | None = Field(
+        default=None,
+        description="File name of the TE trace the single-trace analyses (orders, calibration) "
+        "use; default: the least loaded, then slowest, then coolest file (stated in results).",
+    )
+
+    def import_options(self):
+        """The readers' :class:`gearte.io.bench.ImportOptions` of this section."""
+        from gearte.io.bench import ImportOptions
+
+        return ImportOptions(
+            columns=dict(self.columns), units=dict(self.units),
+            file_name_pattern=self.file_name_pattern, te_convention=self.te_convention,
+        )  # fmt: skip
+
+    @model_validator(mode="after")
+    def _options(self) -> DataSection:
+        from gearte.errors import ParameterError
+
+        try:
+            self.import_options()
+        except ParameterError as exc:
+            raise ValueError(str(exc)) from None
+        return self
 
     @field_validator("te", "hysteresis")
     @classmethod
@@ -215,11 +259,35 @@ def _inputs(case: Case):
     reducer, rcase = _reducer(case.reducer)
     fs = reducer.first_stage
     sources = rv_characteristic_orders(fs.sun_teeth, fs.planet_teeth, reducer.pins.count)
+    from gearte.errors import BenchFileError, BenchFileErrors
+
     d = case.data
-    traces = []
+    opts = d.import_options()
+    traces: list = []
+    hyst = None
+    problems: list[BenchFileError] = []  # every file's problems, reported together
     if d.te is not None:
-        traces = read_te_folder(d.te) if Path(d.te).is_dir() else [read_te_trace(d.te)]
-    hyst = read_hysteresis(d.hysteresis) if d.hysteresis is not None else None
+        try:
+            traces = (read_te_folder(d.te, options=opts) if Path(d.te).is_dir()
+                      else [read_te_trace(d.te, opts)])  # fmt: skip
+        except BenchFileError as exc:
+            problems.append(exc)
+    if d.hysteresis is not None:
+        try:
+            hyst = read_hysteresis(d.hysteresis, opts)
+        except BenchFileError as exc:
+            problems.append(exc)
+    if traces and d.reference is not None:
+        names = [Path(t.source).name for t in traces]
+        if d.reference not in names:
+            problems.append(BenchFileError(
+                d.te or "", None, None,
+                f"reference {d.reference!r} is not one of the TE files ({', '.join(names)})",
+            ))  # fmt: skip
+    if len(problems) == 1:
+        raise problems[0]
+    if problems:
+        raise BenchFileErrors(problems)
     return reducer, rcase, sources, traces, hyst
 
 
@@ -240,23 +308,51 @@ def preflight(case: Case) -> None:
 
 def run(case: Case, options) -> StudyResult:
     reducer, rcase, sources, traces, hyst = _inputs(case)
+    ref = _reference(traces, case.data.reference) if traces else None
+    why = reference_reason(traces, ref, case.data.reference) if traces else ""
     a = case.analyses
     analyses: list[AnalysisResult] = []
     warnings: list[str] = []
-    analyses.append(_catalogue(reducer, traces, hyst, a.catalogue or CatalogueSection()))
+    analyses.append(_catalogue(reducer, traces, hyst, a.catalogue or CatalogueSection(), ref, why))
     if traces:
-        analyses.append(_orders(traces, sources, a.te_orders or OrdersSection()))
+        analyses.append(_orders(traces, sources, a.te_orders or OrdersSection(), ref))
     if a.calibration is not None:
-        cal_res, cal = _calibration(case, reducer, rcase, sources, traces, hyst, warnings)
+        cal_res, cal = _calibration(case, reducer, rcase, sources, ref, hyst, warnings)
         analyses.append(cal_res)
         if a.diagnosis is not None:
             analyses.append(_diagnosis(cal, analyses, a.diagnosis, a.catalogue, options))
     return StudyResult(case=case, analyses=analyses, warnings=warnings)
 
 
-def _reference(traces):
-    """The trace the headline numbers and the calibration use: the least loaded one."""
-    return min(traces, key=lambda t: abs(t.torque) if t.torque is not None else 0.0)
+def _reference(traces, name: str | None = None):
+    """The trace the single-trace analyses use: the file ``name`` (``[data] reference``), else
+    the least loaded, then slowest, then coolest one (then the file name, for a stable choice
+    among equal operating points); :func:`reference_reason` says which rule chose it."""
+    if name is not None:
+        for t in traces:
+            if Path(t.source).name == name:
+                return t
+    return min(traces, key=_reference_key)
+
+
+def _reference_key(t):
+    return (abs(t.torque) if t.torque is not None else 0.0,
+            t.speed_rpm if t.speed_rpm is not None else 0.0,
+            t.oil_temperature if t.oil_temperature is not None else 0.0,
+            Path(t.source).name)  # fmt: skip
+
+
+def reference_reason(traces, ref, name: str | None = None) -> str:
+    """Why ``ref`` is the reference trace, in words (``name``: the case's ``[data] reference``)."""
+    if len(traces) == 1:
+        return "the only TE file"
+    if name is not None:
+        return "chosen in the case ([data] reference)"
+    ties = [t for t in traces if _reference_key(t)[:3] == _reference_key(ref)[:3]]
+    why = "least loaded, then slowest, then coolest operating point"
+    if len(ties) > 1:
+        why += f" ({len(ties)} files at this operating point: the first by file name)"
+    return why + "; set [data] reference to choose another"
 
 
 def te_values(trace) -> dict:
@@ -274,7 +370,7 @@ def te_values(trace) -> dict:
     return out
 
 
-def _catalogue(reducer, traces, hyst, sec: CatalogueSection) -> AnalysisResult:
+def _catalogue(reducer, traces, hyst, sec: CatalogueSection, ref=None, why="") -> AnalysisResult:
     from gearte.models.catalogue import branch_directions, hysteresis_values
 
     values: dict = {}
@@ -282,8 +378,13 @@ def _catalogue(reducer, traces, hyst, sec: CatalogueSection) -> AnalysisResult:
     notes = ["Definitions in docs/bench.md (gearte.models.catalogue), shared with the virtual "
              "test of the rv_reducer kind."]  # fmt: skip
     if traces:
-        ref = _reference(traces)
+        ref = ref if ref is not None else _reference(traces)
         values["reference_operating_point"] = Path(ref.source).name
+        values["reference_reason"] = why or reference_reason(traces, ref)
+        from gearte.io.bench import TE_CONVENTION
+
+        values["te_convention"] = TE_CONVENTION
+        values["te_convention_of_files"] = ref.metadata.get("te_convention", TE_CONVENTION)
         values.update(te_values(ref))
         if len(traces) > 1:
             values["operating_points"] = [
@@ -327,10 +428,10 @@ def order_list(trace, direction: str, sources, n_orders: int) -> list[dict]:
     ]  # fmt: skip
 
 
-def _orders(traces, sources, sec: OrdersSection) -> AnalysisResult:
+def _orders(traces, sources, sec: OrdersSection, ref=None) -> AnalysisResult:
     from gearte.models.orders import order_spectrum
 
-    ref = _reference(traces)
+    ref = ref if ref is not None else _reference(traces)
     dirs = ref.directions()
     first = "forward" if "forward" in dirs else "backward"
     values: dict = {
@@ -367,7 +468,7 @@ def _orders(traces, sources, sec: OrdersSection) -> AnalysisResult:
     )  # fmt: skip
 
 
-def _calibration(case, reducer, rcase, sources, traces, hyst, warnings):
+def _calibration(case, reducer, rcase, sources, ref_trace, hyst, warnings):
     from gearte.runners.bench_calibration import (
         Z95,
         calibrate,
@@ -393,7 +494,7 @@ def _calibration(case, reducer, rcase, sources, traces, hyst, warnings):
         fixed["rig_compliance"] = arcsec_to_rad(sec.rig_compliance_arcsec_per_kNm) / float(
             Nm_to_Nmm(1000.0)
         )
-    ref = [_reference(traces)] if traces else []
+    ref = [ref_trace] if ref_trace is not None else []
     cal = calibrate(
         model, hyst, ref, fit=sec.fit, fixed=fixed, max_relative_ci=sec.max_relative_ci,
         torque_noise=case.data.torque_noise_fraction,
