@@ -25,7 +25,9 @@ PATTERN = "{torque}Nm_{speed}rpm_{temp}C"
 def _bundled_traces():
     from gearte.cases import case_path
 
-    return read_te_folder(case_path("synthetic_rv_bench").parent / "synthetic_rv_bench" / "te")
+    opts = load_case("synthetic_rv_bench").data.import_options()
+    folder = case_path("synthetic_rv_bench").parent / "synthetic_rv_bench" / "te"
+    return read_te_folder(folder, options=opts)
 
 
 def _write_rig_file(path, trace, *, sign=-1.0, delim=";"):
@@ -79,9 +81,9 @@ def test_rig_style_export_runs_without_edits(tmp_path):
     res = run_case(load_case(path), RunOptions(progress=False)).to_dict()
     cat = res["analyses"]["catalogue"]["values"]
     ops = cat["operating_points"]
-    by_point = {(round(o["torque [N·m]"]), o["speed [rpm]"]): o for o in ops}
+    by_point = {(o["torque [N·m]"], o["speed [rpm]"], o["oil_temperature [°C]"]): o for o in ops}
     for t in traces:
-        o = by_point[(round(t.torque / 1e3), t.speed_rpm)]
+        o = by_point[(t.torque / 1e3, t.speed_rpm, t.oil_temperature)]
         assert o["speed [rpm]"] == t.speed_rpm and o["oil_temperature [°C]"] == t.oil_temperature
         # the sign flip restores gearte's convention exactly (same numbers as the original)
         fb = np.mean(t.forward_te) - np.mean(t.backward_te)

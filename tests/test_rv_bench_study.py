@@ -27,7 +27,8 @@ def _case(tmp_path, **analyses):
     from gearte.cases import case_path
 
     bundled = case_path("synthetic_rv_bench").parent / "synthetic_rv_bench"
-    traces = read_te_folder(bundled / "te")
+    opts = load_case("synthetic_rv_bench").data.import_options()
+    traces = read_te_folder(bundled / "te", options=opts)
     write_te_trace(tmp_path / "te.csv", traces[0])
     return {
         "case": {"kind": "rv_bench", "title": "test"},
@@ -96,7 +97,7 @@ def test_bundled_synthetic_bench_runs_calibrates_and_writes_the_serial(tmp_path)
     for name in REQUIRED:
         assert name in a["catalogue"]["values"]
     trend = a["te_orders"]["values"]["order_trend"]
-    assert len(trend) == 6
+    assert len(trend) == 24
     cal = a["calibration"]["values"]
     # known synthetic values (examples/synthetic_rv_bench/make_synthetic_bench.py)
     p = cal["parameters"]["contact_stiffness_factor"]

@@ -26,6 +26,7 @@ __all__ = [
     "rv_characteristic_orders",
     "order_spectrum",
     "labelled_orders",
+    "mean_standard_error",
 ]
 
 
@@ -183,3 +184,30 @@ def labelled_orders(
         }
         for i in idx
     ]
+
+
+def mean_standard_error(amplitude: ArrayLike) -> float:
+    """Standard error of a trace's mean from the noise floor of its order spectrum.
+
+    Parameters
+    ----------
+    amplitude : array_like
+        Amplitudes of :func:`order_spectrum` (order 0 first, then 1, 2, ...) [any angle unit].
+
+    Returns
+    -------
+    float
+        ``σ/√N`` [unit of ``amplitude``]: ``σ`` of white noise on the ``N`` samples, from the
+        median line amplitude (most orders carry noise only).
+
+    Notes
+    -----
+    White noise of standard deviation ``σ`` on ``N`` samples gives line amplitudes ``2|X_k|/N``
+    that are Rayleigh distributed with scale ``σ √(2/N)``, median ``σ √(2/N) √(2 ln 2)``; so
+    ``σ/√N = median / (2 √(ln 2))``. Over one revolution the periodic content averages out of
+    the mean exactly, so this is the mean's whole noise (not the repeatability between runs).
+    """
+    amp = np.asarray(amplitude, dtype=float)[1:]
+    if amp.size < 8:
+        raise ParameterError("amplitude", amp.size, "needs >= 8 orders")
+    return float(np.median(amp) / (2.0 * np.sqrt(np.log(2.0))))

@@ -13,7 +13,7 @@ __all__ = ["figures", "SELF_CONTAINED"]
 
 #: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`);
 #: not the catalogue (its hysteresis figure draws the calibrated model beside the bench curve).
-SELF_CONTAINED = frozenset({"te_orders"})
+SELF_CONTAINED = frozenset({"te_orders", "load_series"})
 
 
 def _analysis(result, name):
@@ -108,6 +108,88 @@ def _trend(orders) -> Figure | None:
     )
 
 
+def _group_label(speed, temp) -> str:
+    parts = []
+    if speed is not None:
+        parts.append(f"{speed:g} rpm")
+    if temp is not None:
+        parts.append(f"{temp:g} °C")
+    return ", ".join(parts) or "all files"
+
+
+def _series_curves(ls) -> Figure:
+    """Forward−backward mean and mean TE against torque, one line per (speed, temperature)."""
+    points = ls.data["points"]
+    groups: dict = {}
+    for p in points:
+        groups.setdefault((p["speed [rpm]"], p["oil_temperature [°C]"]), []).append(p)
+    fig, axes = new_figure(1, 2, figsize=(9.0, 3.8), squeeze=False)
+    for k, ((speed, temp), ps) in enumerate(groups.items()):
+        ps = sorted(ps, key=lambda p: p["torque [N*m]"])
+        t = [p["torque [N*m]"] for p in ps]
+        c = PALETTE[k % len(PALETTE)]
+        lab = _group_label(speed, temp)
+        axes[0, 0].errorbar(
+            t, [p["forward_backward_difference_mean [arcsec]"] / 60.0 for p in ps],
+            yerr=[1.96 * p["forward_backward_difference_se [arcsec]"] / 60.0 for p in ps],
+            fmt="o-", ms=3, lw=0.8, color=c, label=lab,
+        )  # fmt: skip
+        axes[0, 1].plot(t, [p["mean_te [arcsec]"] for p in ps], "o-", ms=3, lw=0.8, color=c,
+                        label=lab)  # fmt: skip
+    axes[0, 0].set_xlabel("load torque [N·m]")
+    axes[0, 0].set_ylabel("forward − backward mean TE [arcmin]")
+    axes[0, 1].set_xlabel("load torque [N·m]")
+    axes[0, 1].set_ylabel("mean of forward and backward TE [arcsec]")
+    axes[0, 0].legend(fontsize=7)
+    return Figure(
+        "Load series: forward − backward and mean TE against torque",
+        "Left: D(T), the running curve's spread (its slope gives the rigidity, its value at "
+        "f T_r the lost motion, at zero load the hysteresis), with 95 % noise intervals; right: "
+        "the mean of both directions (an asymmetry of the reducer or the rig). Definitions: "
+        "docs/bench.md.",
+        fig,
+    )
+
+
+def _series_trends(ls) -> Figure | None:
+    """The four catalogue quantities with their intervals against speed, one marker per oil
+    temperature."""
+    rows = ls.values["series"]
+    if len(rows) < 2:
+        return None
+    names = [("bench_torsional_rigidity", "N*m/arcmin", "torsional rigidity [N·m/arcmin]"),
+             ("bench_lost_motion", "arcmin", "lost motion [arcmin]"),
+             ("bench_hysteresis", "arcmin", "hysteresis [arcmin]"),
+             ("bench_backlash", "arcmin", "backlash [arcmin]")]  # fmt: skip
+    fig, axes = new_figure(1, 4, figsize=(13.0, 3.4), squeeze=False)
+    temps = sorted({r["oil_temperature [°C]"] for r in rows}, key=lambda x: (x is None, x or 0))
+    for j, (name, unit, ylabel) in enumerate(names):
+        ax = axes[0, j]
+        for k, temp in enumerate(temps):
+            rs = sorted((r for r in rows if r["oil_temperature [°C]"] == temp),
+                        key=lambda r: r["speed [rpm]"] or 0.0)  # fmt: skip
+            x = np.array([r["speed [rpm]"] or 0.0 for r in rs], dtype=float)
+            y = np.array([np.nan if r[f"{name} [{unit}]"] is None else r[f"{name} [{unit}]"]
+                          for r in rs])  # fmt: skip
+            lo = np.array([np.nan if r[f"{name}_ci_low [{unit}]"] is None
+                           else r[f"{name}_ci_low [{unit}]"] for r in rs])  # fmt: skip
+            hi = np.array([np.nan if r[f"{name}_ci_high [{unit}]"] is None
+                           else r[f"{name}_ci_high [{unit}]"] for r in rs])  # fmt: skip
+            err = np.nan_to_num(np.vstack([y - lo, hi - y]), nan=0.0)
+            ax.errorbar(x, y, yerr=err, fmt="o-", ms=4, lw=0.8, capsize=3,
+                        color=PALETTE[k % len(PALETTE)],
+                        label="oil " + ("?" if temp is None else f"{temp:g} °C"))  # fmt: skip
+        ax.set_xlabel("output speed [rpm]")
+        ax.set_ylabel(ylabel)
+    axes[0, 0].legend(fontsize=7)
+    return Figure(
+        "Load series: trends over speed and oil temperature",
+        "Torsional rigidity, lost motion, hysteresis and backlash of each (speed, oil "
+        "temperature) series with 95 % intervals (noise of the traces only).",
+        fig,
+    )
+
+
 def figures(result) -> list[Figure]:
     """The figures of an ``rv_bench`` result: hysteresis with the calibrated model, TE traces,
     order spectrum and order trend (each where its analysis ran).
@@ -124,11 +206,15 @@ def figures(result) -> list[Figure]:
     """
     cat = _analysis(result, "catalogue")
     orders = _analysis(result, "te_orders")
+    ls = _analysis(result, "load_series")
     cal_a = _analysis(result, "calibration")
     cal = cal_a.data["calibration"] if cal_a is not None else None
     out: list[Figure] = []
     if cat is not None:
         out += for_analysis("catalogue", [f for f in [_hysteresis(cat, cal)] if f is not None])
+    if ls is not None:
+        figs = [f for f in (_series_curves(ls), _series_trends(ls)) if f is not None]
+        out += for_analysis("load_series", figs)
     if orders is not None:
         figs = [f for f in (_traces(orders), _spectrum(orders), _trend(orders)) if f is not None]
         out += for_analysis("te_orders", figs)

@@ -168,6 +168,16 @@ class CatalogueSection(StrictModel):
     )
 
 
+class LoadSeriesSection(StrictModel):
+    temperature_step_C: float = Field(
+        default=5.0,
+        gt=0.0,
+        le=100.0,
+        description="Operating points whose oil temperatures round to the same multiple of this "
+        "step form one series [°C].",
+    )
+
+
 class OrdersSection(StrictModel):
     n_orders: int = Field(
         default=12, ge=1, le=200, description="Largest TE orders listed per trace."
@@ -213,6 +223,11 @@ class Analyses(StrictModel):
         None,
         description="Catalogue numbers from the hysteresis curve (rigidity, lost motion, "
         "backlash).",
+    )
+    load_series: LoadSeriesSection | None = Field(
+        None,
+        description="Rigidity, lost motion, hysteresis and backlash from the TE traces against "
+        "torque, per speed and oil temperature (runs whenever the TE files form a series).",
     )
     te_orders: OrdersSection | None = Field(
         None, description="TE orders labelled from the drive's tooth numbers."
@@ -314,6 +329,10 @@ def run(case: Case, options) -> StudyResult:
     analyses: list[AnalysisResult] = []
     warnings: list[str] = []
     analyses.append(_catalogue(reducer, traces, hyst, a.catalogue or CatalogueSection(), ref, why))
+    lmf = (a.catalogue or CatalogueSection()).lost_motion_fraction
+    series = _load_series(traces, reducer, a.load_series or LoadSeriesSection(), lmf, warnings)
+    if series is not None:
+        analyses.append(series)
     if traces:
         analyses.append(_orders(traces, sources, a.te_orders or OrdersSection(), ref))
     if a.calibration is not None:
@@ -414,6 +433,101 @@ def _catalogue(reducer, traces, hyst, sec: CatalogueSection, ref=None, why="") -
         name="catalogue", title="Catalogue quantities from the bench data", values=values,
         notes=notes, data=data,
     )  # fmt: skip
+
+
+def _series_point(t) -> dict:
+    """Forward−backward mean ``D``, mean TE and the standard error of ``D`` of one trace [rad]."""
+    from gearte.models.orders import mean_standard_error, order_spectrum
+
+    dirs = t.directions()
+    means, ses = {}, {}
+    for name, (pos, te) in dirs.items():
+        _, amp, _ = order_spectrum(pos, te)
+        means[name] = float(amp[0])
+        ses[name] = mean_standard_error(amp)
+    return {
+        "D": means["forward"] - means["backward"],
+        "mean": 0.5 * (means["forward"] + means["backward"]),
+        "se": float(np.hypot(ses["forward"], ses["backward"])),
+    }
+
+
+def _load_series(traces, reducer, sec: LoadSeriesSection, lmf: float, warnings):
+    """The load-series analysis (:func:`gearte.models.catalogue.load_series_values`) of every
+    (speed, oil temperature) group with >= 2 torques; ``None`` without such a group."""
+    from gearte.models.catalogue import load_series_values
+    from gearte.units import Nmm_per_rad_to_Nm_per_arcmin, Nmm_to_Nm, rad_to_arcmin
+
+    per_arcmin = Nmm_per_rad_to_Nm_per_arcmin
+    usable = [t for t in traces if t.torque is not None and len(t.directions()) == 2]
+    if len(usable) < 2:
+        return None
+    groups: dict = {}
+    for t in usable:
+        step = sec.temperature_step_C
+        temp = None if t.oil_temperature is None else float(step * round(t.oil_temperature / step))
+        groups.setdefault((t.speed_rpm, temp), []).append(t)
+    rows, points = [], []
+    negative = 0
+    for (speed, temp), ts in sorted(groups.items(), key=lambda kv: (kv[0][0] or 0, kv[0][1] or 0)):
+        pts = [_series_point(t) for t in ts]
+        torque = np.array([abs(t.torque) for t in ts])
+        for t, pt in zip(ts, pts, strict=True):
+            negative += pt["D"] < 0
+            points.append({"file": Path(t.source).name, "speed [rpm]": speed,
+                           "oil_temperature [°C]": temp,
+                           "torque [N*m]": float(Nmm_to_Nm(abs(t.torque))),
+                           "forward_backward_difference_mean [arcsec]": _sec(pt["D"]),
+                           "mean_te [arcsec]": _sec(pt["mean"]),
+                           "forward_backward_difference_se [arcsec]": _sec(pt["se"])})  # fmt: skip
+        if np.unique(torque).size < 2:
+            continue
+        v = load_series_values(
+            torque, [p["D"] for p in pts], reducer.rated_torque,
+            standard_error=[p["se"] for p in pts], lost_motion_fraction=lmf,
+        )  # fmt: skip
+        row: dict = {"speed [rpm]": speed, "oil_temperature [°C]": temp,
+                     "torques [N*m]": sorted({float(Nmm_to_Nm(x)) for x in torque})}  # fmt: skip
+        for name, val, conv, unit in (
+            ("torsional_rigidity", v.torsional_rigidity, per_arcmin, "N*m/arcmin"),
+            ("lost_motion", v.lost_motion, rad_to_arcmin, "arcmin"),
+            ("hysteresis", v.hysteresis, rad_to_arcmin, "arcmin"),
+            ("backlash", v.backlash, rad_to_arcmin, "arcmin"),
+        ):  # fmt: skip
+            lo, hi = v.ci[name]
+            if name == "torsional_rigidity":
+                lo, hi = hi, lo  # (low, high) of K come from the compliance's (high, low)
+                lo, hi = min(lo, hi), max(lo, hi)
+            fin = lambda x, c=conv: float(c(x)) if np.isfinite(x) else None  # noqa: E731
+            row[f"bench_{name} [{unit}]"] = fin(val)
+            row[f"bench_{name}_ci_low [{unit}]"] = fin(lo)
+            row[f"bench_{name}_ci_high [{unit}]"] = fin(hi)
+        row["interpolated"] = list(v.interpolated)
+        row["not_available"] = dict(v.missing)
+        rows.append(row)
+    if not rows:
+        return None
+    if negative > len(points) / 2:
+        warnings.append(
+            f"load series: the forward−backward mean is negative in {negative} of {len(points)} "
+            "files; gearte's TE convention (nominal − output) makes it positive for a lagging "
+            "reducer: are the files output − nominal? (set [data] te_convention = "
+            '"output_minus_nominal")'
+        )
+    return AnalysisResult(
+        name="load_series",
+        title="Load series: rigidity, lost motion, hysteresis, backlash from TE against torque",
+        values={"series": rows, "operating_points": points, "lost_motion_fraction": lmf},
+        notes=[
+            "Definitions in docs/bench.md (gearte.models.catalogue.load_series_values): the "
+            "catalogue's hysteresis definitions read on the running curve θ(+T) = mean forward "
+            "TE, θ(−T) = mean backward TE; load torques oppose the motion in both directions.",
+            "95 % intervals from each trace's noise (its order spectrum's floor), propagated "
+            "linearly; not the repeatability between runs, nor an interpolation error (quantities "
+            "read between measured torques are listed under 'interpolated').",
+        ],
+        data={"points": points, "series": rows},
+    )
 
 
 def order_list(trace, direction: str, sources, n_orders: int) -> list[dict]:
