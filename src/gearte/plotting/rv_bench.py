@@ -81,29 +81,41 @@ def _spectrum(orders) -> Figure:
 
 
 def _trend(orders) -> Figure | None:
+    """Amplitude of each tracked order against torque, one line per (speed, temperature)."""
     trend = orders.data.get("trend") or {}
     rows = trend.get("rows") or []
-    if len(rows) < 2:
+    labels = list(trend.get("labels") or [])
+    if len(rows) < 2 or not labels:
         return None
-    keys = [("torque [N·m]", "torque [N·m]"), ("speed [rpm]", "speed [rpm]"),
-            ("oil_temperature [°C]", "oil temperature [°C]")]  # fmt: skip
-    keys = [k for k in keys if all(r[k[0]] is not None for r in rows)]
-    if not keys:
-        return None
-    fig, axes = new_figure(1, len(keys), figsize=(4.0 * len(keys), 3.6), squeeze=False)
-    labels = list(trend["labels"])
-    for j, (key, xlabel) in enumerate(keys):
-        ax = axes[0, j]
-        x = np.array([r[key] for r in rows], dtype=float)
-        for k, lab in enumerate(labels):
-            y = np.array([r["amplitude [arcsec]"][lab] or np.nan for r in rows], dtype=float)
-            ax.plot(x, y, "o", ms=3, color=PALETTE[k % len(PALETTE)], label=lab)
-        ax.set_xlabel(xlabel)
+    by_torque = all(r["torque [N·m]"] is not None for r in rows)
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault((r["speed [rpm]"], r["oil_temperature [°C]"]), []).append(r)
+    ncol = min(4, len(labels))
+    nrow = (len(labels) + ncol - 1) // ncol
+    fig, axes = new_figure(nrow, ncol, figsize=(3.3 * ncol, 2.8 * nrow), squeeze=False)
+    for j, lab in enumerate(labels):
+        ax = axes[j // ncol, j % ncol]
+        for k, ((speed, temp), rs) in enumerate(groups.items()):
+            if by_torque:
+                rs = sorted(rs, key=lambda r: r["torque [N·m]"])
+                x = [r["torque [N·m]"] for r in rs]
+            else:
+                x = list(range(len(rs)))
+            y = [r["amplitude [arcsec]"][lab] for r in rs]
+            ax.plot(x, y, "o-", ms=3, lw=0.8, color=PALETTE[k % len(PALETTE)],
+                    label=_group_label(speed, temp))  # fmt: skip
+        ax.set_title(f"order {lab}", fontsize=8)
+        ax.set_xlabel("load torque [N·m]" if by_torque else "file")
         ax.set_ylabel("amplitude [arcsec]")
-    axes[0, 0].legend(fontsize=7)
+    for j in range(len(labels), nrow * ncol):
+        axes[j // ncol, j % ncol].set_visible(False)
+    axes[0, 0].legend(fontsize=6)
     return Figure(
-        "Trend of each labelled order across operating points",
-        "Amplitude of every characteristic order in each operating-point file.",
+        "Each order tracked across the files of the series",
+        "Amplitude of the largest orders (over all files) in every file, against the load "
+        "torque, one line per speed and oil temperature: a line that grows with load points to "
+        "a load-dependent source (labels from the drive's tooth numbers).",
         fig,
     )
 

@@ -115,6 +115,7 @@ class CalibrationResult:
     cost: float = 0.0
     success: bool = True
     message: str = ""
+    fixed: tuple[str, ...] = ()
 
     def identified(self) -> list[str]:
         return [n for n in self.fitted if n not in self.flags]
@@ -449,6 +450,7 @@ def calibrate(
         cost=float(res.cost),
         success=bool(res.success),
         message=f"{res.message} ({nfev} evaluations)",
+        fixed=tuple(fixed),
     )
 
 

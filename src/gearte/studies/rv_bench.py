@@ -47,7 +47,7 @@ FIGURES = "gearte.plotting.rv_bench"
 
 FamilyName = Literal[
     "output rotation", "crank rotation", "2× crank rotation", "involute mesh", "cycloid mesh",
-    "input rotation",
+    "input rotation", "cycloid lobes",
 ]  # fmt: skip
 _DEFAULT_FAMILIES: list[FamilyName] = [
     "output rotation", "crank rotation", "2× crank rotation", "involute mesh", "cycloid mesh",
@@ -182,6 +182,19 @@ class OrdersSection(StrictModel):
     n_orders: int = Field(
         default=12, ge=1, le=200, description="Largest TE orders listed per trace."
     )
+    tracked_orders: int = Field(
+        default=8,
+        ge=1,
+        le=50,
+        description="Orders tracked across the files of a series (the largest over all files).",
+    )
+    unexplained_fraction: float = Field(
+        default=0.05,
+        gt=0.0,
+        le=1.0,
+        description="A line no tooth number explains is reported when its amplitude reaches this "
+        "share of the trace's peak-to-peak (and 4 x the spectrum's noise floor) [-].",
+    )
 
 
 class CalibrationSection(StrictModel):
@@ -269,11 +282,11 @@ def _inputs(case: Case):
     """``(reducer, its case, characteristic orders, TE traces, hysteresis curve)``: the
     reducer case loaded and built, the bench files read (:mod:`gearte.io.bench`)."""
     from gearte.io.bench import read_hysteresis, read_te_folder, read_te_trace
-    from gearte.models.orders import rv_characteristic_orders
+    from gearte.models.orders import rv_tooth_orders
 
     reducer, rcase = _reducer(case.reducer)
     fs = reducer.first_stage
-    sources = rv_characteristic_orders(fs.sun_teeth, fs.planet_teeth, reducer.pins.count)
+    sources = rv_tooth_orders(fs.sun_teeth, fs.planet_teeth, reducer.pins.count)
     from gearte.errors import BenchFileError, BenchFileErrors
 
     d = case.data
@@ -334,7 +347,7 @@ def run(case: Case, options) -> StudyResult:
     if series is not None:
         analyses.append(series)
     if traces:
-        analyses.append(_orders(traces, sources, a.te_orders or OrdersSection(), ref))
+        analyses.append(_orders(traces, sources, a.te_orders or OrdersSection(), ref, warnings))
     if a.calibration is not None:
         cal_res, cal = _calibration(case, reducer, rcase, sources, ref, hyst, warnings)
         analyses.append(cal_res)
@@ -542,8 +555,13 @@ def order_list(trace, direction: str, sources, n_orders: int) -> list[dict]:
     ]  # fmt: skip
 
 
-def _orders(traces, sources, sec: OrdersSection, ref=None) -> AnalysisResult:
-    from gearte.models.orders import order_spectrum
+def _orders(traces, sources, sec: OrdersSection, ref=None, warnings=None) -> AnalysisResult:
+    from gearte.models.orders import (
+        label_order,
+        labelled_orders,
+        order_spectrum,
+        unexplained_lines,
+    )
 
     ref = ref if ref is not None else _reference(traces)
     dirs = ref.directions()
@@ -554,22 +572,53 @@ def _orders(traces, sources, sec: OrdersSection, ref=None) -> AnalysisResult:
     }
     if "backward" in dirs and first == "forward":
         values["te_orders_backward"] = order_list(ref, "backward", sources, sec.n_orders)
+    # every file: its spectrum, its unexplained lines (arcsec, relative to its own trace)
+    spectra = []
+    unexplained: dict[int, list] = {}
+    for t in traces:
+        d = first if first in t.directions() else next(iter(t.directions()))
+        pos, te = t.directions()[d]
+        o, amp, ph = order_spectrum(pos, te)
+        spectra.append(amp)
+        lines = labelled_orders(o, amp, ph, sources, sec.n_orders)
+        p2p = float(np.ptp(te))
+        floor = float(np.median(amp[1:]))
+        for x in unexplained_lines(lines, p2p, floor, fraction=sec.unexplained_fraction):
+            unexplained.setdefault(x["order"], []).append(
+                (Path(t.source).name, x["amplitude"], p2p)
+            )
+    rows_u = []
+    for n, hits in sorted(unexplained.items()):
+        top = max(hits, key=lambda h: h[1])
+        rows_u.append({"order": n, "files": len(hits), "largest_amplitude [arcsec]": _sec(top[1]),
+                       "share_of_peak_to_peak": top[1] / top[2], "file": top[0]})  # fmt: skip
+        if warnings is not None:
+            warnings.append(
+                f"TE orders: order {n} matches no order of this drive's tooth numbers and carries "
+                f"up to {_sec(top[1]):.3g}″ ({100 * top[1] / top[2]:.0f} % of the trace's "
+                f"{_sec(top[2]):.3g}″ peak-to-peak; {len(hits)} of {len(traces)} file(s), largest "
+                f"in {top[0]}): the rig, or a part not modelled"
+            )
+    values["unexplained_lines"] = rows_u
+    _, ref_amp, _ = order_spectrum(*dirs[first])
+    ref_limit = max(sec.unexplained_fraction * float(np.ptp(dirs[first][1])),
+                    4.0 * float(np.median(ref_amp[1:])))  # fmt: skip
     trend: dict = {}
     if len(traces) > 1:
-        labels = {}
-        for name, n in sources.items():
-            if abs(n - round(n)) < 1e-9:
-                labels[name] = int(round(n))
+        size = min(a.size for a in spectra)
+        peak = np.max(np.vstack([a[:size] for a in spectra]), axis=0)
+        peak[0] = 0.0
+        floor = float(np.median(np.vstack([a[1:size] for a in spectra])))
+        tracked = [int(i) for i in np.argsort(peak)[::-1][: sec.tracked_orders]
+                   if peak[i] >= 4.0 * floor]  # fmt: skip
+        labels = {f"{n}: {label_order(n, sources)}": n for n in sorted(tracked)}
         rows = []
-        for t in traces:
-            pos, te = t.directions()[first]
-            _, amp, _ = order_spectrum(pos, te)
+        for t, amp in zip(traces, spectra, strict=True):
             rows.append({
                 "file": Path(t.source).name, "speed [rpm]": t.speed_rpm,
                 "torque [N·m]": None if t.torque is None else t.torque / float(Nm_to_Nmm(1.0)),
                 "oil_temperature [°C]": t.oil_temperature,
-                "amplitude [arcsec]": {k: _sec(float(amp[n])) if n < amp.size else None
-                                       for k, n in labels.items()},
+                "amplitude [arcsec]": {k: _sec(float(amp[n])) for k, n in labels.items()},
             })  # fmt: skip
         values["order_trend"] = rows
         trend = {"rows": rows, "labels": labels}
@@ -577,8 +626,11 @@ def _orders(traces, sources, sec: OrdersSection, ref=None) -> AnalysisResult:
         name="te_orders", title="Order spectrum of the measured TE (per output revolution)",
         values=values,
         notes=[f"{first} trace of {Path(ref.source).name}; amplitude of TE = mean + Σ A cos(kφ + "
-               "phase); orders labelled from the drive's tooth numbers (gearte.models.orders)."],
-        data={"reference": ref, "direction": first, "sources": sources, "trend": trend},
+               "phase); orders labelled from the drive's tooth numbers, their harmonics and "
+               "sidebands (gearte.models.orders.label_order); order_trend: the largest orders "
+               "over all files, tracked in every file."],
+        data={"reference": ref, "direction": first, "sources": sources, "trend": trend,
+              "unexplained_limit": ref_limit},
     )  # fmt: skip
 
 
@@ -679,17 +731,22 @@ def _diagnosis(cal, analyses, sec: DiagnosisSection, cat_sec, options) -> Analys
     from gearte.runners.bench_diagnosis import diagnose
 
     spectrum = None
+    limit = None
     for a in analyses:
         if a.name == "te_orders":
             spectrum = [
                 {**x, "amplitude": arcsec_to_rad(x["amplitude [arcsec]"])}
                 for x in a.values["te_orders"]
             ]
+            limit = a.data.get("unexplained_limit")
     lmf = (cat_sec or CatalogueSection()).lost_motion_fraction
     from gearte.studies import sample_cap
 
     draws = sample_cap(sec, "draws", options)
-    dg = diagnose(cal, spectrum, lost_motion_fraction=lmf, draws=draws, seed=sec.seed)
+    dg = diagnose(
+        cal, spectrum, lost_motion_fraction=lmf, draws=draws, seed=sec.seed,
+        unexplained_limit=limit,
+    )  # fmt: skip
 
     def conv(rows, key):
         return [
