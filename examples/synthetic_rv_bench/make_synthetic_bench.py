@@ -38,7 +38,7 @@ import numpy as np
 
 from gearte.io.bench import write_hysteresis
 from gearte.io.case_file import load_case
-from gearte.models.bench_reduced import hysteresis_angle, parameter_names, te_trace
+from gearte.models.bench_reduced import hysteresis_angle, parameter_names, play, te_trace
 from gearte.models.orders import rv_characteristic_orders
 from gearte.runners.bench_calibration import reduced_constants, synthetic_bench
 from gearte.studies.rv_reducer import build_reducer
@@ -140,9 +140,10 @@ def main() -> None:
             for torque in TORQUES_NM:
                 t_nmm = float(Nm_to_Nmm(torque))
                 p = with_families(base, t_nmm / tr, speed)
-                # the play is inside θ_run: the TE part of the model carries none of its own
-                p.update(cam_bearing_clearance=0.0, carrier_bearing_clearance=0.0)
-                p["running_windup"] = 2.0 * float(running_angle(gen, base, t_nmm, temp))
+                # TE_d = o + d (β + w)/2: w such that the forward−backward spread is 2 θ_run
+                p["running_windup"] = 2.0 * float(running_angle(gen, base, t_nmm, temp)) - play(
+                    gen, p
+                )
                 cols = []
                 for pos, d in ((pos_f, 1), (pos_b, -1)):
                     te = te_trace(gen, p, pos, d) + rng.normal(0.0, noise, pos.size)

@@ -24,6 +24,7 @@ from gearte.models.bench_reduced import (
     hysteresis_angle,
     hysteresis_jacobian,
     parameter_names,
+    play,
     te_basis,
     te_coefficients,
     te_orders,
@@ -39,6 +40,9 @@ __all__ = [
     "calibrate",
     "synthetic_bench",
     "reduced_constants",
+    "serial_reducer",
+    "ClosedLoop",
+    "close_loop",
     "Z95",
 ]
 
@@ -167,7 +171,10 @@ def _initial(model, hyst, direction, te_rows, fixed):
     if hyst is not None:
         hv = hysteresis_values(hyst.torque, hyst.angle, tr, direction=direction)
         beta = max(hv.backlash, 1e-7)
-        p["cam_bearing_clearance"] = p["carrier_bearing_clearance"] = beta / (2 * g)
+        c0 = model.design_clearances
+        g_cam, g_car = model.backlash_per_clearance
+        common = (beta - model.design_backlash + g_cam * c0[0] + g_car * c0[1]) / g
+        p["cam_bearing_clearance"] = p["carrier_bearing_clearance"] = max(common, 1e-4)
         k_meas = hv.torsional_rigidity
         p["rig_compliance"] = 0.05 / k_meas
         p["contact_stiffness_factor"] = float(
@@ -207,9 +214,9 @@ def _initial(model, hyst, direction, te_rows, fixed):
     return p
 
 
-def hysteresis_play(model: ReducedRV, p: dict) -> float:
-    g_cam, g_car = model.backlash_per_clearance
-    return g_cam * p["cam_bearing_clearance"] + g_car * p["carrier_bearing_clearance"]
+def hysteresis_play(model: ReducedRV, p: dict) -> Any:
+    """The free play β [rad] (:func:`gearte.models.bench_reduced.play`)."""
+    return play(model, p)
 
 
 def calibrate(
@@ -554,7 +561,8 @@ def reduced_constants(reducer, families: dict[str, int], *, clearance: float = 0
     ``K_nom`` is the catalogue rigidity of the reducer as described (its clearances included);
     ``g_cam``, ``g_car`` [rad/mm] are the backlash added per mm of radial clearance of the cam
     and carrier crank bearings, by finite difference of the virtual backlash with ``clearance``
-    [mm] added to each in turn.
+    [mm] added to each in turn; ``B0`` is the design's own backlash and ``c0`` its clearances
+    (the reduced play is linearised about them).
 
     Parameters
     ----------
@@ -586,4 +594,155 @@ def reduced_constants(reducer, families: dict[str, int], *, clearance: float = 0
         nominal_rigidity=k_nom,
         backlash_per_clearance=(g[0], g[1]),
         families=dict(families),
+        design_backlash=base,
+        design_clearances=(c.cam_bearing_clearance, c.carrier_bearing_clearance),
     )
+
+
+# ---- closing the loop: the calibrated serial through the whole model ------------------------
+def serial_reducer(reducer, stiffness_scale: float, clearances: tuple[float, float]):
+    """The reducer with every stiffness of its load path scaled and the crank-bearing clearances
+    set.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The design.
+    stiffness_scale : float
+        Factor on the cam and carrier bearing stiffnesses, the carrier support stiffness, the
+        involute mesh stiffness and the Young's modulus of discs and pins [-] (1: the design).
+    clearances : (float, float)
+        Radial clearance of the cam and carrier crank bearings [mm].
+
+    Returns
+    -------
+    RVReducer
+    """
+    if not (np.isfinite(stiffness_scale) and stiffness_scale > 0):
+        raise ParameterError("stiffness_scale", stiffness_scale, "must be > 0")
+    s = float(stiffness_scale)
+    c, d, sup, fs = reducer.cranks, reducer.discs, reducer.supports, reducer.first_stage
+    return reducer.replace(
+        cranks=type(c)(**{**c.__dict__,
+                          "cam_bearing_stiffness": s * c.cam_bearing_stiffness,
+                          "carrier_bearing_stiffness": s * c.carrier_bearing_stiffness,
+                          "cam_bearing_clearance": float(clearances[0]),
+                          "carrier_bearing_clearance": float(clearances[1])}),
+        discs=type(d)(**{**d.__dict__, "youngs_modulus": s * d.youngs_modulus}),
+        supports=type(sup)(**{**sup.__dict__,
+                              "carrier_radial_stiffness": s * sup.carrier_radial_stiffness}),
+        first_stage=type(fs)(**{**fs.__dict__, "mesh_stiffness": s * fs.mesh_stiffness}),
+    )  # fmt: skip
+
+
+@dataclass
+class ClosedLoop:
+    """Outcome of :func:`close_loop`.
+
+    Attributes
+    ----------
+    stiffness_scale : float
+        Factor on every stiffness of the load path [-] (:func:`serial_reducer`).
+    clearances : (float, float)
+        Cam and carrier crank-bearing clearances [mm].
+    values : CatalogueValues
+        The whole model's catalogue numbers of the serial (reducer alone).
+    iterations : int
+    converged : bool
+    notes : list of str
+        What could not be matched, and why.
+    """
+
+    stiffness_scale: float
+    clearances: tuple[float, float]
+    values: Any
+    iterations: int
+    converged: bool
+    notes: list = field(default_factory=list)
+
+
+def close_loop(
+    reducer,
+    rigidity: float,
+    backlash: float,
+    *,
+    start_clearances: tuple[float, float] = (0.0, 0.0),
+    lost_motion_fraction: float = 0.03,
+    rtol: float = 2e-3,
+    max_iter: int = 12,
+) -> ClosedLoop:
+    """Stiffness scale and clearances with which the whole model gives a rigidity and backlash.
+
+    Fixed-point iteration on the whole model's virtual test
+    (:func:`gearte.models.rv_catalogue.catalogue_values`): the stiffness scale by the ratio of
+    rigidities, both clearances shifted by the backlash gap over ``g_cam + g_car`` (their
+    difference kept, as the bench sees only their play).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The design.
+    rigidity : float
+        Target catalogue rigidity of the reducer alone [N·mm/rad].
+    backlash : float
+        Target backlash [rad].
+    start_clearances : (float, float)
+        Starting clearances [mm] (their difference is kept).
+    lost_motion_fraction : float
+        ``f`` of the lost-motion definition [-].
+    rtol : float
+        Relative tolerance on rigidity and backlash [-].
+    max_iter : int
+        Largest number of whole-model evaluations [-].
+
+    Returns
+    -------
+    ClosedLoop
+        A clearance that would have to be negative is held at 0 and said so in ``notes``.
+    """
+    from gearte.models.rv_catalogue import catalogue_values
+
+    if not (rigidity > 0 and np.isfinite(rigidity)):
+        raise ParameterError("rigidity", rigidity, "must be a finite value > 0 N·mm/rad")
+    if not (backlash >= 0 and np.isfinite(backlash)):
+        raise ParameterError("backlash", backlash, "must be a finite value >= 0 rad")
+    scale = 1.0
+    cl = np.maximum(np.asarray(start_clearances, dtype=float), 0.0)
+    notes: list[str] = []
+    g = None
+    prev = None
+    converged = False
+    it = 0
+    for it in range(1, max_iter + 1):  # noqa: B007 - the count is returned
+        cv = catalogue_values(
+            serial_reducer(reducer, scale, (cl[0], cl[1])), steps_per_segment=4,
+            lost_motion_fraction=lost_motion_fraction,
+        )  # fmt: skip
+        ok_k = abs(cv.torsional_rigidity / rigidity - 1.0) <= rtol
+        ok_b = abs(cv.backlash - backlash) <= rtol * max(backlash, 1e-9)
+        if ok_k and ok_b:
+            converged = True
+            break
+        if prev is not None and abs(np.sum(cl - prev[0])) > 0:
+            g = (cv.backlash - prev[1]) / float(np.mean(cl - prev[0]))
+        if g is None or not (g > 0):
+            g = 2.0 * 0.047  # rad per mm of both clearances: a first guess, refined above
+        prev = (cl.copy(), cv.backlash)
+        scale *= rigidity / cv.torsional_rigidity
+        shift = (backlash - cv.backlash) / g
+        new = cl + shift
+        if np.any(new < 0):
+            new = np.maximum(new, 0.0)
+            if np.all(cl <= 0):
+                notes.append(
+                    "the bench's backlash is below the design's backlash without crank-bearing "
+                    "clearance: the play sits in another part (pins, profile modifications); "
+                    "clearances written 0, backlash not reproduced"
+                )
+                cv = catalogue_values(
+                    serial_reducer(reducer, scale, (0.0, 0.0)), steps_per_segment=4,
+                    lost_motion_fraction=lost_motion_fraction,
+                )  # fmt: skip
+                break
+        cl = new
+    return ClosedLoop(scale, (float(cl[0]), float(cl[1])), cv, it, converged, notes)

@@ -23,6 +23,7 @@ Definitions: docs/bench.md. Results: ``angular_te_peak_to_peak_forward [arcsec]`
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Literal
 
@@ -349,7 +350,9 @@ def run(case: Case, options) -> StudyResult:
     if traces:
         analyses.append(_orders(traces, sources, a.te_orders or OrdersSection(), ref, warnings))
     if a.calibration is not None:
-        cal_res, cal = _calibration(case, reducer, rcase, sources, ref, hyst, warnings)
+        cal_res, cal = _calibration(
+            case, reducer, rcase, sources, ref, hyst, warnings, analyses, traces
+        )
         analyses.append(cal_res)
         if a.diagnosis is not None:
             analyses.append(_diagnosis(cal, analyses, a.diagnosis, a.catalogue, options))
@@ -634,7 +637,7 @@ def _orders(traces, sources, sec: OrdersSection, ref=None, warnings=None) -> Ana
     )  # fmt: skip
 
 
-def _calibration(case, reducer, rcase, sources, ref_trace, hyst, warnings):
+def _calibration(case, reducer, rcase, sources, ref_trace, hyst, warnings, analyses, traces):
     from gearte.runners.bench_calibration import (
         Z95,
         calibrate,
@@ -712,6 +715,22 @@ def _calibration(case, reducer, rcase, sources, ref_trace, hyst, warnings):
         },
         "solver": cal.message,
     }  # fmt: skip
+    lmf = (case.analyses.catalogue or CatalogueSection()).lost_motion_fraction
+    noise = _noise(hyst, [ref_trace] if ref_trace is not None else [])
+    values["data_noise [arcsec]"] = {k: _sec(v) for k, v in noise.items()}
+    for k, r in cal.residual_rms.items():
+        if k in noise and noise[k] > 0 and r > RESIDUAL_WARNING * noise[k]:
+            warnings.append(
+                f"calibration: the {k} residual ({_sec(r):.3g}″ rms) is {r / noise[k]:.1f}× the "
+                f"data's noise ({_sec(noise[k]):.3g}″): the reduced model does not describe this "
+                "serial (a law or an error family missing); its intervals understate the "
+                "uncertainty"
+            )
+    closed, record = _close_loop(case, reducer, cal, analyses, lmf, warnings)
+    values["round_trip"] = record["round_trip"]
+    values["calibrated_serial"] = {
+        k: v for k, v in record.items() if k not in ("round_trip", "parameters")
+    }
     res = AnalysisResult(
         name="calibration",
         title="Calibrated reduced model of this serial (bounded least squares)",
@@ -721,10 +740,182 @@ def _calibration(case, reducer, rcase, sources, ref_trace, hyst, warnings):
             "Intervals: 95 %, from the Jacobian; 'identified' false where the data see only a "
             "combination of parameters (null space of J) or the interval is huge.",
         ],
-        data={"calibration": cal},
-        files={"calibrated_serial.toml": calibrated_case_text(rcase, cal, case)},
+        data={"calibration": cal, "closed_loop": closed},
+        files={"calibrated_serial.toml": calibrated_case_text(rcase, cal, case, closed, record)},
     )
     return res, cal
+
+
+RESIDUAL_WARNING = 3.0
+"""A calibration block whose rms residual exceeds this multiple of the data's own noise is a
+warning [-]."""
+
+
+def _noise(hyst, traces) -> dict:
+    """The data's own noise [rad], independent of any model: hysteresis from the second
+    differences along each branch sorted by torque (robust, MAD), TE from the median line of each
+    trace's order spectrum (:func:`gearte.models.orders.mean_standard_error` × √N)."""
+    from gearte.models.catalogue import branch_directions
+    from gearte.models.orders import mean_standard_error, order_spectrum
+
+    out = {}
+    if hyst is not None:
+        direction = hyst.branch if hyst.branch is not None else branch_directions(hyst.torque)
+        sig = []
+        for sgn in (1, -1):
+            m = np.asarray(direction) == sgn
+            if m.sum() < 8:
+                continue
+            a = hyst.angle[m][np.argsort(hyst.torque[m], kind="stable")]
+            d2 = a[2:] - 2 * a[1:-1] + a[:-2]
+            sig.append(1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0))
+        if sig:
+            out["hysteresis"] = float(np.median(sig))
+    te = []
+    for t in traces:
+        for pos, y in t.directions().values():
+            _, amp, _ = order_spectrum(pos, y)
+            te.append(mean_standard_error(amp) * np.sqrt(y.size))
+    if te:
+        out["te"] = float(np.sqrt(np.mean(np.square(te))))
+    return out
+
+
+def _bench_targets(analyses) -> dict | None:
+    """The bench's catalogue numbers the calibrated serial must reproduce [N·mm/rad, rad]: from
+    the hysteresis curve, else from the first load series that gives them."""
+    from gearte.units import arcmin_to_rad
+
+    per_arcmin = float(Nm_to_Nmm(1.0)) * ARCMIN_PER_RAD
+    for a in analyses:
+        v = a.values
+        if a.name == "catalogue" and "torsional_rigidity [N·m/arcmin]" in v:
+            return {"source": "hysteresis curve",
+                    "torsional_rigidity": v["torsional_rigidity [N·m/arcmin]"] * per_arcmin,
+                    "lost_motion": arcmin_to_rad(v["lost_motion [arcmin]"]),
+                    "backlash": arcmin_to_rad(v["backlash [arcmin]"])}  # fmt: skip
+    for a in analyses:
+        if a.name == "load_series":
+            for row in a.values["series"]:
+                keys = ("bench_torsional_rigidity [N*m/arcmin]", "bench_lost_motion [arcmin]",
+                        "bench_backlash [arcmin]")  # fmt: skip
+                if all(row[k] is not None for k in keys):
+                    return {"source": f"load series at {row['speed [rpm]']} rpm, "
+                                      f"{row['oil_temperature [°C]']} °C",
+                            "torsional_rigidity": row[keys[0]] * per_arcmin,
+                            "lost_motion": arcmin_to_rad(row[keys[1]]),
+                            "backlash": arcmin_to_rad(row[keys[2]])}  # fmt: skip
+    return None
+
+
+def _close_loop(case, reducer, cal, analyses, lmf, warnings):
+    """The calibrated serial through the whole model: stiffness scale and clearances with which
+    the whole model (plus the calibrated rig's twist) gives the bench's rigidity and backlash
+    (:func:`gearte.runners.bench_calibration.close_loop`); its lost motion is the check. Returns
+    ``(ClosedLoop or None, record)`` — the record is the calibrated serial's
+    ``[bench_calibration]`` section."""
+    from gearte.runners.bench_calibration import close_loop, parameter_specs
+
+    specs = parameter_specs(cal.model)
+    record: dict = {
+        "source": f"rv_bench case {case.case.title or case.case.name}",
+        "stiffness_scale": 1.0,
+        "parameters": {
+            n: {
+                "value": float(cal.params[n]),
+                "ci95": float(cal.ci[n]) if np.isfinite(cal.ci[n]) else None,
+                "unit": specs[n].unit,
+                "identified": n not in cal.flags,
+                "note": cal.flags.get(n, ""),
+            }
+            for n in cal.fitted
+        },  # fmt: skip
+        "round_trip": {},
+        "not_written": [],
+    }
+    p = cal.params
+
+    def known(n):
+        return n in cal.fixed or (n in cal.fitted and n not in cal.flags)
+
+    if known("contact_stiffness_factor"):
+        record["contact_stiffness_factor"] = float(p["contact_stiffness_factor"])
+    if known("friction_torque"):
+        record["friction_torque_Nm"] = float(p["friction_torque"]) / float(Nm_to_Nmm(1.0))
+    c_rig = 0.0
+    if known("rig_compliance"):
+        c_rig = float(p["rig_compliance"])
+        record["rig_compliance_arcsec_per_kNm"] = _sec(c_rig) * float(Nm_to_Nmm(1000.0))
+    else:
+        record["not_written"].append(
+            "rig compliance: not identified (it cannot be told from the reducer's stiffness): "
+            "the whole compliance is attributed to the reducer"
+        )
+    clear = ("cam_bearing_clearance", "carrier_bearing_clearance")
+    play_known = all(n in cal.fitted for n in clear) and not any(
+        "no data" in cal.flags.get(n, "") or "at a bound" in cal.flags.get(n, "") for n in clear
+    )
+    record["clearances_identified"] = play_known and not any(n in cal.flags for n in clear)
+    targets = _bench_targets(analyses)
+    if targets is None:
+        record["not_written"].append(
+            "clearances and stiffness: no bench catalogue numbers (a hysteresis curve or a load "
+            "series at zero load, f T_r, T_r/2 and T_r) to reproduce; the design's kept"
+        )
+        return None, record
+    k_bench = targets["torsional_rigidity"]
+    k_target = 1.0 / (1.0 / k_bench - c_rig) if 1.0 / k_bench > c_rig else k_bench
+    if k_target == k_bench and c_rig > 0:
+        record["not_written"].append(
+            "rig compliance exceeds the bench's whole compliance: ignored for the reducer"
+        )
+        c_rig = 0.0
+    c0 = reducer.cranks
+    start: tuple[float, float] = (
+        (float(p[clear[0]]), float(p[clear[1]])) if record["clearances_identified"]
+        else (c0.cam_bearing_clearance, c0.carrier_bearing_clearance)
+    )  # fmt: skip
+    if not record["clearances_identified"]:
+        mean = 0.5 * (start[0] + start[1])
+        start = (mean, mean)
+        record["not_written"].append(
+            "cam and carrier bearing clearance: the bench sees only their common play; one "
+            "common clearance written that gives it"
+        )
+    closed = close_loop(reducer, k_target, targets["backlash"], start_clearances=start,
+                        lost_motion_fraction=lmf)  # fmt: skip
+    record["stiffness_scale"] = float(closed.stiffness_scale)
+    record["not_written"] += closed.notes
+    tr = reducer.rated_torque
+    cv = closed.values
+    system = {
+        "torsional_rigidity": 1.0 / (1.0 / cv.torsional_rigidity + c_rig),
+        "lost_motion": cv.lost_motion + 2.0 * lmf * tr * c_rig,
+        "backlash": cv.backlash,
+    }
+    per_arcmin = float(Nm_to_Nmm(1.0)) * ARCMIN_PER_RAD
+    for name, unit, conv in (("torsional_rigidity", "N*m/arcmin", 1.0 / per_arcmin),
+                             ("lost_motion", "arcmin", ARCMIN_PER_RAD),
+                             ("backlash", "arcmin", ARCMIN_PER_RAD)):  # fmt: skip
+        b, m = targets[name], system[name]
+        rel = (m - b) / b if b else None
+        record["round_trip"][f"{name} [{unit}]"] = {
+            "bench": b * conv, "serial_whole_model": m * conv, "relative_difference": rel,
+        }  # fmt: skip
+        if rel is None or abs(rel) > 0.05:
+            warnings.append(
+                f"calibration: the calibrated serial through the whole model gives {name} "
+                f"{m * conv:.4g} {unit} against the bench's {b * conv:.4g} ("
+                + ("n/a" if rel is None else f"{100 * rel:+.1f} %")
+                + ")"
+            )
+    record["round_trip_source"] = targets["source"]
+    if not closed.converged:
+        warnings.append(
+            f"calibration: the whole model did not reach the bench's rigidity and backlash in "
+            f"{closed.iterations} evaluations"
+        )
+    return closed, record
 
 
 def _diagnosis(cal, analyses, sec: DiagnosisSection, cat_sec, options) -> AnalysisResult:
@@ -783,6 +974,11 @@ def _toml_value(v) -> str:
     raise TypeError(type(v))
 
 
+def _key(k: str) -> str:
+    """A TOML key: bare where it may be, else quoted."""
+    return k if re.fullmatch(r"[A-Za-z0-9_-]+", k) else _toml_value(k)
+
+
 def _toml(d: dict, prefix: str = "") -> list[str]:
     """Minimal TOML writer: scalars and lists inline, nested mappings as dotted tables."""
     lines = [f"[{prefix}]"] if prefix else []
@@ -791,40 +987,52 @@ def _toml(d: dict, prefix: str = "") -> list[str]:
         if isinstance(v, dict):
             tables[k] = v
         elif v is not None:
-            lines.append(f"{k} = {_toml_value(v)}")
+            lines.append(f"{_key(k)} = {_toml_value(v)}")
     for k, v in tables.items():
         lines.append("")
-        lines += _toml(v, f"{prefix}.{k}" if prefix else k)
+        lines += _toml(v, f"{prefix}.{_key(k)}" if prefix else _key(k))
     return lines
 
 
-def calibrated_case_text(rcase, cal, case) -> str:
-    """The serial as an ``rv_reducer`` case: the drive's case with the calibrated bearing
-    clearances (where identified) and the calibration recorded in the header."""
+def calibrated_case_text(rcase, cal, case, closed=None, record=None) -> str:
+    """The serial as an ``rv_reducer`` case: the drive's case with the clearances and the
+    stiffness scale that reproduce the bench (``closed``, :func:`_close_loop`) as values of
+    ``[reducer]``, and every estimate of the calibration as values of ``[bench_calibration]``."""
+    from gearte.geometry.rv import palmgren_radial_stiffness
+
     data = rcase.model_dump(mode="json", exclude_none=True)
-    cranks = data["reducer"]["cranks"]
-    notes = []
-    names = ("cam_bearing_clearance", "carrier_bearing_clearance")
-    clear = [cal.params[n] for n in names]
-    if all(n in cal.fitted for n in names) and any(n in cal.flags for n in names):
-        # only the play g_cam c_cam + g_car c_car is seen: split it as one common clearance
-        g = cal.model.backlash_per_clearance
-        common = (g[0] * clear[0] + g[1] * clear[1]) / (g[0] + g[1])
-        clear = [common, common]
-        notes.append("the bench sees only the play of both crank bearings together: written as "
-                     "one common radial clearance that gives the calibrated play")  # fmt: skip
-    for key, name, c in zip(("cam_bearing", "carrier_bearing"), names, clear, strict=True):
-        if name in cal.fitted:
-            cranks[key]["radial_clearance_um"] = float(mm_to_um(c))
+    red = data["reducer"]
+    if closed is not None:
+        sc = closed.stiffness_scale
+        for key, c in zip(("cam_bearing", "carrier_bearing"), closed.clearances, strict=True):
+            b = red["cranks"][key]
+            k = b.get("stiffness_N_per_mm")
+            if k is None:
+                k = palmgren_radial_stiffness(b.pop("rollers"), b.pop("roller_length_mm"),
+                                              b.pop("reference_load_N"))  # fmt: skip
+            b["stiffness_N_per_mm"] = float(sc * k)
+            b["radial_clearance_um"] = float(mm_to_um(c))
+        red["supports"]["carrier_radial_stiffness_N_per_mm"] *= sc
+        red["discs"]["youngs_modulus_MPa"] *= sc
+        fs = red["first_stage"]
+        design_mesh = closed_design_mesh(rcase)
+        fs["mesh_stiffness_N_per_mm"] = float(sc * design_mesh)
+    if record is not None:
+        data["bench_calibration"] = {
+            k: v for k, v in record.items() if k != "round_trip_source" and v is not None
+        }
     data["case"]["title"] = f"Calibrated serial: {case.case.title or case.case.name}"
     data["case"].pop("name", None)
     head = [
-        "# Calibrated serial written by gearte (kind rv_bench) from bench data; the reduced",
-        "# model's estimates (gearte units: mm, N·mm, rad) with 95 % half-widths:",
+        "# Calibrated serial written by gearte (kind rv_bench) from bench data. [reducer] holds",
+        "# the clearances and the stiffness scale with which the whole model reproduces the",
+        "# bench's rigidity and backlash; [bench_calibration] every estimate with its interval.",
     ]
-    for n in cal.fitted:
-        ci = cal.ci[n]
-        head.append(f"#   {n} = {cal.params[n]:.6g} ± {ci:.3g}" + (
-            f"  ({cal.flags[n]})" if n in cal.flags else ""))  # fmt: skip
-    head += [f"# {x}" for x in notes]
     return "\n".join([*head, "", *_toml(data)]) + "\n"
+
+
+def closed_design_mesh(rcase) -> float:
+    """The design's involute mesh stiffness [N/mm] (given, or derived from the face width)."""
+    from gearte.studies.rv_reducer import build_reducer
+
+    return float(build_reducer(rcase.reducer).first_stage.mesh_stiffness)
