@@ -153,7 +153,7 @@ def main() -> None:
                     "# SYNTHETIC data: examples/synthetic_rv_bench/make_synthetic_bench.py",
                     "Angle CW;TE CW;Angle CCW;TE CCW",
                 ]
-                lines += [f"{a:.2f};{b:.3f};{c:.2f};{e:.3f}" for a, b, c, e in zip(*cols)]
+                lines += [f"{a:.2f};{b:.3f};{c:.2f};{e:.3f}" for a, b, c, e in zip(*cols, strict=True)]
                 name = f"SN0001_{torque:g}Nm_{speed:g}rpm_{temp:g}C.csv"
                 (te_dir / name).write_text("\n".join(lines) + "\n", encoding="utf-8")
 

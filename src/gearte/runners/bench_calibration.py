@@ -40,6 +40,7 @@ __all__ = [
     "calibrate",
     "synthetic_bench",
     "reduced_constants",
+    "synthetic_full_model_hysteresis",
     "serial_reducer",
     "ClosedLoop",
     "close_loop",
@@ -746,3 +747,63 @@ def close_loop(
                 break
         cl = new
     return ClosedLoop(scale, (float(cl[0]), float(cl[1])), cv, it, converged, notes)
+
+
+def synthetic_full_model_hysteresis(
+    reducer,
+    rng: np.random.Generator,
+    *,
+    friction_torque: float = 0.0,
+    rig_compliance: float = 0.0,
+    steps_per_segment: int = 120,
+    angle_noise: float = arcsec_to_rad(0.3),
+    torque_noise: float = 2e-4,
+    encoder_counts: int = 2**21,
+    serial: str = "synthetic full model",
+) -> HysteresisCurve:
+    """A bench hysteresis curve from the WHOLE model of a serial (not the reduced one).
+
+    The sweep ``0 → +T_r → −T_r → +T_r``; the elements see the measured torque less a Coulomb
+    friction torque opposing the twist (``T − s T_fr``, s = +1 rising); the rig adds
+    ``C_rig T``; Gaussian angle and torque-reading noise and encoder quantisation as in
+    :func:`synthetic_bench`.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The serial (e.g. :func:`serial_reducer` of a design).
+    rng : numpy.random.Generator
+        Source of the noise.
+    friction_torque : float
+        ``T_fr`` [N·mm].
+    rig_compliance : float
+        ``C_rig`` [rad/(N·mm)].
+    steps_per_segment : int
+        Samples per quarter sweep [-].
+    angle_noise : float
+        Standard deviation of the angle readings [rad].
+    torque_noise : float
+        Standard deviation of the torque reading as a fraction of T_r [-].
+    encoder_counts : int
+        Encoder counts per revolution [-].
+    serial : str
+        Serial number written with the data.
+
+    Returns
+    -------
+    HysteresisCurve
+        Measured torque [N·mm], angle [rad], branch marks.
+    """
+    from gearte.models.rv_catalogue import torque_path, torsion_angles
+
+    tr = reducer.rated_torque
+    t_true = torque_path((0.0, 1.0, 0.0, -1.0, 0.0, 1.0), steps_per_segment) * tr
+    d = np.sign(np.diff(t_true, prepend=t_true[0] - 1.0)).astype(np.int64)
+    d[d == 0] = 1
+    t_eff = t_true - d * friction_torque
+    t_eff = np.where(t_eff == 0.0, -d * 1e-4 * tr, t_eff)
+    q = 2 * np.pi / encoder_counts
+    angle = torsion_angles(reducer, t_eff) + rig_compliance * t_true
+    angle = q * np.round((angle + rng.normal(0.0, angle_noise, angle.size)) / q)
+    torque = t_true + rng.normal(0.0, torque_noise * tr, t_true.size)
+    return HysteresisCurve(serial, torque, angle, d, serial=serial)
