@@ -158,3 +158,19 @@ def test_validate_reports_every_problem_of_every_file(tmp_path):
     out = r.output
     assert "3 error(s)" in out, out
     assert out.count("Bogus") >= 2 and "no_operating_point.csv" in out
+
+
+def test_the_reference_trace_is_chosen_or_stated_never_silent(tmp_path):
+    traces = _bundled_traces()[:3]
+    path = _rig_case(tmp_path, traces)
+    data = __import__("tomllib").loads(path.read_text(encoding="utf-8"))
+    data["data"]["te"] = str(tmp_path / "rig_export")
+    names = sorted(p.name for p in (tmp_path / "rig_export").iterdir())
+    data["data"]["reference"] = names[-1]
+    res = run_case(load_case_dict(data), RunOptions(progress=False)).to_dict()
+    cat = res["analyses"]["catalogue"]["values"]
+    assert cat["reference_operating_point"] == names[-1]
+    assert "chosen in the case" in cat["reference_reason"]
+    data["data"]["reference"] = "nope.csv"
+    with pytest.raises(BenchFileError, match="reference 'nope.csv' is not one of"):
+        run_case(load_case_dict(data), RunOptions(progress=False))

@@ -1,5 +1,7 @@
-"""Study kind ``rv_bench``: one RV serial's bench data → catalogue numbers, labelled TE orders,
-calibrated reduced model, likely culprit parts (issue 17).
+"""Study kind ``rv_bench``: one RV serial's bench data → catalogue numbers (from the hysteresis
+curve and from the load series of TE traces), labelled TE orders tracked across the series,
+calibrated reduced model and the calibrated serial closed through the whole model, likely
+culprit parts.
 
 Case file::
 
@@ -9,14 +11,21 @@ Case file::
                                                            model behind the reduced one
     [data]    te = "<CSV file or folder of operating points>", hysteresis = "<CSV file>"
               (paths relative to the case file, else to the bundled examples),
-              torque_noise_fraction (torque sensor, × T_r)
+              torque_noise_fraction (torque sensor, × T_r),
+              columns = {gearte column = "rig's name"}, units = {column or group = "unit"},
+              file_name_pattern = "{torque}Nm_{speed}rpm_{temp}C",
+              te_convention ("nominal_minus_output" | "output_minus_nominal"), reference
     [analyses.catalogue]    lost_motion_fraction (0.03)
-    [analyses.te_orders]    n_orders (12)
+    [analyses.load_series]  temperature_step_C (5)
+    [analyses.te_orders]    n_orders (12), tracked_orders (8), unexplained_fraction (0.05)
     [analyses.calibration]  families, fit, encoder_eccentricity_arcsec,
                             rig_compliance_arcsec_per_kNm
     [analyses.diagnosis]    draws, seed
 
-Definitions: docs/bench.md. Results: ``angular_te_peak_to_peak_forward [arcsec]``,
+Definitions: docs/bench.md. Results: per (speed, oil temperature) of a load series
+``bench_torsional_rigidity [N*m/arcmin]``, ``bench_lost_motion [arcmin]``,
+``bench_hysteresis [arcmin]``, ``bench_backlash [arcmin]`` with ``_ci_low``/``_ci_high``;
+``angular_te_peak_to_peak_forward [arcsec]``,
 ``angular_te_peak_to_peak_backward [arcsec]``, ``forward_backward_difference_mean [arcsec]``,
 ``te_orders`` (order, ``amplitude [arcsec]``, ``phase [deg]``, source) and per operating point.
 """
