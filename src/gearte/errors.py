@@ -172,7 +172,18 @@ class BenchFileErrors(BenchFileError):
 
 
 def bench_problems(exc: BenchFileError) -> list[BenchFileError]:
-    """Every problem an exception carries: its ``errors`` (:class:`BenchFileErrors`) or itself."""
+    """Every problem an exception carries: its ``errors`` (:class:`BenchFileErrors`) or itself.
+
+    Parameters
+    ----------
+    exc : BenchFileError
+        The exception raised by a bench or metrology reader.
+
+    Returns
+    -------
+    list of BenchFileError
+        One per problem.
+    """
     return list(exc.errors) if isinstance(exc, BenchFileErrors) else [exc]
 
 

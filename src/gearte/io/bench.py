@@ -793,8 +793,18 @@ def read_te_folder(
 def series_problems(traces: list[TETrace]) -> list[BenchFileError]:
     """What a series of operating points lacks: every file needs its torque, and speed and oil
     temperature are given for every file or for none (a file without them cannot be placed
-    in the series). One error per file, naming it; an empty list when the series is complete.
-    A single trace is not a series (no requirement)."""
+    in the series). A single trace is not a series (no requirement).
+
+    Parameters
+    ----------
+    traces : list of TETrace
+        The traces of one folder.
+
+    Returns
+    -------
+    list of BenchFileError
+        One error per file and missing key, naming the file; empty when the series is complete.
+    """
     if len(traces) < 2:
         return []
     out = []

@@ -131,7 +131,20 @@ def parameter_names(model: ReducedRV) -> tuple[str, ...]:
 
 
 def play(model: ReducedRV, p: dict) -> Any:
-    """The free play ``β`` [rad] of the parameters ``p`` (module docstring; arrays broadcast)."""
+    """The free play ``β`` [rad] of the parameters ``p`` (module docstring; arrays broadcast).
+
+    Parameters
+    ----------
+    model : ReducedRV
+        Constants of the reducer type (``g``, ``B0``, ``c0``).
+    p : dict
+        Parameters; ``cam_bearing_clearance`` and ``carrier_bearing_clearance`` [mm] are read.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``β = B0 + g_cam (c_cam − c0_cam) + g_car (c_car − c0_car)`` [rad].
+    """
     g_cam, g_car = model.backlash_per_clearance
     c0_cam, c0_car = model.design_clearances
     return (
