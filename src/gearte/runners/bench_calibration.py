@@ -111,8 +111,8 @@ class CalibrationResult:
     residual_rms : dict
         RMS residual [rad] of the hysteresis and the TE data; ``residuals`` holds them.
     covariance_inflation : float
-        ``(1 + ρ)/(1 − ρ)`` [-]: the hysteresis rows' information divided by it, ρ the lag-1
-        autocorrelation of the hysteresis residuals along the sweep (1: independent residuals).
+        Long-run variance over variance of the hysteresis residuals along the sweep [-]: the
+        hysteresis rows' information is divided by it (1: independent residuals).
     """
 
     model: ReducedRV
@@ -274,8 +274,9 @@ def calibrate(
     Residuals are weighted by each block's noise (hysteresis angle, TE), estimated from a first
     fit; the covariance is ``s² (JᵀJ)⁺`` at the weighted solution with ``s²`` the reduced
     chi-square, so the interval of any identified parameter is valid whatever the null space.
-    Where the hysteresis residuals are correlated along the sweep (lag-1 autocorrelation ρ, a
-    law the reduced model lacks), its rows count as ``n (1 − ρ)/(1 + ρ)`` independent samples.
+    Where the hysteresis residuals are correlated along the sweep (a law the reduced model
+    lacks), its rows count as ``n σ²/σ_LR²`` independent samples, ``σ_LR²`` their long-run
+    variance (Bartlett window of 5 % of the samples).
     """
     from scipy.optimize import least_squares
 
@@ -399,12 +400,10 @@ def calibrate(
     if hysteresis is not None:
         # residuals along the sweep that are correlated (a law the reduced model lacks) carry
         # less information than as many independent ones: the hysteresis rows count for
-        # n_eff = n (1 − ρ)/(1 + ρ) samples, ρ the lag-1 autocorrelation of the residuals
+        # n_eff = n σ²/σ_LR² samples, σ_LR² the residuals' long-run variance
         rh = b["hysteresis"] * np.asarray(weights["hysteresis"])
         if rh.size > 8 and np.std(rh) > 0:
-            rho = float(np.corrcoef(rh[:-1], rh[1:])[0, 1])
-            rho = min(max(rho, 0.0), 0.99)
-            inflation = (1.0 + rho) / (1.0 - rho)
+            inflation = _long_run_ratio(rh)
             jmat[: rh.size] /= np.sqrt(inflation)
     norms = np.linalg.norm(jmat, axis=0)
     norms = np.where(norms > 0, norms, 1.0)
@@ -501,6 +500,24 @@ def calibrate(
         fixed=tuple(fixed),
         covariance_inflation=inflation,
     )
+
+
+LONG_RUN_BANDWIDTH = 0.05
+"""Bartlett bandwidth of :func:`_long_run_ratio` as a fraction of the samples [-]."""
+
+
+def _long_run_ratio(r: np.ndarray) -> float:
+    """Long-run variance of a residual series over its variance (Bartlett / Newey–West window
+    of ``LONG_RUN_BANDWIDTH`` × n lags), at least 1: how many times fewer independent samples
+    correlated residuals are worth."""
+    x = r - r.mean()
+    n = x.size
+    var = float(x @ x) / n
+    lags = max(1, int(LONG_RUN_BANDWIDTH * n))
+    acc = var
+    for k in range(1, min(lags, n - 1) + 1):
+        acc += 2.0 * (1.0 - k / (lags + 1)) * float(x[k:] @ x[:-k]) / n
+    return max(acc / var, 1.0) if var > 0 else 1.0
 
 
 def _residuals(model, p, hysteresis, direction, traces) -> dict:
