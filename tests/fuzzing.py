@@ -771,7 +771,17 @@ def measurement_corpus() -> dict[str, tuple[str, str]]:
     bench = case_path("synthetic_rv_bench").parent / "synthetic_rv_bench"
     te = sorted((bench / "te").glob("*.csv"))[0]
     files: dict[str, tuple[str, str]] = {
-        "te_trace": ("te_trace", _thin(te.read_text("utf-8"), 20)),
+        # the bundled files are a rig's export (units given in the case): units into the header
+        "te_trace": (
+            "te_trace",
+            _thin(
+                te.read_text("utf-8").replace(
+                    "Angle CW;TE CW;Angle CCW;TE CCW",
+                    "Angle CW [deg];TE CW [arcsec];Angle CCW [deg];TE CCW [arcsec]",
+                ),
+                20,
+            ),
+        ),  # fmt: skip
         "hysteresis": ("hysteresis", _thin((bench / "hysteresis.csv").read_text("utf-8"), 10)),
     }
     rng = np.random.default_rng(13)

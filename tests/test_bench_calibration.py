@@ -85,8 +85,10 @@ def test_calibration_recovers_identifiable_parameters_and_flags_the_rest():
     assert ("cam_bearing_clearance", "carrier_bearing_clearance") in cal.groups
     assert ("output_rotation_cos", "encoder_eccentricity_cos") in cal.groups
     assert cal.rank == len(cal.fitted) - 3  # three null directions
+    # the reducer's stiffness and the rig's compliance: seen almost only together
+    assert ("contact_stiffness_factor", "rig_compliance") in cal.groups
     ident = cal.identified()
-    assert {"contact_stiffness_factor", "friction_torque", "crank_rotation_cos"} <= set(ident)
+    assert {"friction_torque", "crank_rotation_cos"} <= set(ident)
     within = [abs(cal.params[n] - truth[n]) <= cal.ci[n] for n in ident]
     assert np.mean(within) >= 0.8  # 95 % intervals, one seed (the rate over seeds is slow)
     for n in ident:  # and nothing wildly off
@@ -97,6 +99,18 @@ def test_calibration_recovers_identifiable_parameters_and_flags_the_rest():
     )
     assert fitted_play == pytest.approx(play, rel=0.02)
     assert cal.residual_rms["te"] < arcsec_to_rad(0.5)
+
+
+def test_a_known_rig_compliance_makes_the_contact_stiffness_identifiable():
+    rng = np.random.default_rng(11)
+    truth = _truth(rng)
+    hyst, trace = synthetic_bench(MODEL, truth, rng)
+    cal = calibrate(MODEL, hyst, [trace], torque_noise=2e-4,
+                    fixed={"rig_compliance": truth["rig_compliance"]})  # fmt: skip
+    assert "contact_stiffness_factor" in cal.identified()
+    assert abs(cal.params["contact_stiffness_factor"] - truth["contact_stiffness_factor"]) <= (
+        3 * cal.ci["contact_stiffness_factor"]
+    )
 
 
 def test_fixing_the_encoder_makes_the_output_eccentricity_identifiable():

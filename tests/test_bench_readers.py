@@ -96,7 +96,7 @@ def test_te_round_trip_through_writer_is_exact(tmp_path):
 
 def test_te_folder_reads_every_operating_point_sorted(tmp_path):
     for k in (2, 1, 3):
-        _write(tmp_path, _te_text(meta=(f"# speed_rpm: {k}",)), name=f"op{k}.csv")
+        _write(tmp_path, _te_text(meta=(f"# speed_rpm: {k}", "# torque_Nm: 0")), name=f"op{k}.csv")
     traces = read_te_folder(tmp_path)
     assert [t.speed_rpm for t in traces] == [1.0, 2.0, 3.0]
 

@@ -173,7 +173,7 @@ def _pngs(figs: list) -> list[tuple[str, str, str]]:
 @pytest.mark.parametrize(
     ("case", "expected"),
     [("hu2020_rv80e_initial", {"geometry", "geometric_te", "tooth_contact"}),
-     ("synthetic_rv_bench", {"te_orders"}),
+     ("synthetic_rv_bench", {"load_series", "te_orders"}),
      ("wang2013_2kh_eq9", {"terms", "coupled_te", "assembly"})],
 )  # fmt: skip
 def test_figures_of_one_analysis_are_those_of_the_whole_result(

@@ -499,7 +499,7 @@ def export(
 @click.argument("cases", nargs=-1, required=True)
 def validate(cases: tuple[str, ...]) -> None:
     """Check case files without running them; print every problem, one per line."""
-    from gearte.errors import BenchFileError, CaseFileError, ParameterError
+    from gearte.errors import BenchFileError, CaseFileError, ParameterError, bench_problems
 
     def _validate() -> None:
         from gearte.io.case_file import load_case
@@ -521,7 +521,14 @@ def validate(cases: tuple[str, ...]) -> None:
                 continue
             try:  # the checks `run` makes on the built drive before any analysis
                 preflight(case)
-            except (ParameterError, BenchFileError) as exc:
+            except BenchFileError as exc:  # every problem of every data file, one per line
+                bad += 1
+                found = bench_problems(exc)
+                click.echo(f"{c}: {len(found)} error(s)", err=True)
+                for e in found:
+                    click.echo(f"  {e}", err=True)
+                continue
+            except ParameterError as exc:
                 bad += 1
                 click.echo(f"{c}: 1 error(s)\n  {exc}", err=True)
                 continue

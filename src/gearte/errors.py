@@ -17,6 +17,8 @@ __all__ = [
     "SchedulerError",
     "ClusterLostError",
     "BenchFileError",
+    "BenchFileErrors",
+    "bench_problems",
     "MeasurementFileError",
     "OutputError",
     "Interrupted",
@@ -142,6 +144,47 @@ class BenchFileError(GearteError, ValueError):
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (type(self), (self.file, self.line, self.column, self.reason))
+
+
+class BenchFileErrors(BenchFileError):
+    """Several problems of bench files, reported together (``gearte validate`` lists them all).
+
+    ``errors`` holds one :class:`BenchFileError` per problem; the message lists them one per line.
+    The first problem's file, line, column and reason are this exception's own.
+    """
+
+    errors: list[BenchFileError]
+
+    def __init__(self, errors: list[BenchFileError]) -> None:
+        flat: list[BenchFileError] = []
+        for e in errors:
+            flat.extend(e.errors if isinstance(e, BenchFileErrors) else [e])
+        if not flat:
+            raise ValueError("BenchFileErrors needs at least one error")
+        self.errors = flat
+        first = flat[0]
+        super().__init__(first.file, first.line, first.column, first.reason)
+        if len(flat) > 1:
+            self.args = (f"{len(flat)} problems:\n" + "\n".join(f"  {e}" for e in flat),)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.errors,))
+
+
+def bench_problems(exc: BenchFileError) -> list[BenchFileError]:
+    """Every problem an exception carries: its ``errors`` (:class:`BenchFileErrors`) or itself.
+
+    Parameters
+    ----------
+    exc : BenchFileError
+        The exception raised by a bench or metrology reader.
+
+    Returns
+    -------
+    list of BenchFileError
+        One per problem.
+    """
+    return list(exc.errors) if isinstance(exc, BenchFileErrors) else [exc]
 
 
 class Interrupted(KeyboardInterrupt):

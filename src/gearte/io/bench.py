@@ -33,12 +33,13 @@ from __future__ import annotations
 import difflib
 import os
 import re
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from gearte.errors import BenchFileError
+from gearte.errors import BenchFileError, BenchFileErrors, ParameterError
 from gearte.io._textfile import read_header, read_text_file
 from gearte.models.bench_data import HysteresisCurve, TETrace
 from gearte.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, Nm_to_Nmm, rad_to_deg
@@ -46,8 +47,14 @@ from gearte.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, DEG_PER_RAD, Nm_to_Nmm,
 __all__ = [
     "TETrace",
     "HysteresisCurve",
+    "ImportOptions",
+    "TE_COLUMN_ALIASES",
+    "HYSTERESIS_COLUMN_ALIASES",
+    "metadata_from_name",
     "read_te_trace",
     "read_te_folder",
+    "series_problems",
+    "TE_CONVENTION",
     "read_hysteresis",
     "write_te_trace",
     "write_hysteresis",
@@ -85,14 +92,228 @@ _TORQUE_UNITS = {
     "n.mm": 1.0,
 }
 _TE_COLUMNS = ("forward_position", "forward_te", "backward_position", "backward_te")
-_TE_ALIASES = {"position": "forward_position", "te": "forward_te"}
 _HYST_COLUMNS = ("torque", "angle", "branch")
-_HYST_ALIASES = {"output_angle": "angle", "torsion_angle": "angle", "output_torque": "torque"}
+_DIRECTION_WORDS = {
+    "forward": ("forward", "fwd", "fw", "forw", "cw", "clockwise", "positive", "pos_dir", "plus"),
+    "backward": ("backward", "bwd", "bw", "back", "ccw", "counterclockwise", "anticlockwise",
+                 "negative", "neg_dir", "minus", "reverse", "rev"),
+}  # fmt: skip
+_QUANTITY_WORDS = {
+    "position": ("position", "pos", "angle", "output_angle", "output_position", "theta", "phi",
+                 "angular_position", "rotation_angle", "encoder_angle"),
+    "te": ("te", "transmission_error", "angular_te", "ate", "error", "angular_transmission_error",
+           "te_angle", "trans_error"),
+}  # fmt: skip
+
+
+def _te_aliases() -> dict[str, str]:
+    out = {"position": "forward_position", "te": "forward_te"}
+    for d, dwords in _DIRECTION_WORDS.items():
+        for q, qwords in _QUANTITY_WORDS.items():
+            for dw in dwords:
+                for qw in qwords:
+                    for name in (f"{dw}_{qw}", f"{qw}_{dw}"):
+                        out.setdefault(name, f"{d}_{q}")
+    for q in _QUANTITY_WORDS:
+        for qw in _QUANTITY_WORDS[q]:
+            out.setdefault(qw, f"forward_{q}")
+    return out
+
+
+TE_COLUMN_ALIASES: dict[str, str] = _te_aliases()
+"""Column names of TE traces as rigs write them (normalised: lower case, runs of other
+characters as ``_``) → gearte's column: ``TE CW``, ``te_fwd``, ``Angle CCW``, ``backward angle``,
+``transmission_error_reverse``, ... (direction words: forward/fwd/cw/positive/...,
+backward/bwd/ccw/reverse/...; quantity words: position/angle/theta/..., te/transmission_error/...).
+A bare quantity (``angle``, ``te``) is the forward direction."""
+HYSTERESIS_COLUMN_ALIASES: dict[str, str] = {
+    **{w: "angle" for w in ("output_angle", "torsion_angle", "twist", "torsion", "twist_angle",
+                            "angular_displacement", "rotation", "rotation_angle", "position",
+                            "output_position", "theta")},
+    **{w: "torque" for w in ("output_torque", "load", "load_torque", "moment", "torque_output",
+                             "applied_torque", "t_out", "m")},
+    **{w: "branch" for w in ("direction", "phase", "segment")},
+}  # fmt: skip
+"""Column names of hysteresis curves as rigs write them → gearte's column."""
+_TE_ALIASES = TE_COLUMN_ALIASES
+_HYST_ALIASES = HYSTERESIS_COLUMN_ALIASES
+_UNIT_GROUPS = {
+    "position": ("forward_position", "backward_position"),
+    "te": ("forward_te", "backward_te"),
+}
 _META_NUMERIC = ("speed_rpm", "torque_Nm", "oil_temperature_C", "sample_rate_Hz")
 _META_TEXT = ("serial", "angle_unit", "te_unit", "torque_unit", "kind")
 _KEY = re.compile(r"^#\s*([A-Za-z_][A-Za-z0-9_]*)\s*:\s*(.*?)\s*$")
 _HEADER = re.compile(r"^\s*([^\[\]]+?)\s*(?:\[\s*([^\[\]]*?)\s*\])?\s*$")
+_PAREN_UNIT = re.compile(r"^(.*?)\s*\(\s*([^()]*?)\s*\)\s*$")
 _TE_LIMIT = 1.0 / DEG_PER_RAD  # a TE beyond 1° is a unit mistake, not a reducer
+
+
+_TE_CONVENTIONS = {"nominal_minus_output": 1.0, "output_minus_nominal": -1.0}
+TE_CONVENTION = "nominal_minus_output"
+"""gearte's TE sign: TE = nominal output angle (input angle / ratio) − measured output angle,
+both in the forward sense of rotation. With it a loaded reducer lags in both directions, so the
+forward trace lies above the backward one and TE_forward − TE_backward > 0 is the running lost
+motion. A rig writing output − nominal is read with ``te_convention = "output_minus_nominal"``
+(the TE columns are negated on reading)."""
+
+_NAME_FIELDS = {
+    "torque": "torque_Nm",
+    "torque_Nm": "torque_Nm",
+    "speed": "speed_rpm",
+    "speed_rpm": "speed_rpm",
+    "temp": "oil_temperature_C",
+    "temperature": "oil_temperature_C",
+    "oil_temperature_C": "oil_temperature_C",
+}
+_NUMBER = r"[-+]?\d+(?:[.,p]\d+)?"
+
+
+def _pattern_regex(pattern: str) -> re.Pattern:
+    """``"{torque}Nm_{speed}rpm_{temp}C"`` → a regex with one named group per field."""
+    parts = re.split(r"(\{[^{}]*\})", pattern)
+    out, seen = [], set()
+    for part in parts:
+        if part.startswith("{") and part.endswith("}"):
+            name = part[1:-1].strip()
+            if name == "*":
+                out.append(".*?")
+                continue
+            if name not in _NAME_FIELDS:
+                known = ", ".join("{" + k + "}" for k in _NAME_FIELDS)
+                raise ParameterError(
+                    "data.file_name_pattern", pattern,
+                    f"unknown field {{{name}}} (known: {known}, {{*}} for any text)",
+                )  # fmt: skip
+            key = _NAME_FIELDS[name]
+            if key in seen:
+                raise ParameterError("data.file_name_pattern", pattern, f"{part} appears twice")
+            seen.add(key)
+            out.append(f"(?P<{key}>{_NUMBER})")
+        else:
+            if "{" in part or "}" in part:
+                raise ParameterError("data.file_name_pattern", pattern, "unbalanced braces")
+            out.append(re.escape(part))
+    if not seen:
+        raise ParameterError(
+            "data.file_name_pattern", pattern, "names no field ({torque}, {speed}, {temp})"
+        )
+    return re.compile("".join(out), re.IGNORECASE)
+
+
+def metadata_from_name(name: str, pattern: str) -> dict[str, float] | None:
+    """Operating point written in a file name, read with a pattern.
+
+    Parameters
+    ----------
+    name : str
+        The file name (its folder and extension are ignored).
+    pattern : str
+        Literal text with fields ``{torque}`` [N·m], ``{speed}`` [rpm], ``{temp}`` [°C] (or
+        ``{torque_Nm}``, ``{speed_rpm}``, ``{temperature}``, ``{oil_temperature_C}``) and ``{*}``
+        for any text; searched anywhere in the name, case-insensitive. A decimal point may be
+        written ``.``, ``,`` or ``p`` (``12p5``).
+
+    Returns
+    -------
+    dict or None
+        ``{"torque_Nm": ..., "speed_rpm": ..., "oil_temperature_C": ...}`` (the fields the
+        pattern names), or ``None`` when the name does not match.
+
+    Examples
+    --------
+    >>> metadata_from_name("RV81_300Nm_15rpm_40C.csv", "{torque}Nm_{speed}rpm_{temp}C")
+    {'torque_Nm': 300.0, 'speed_rpm': 15.0, 'oil_temperature_C': 40.0}
+    """
+    m = _pattern_regex(pattern).search(Path(name).stem)
+    if m is None:
+        return None
+    return {
+        k: float(v.replace(",", ".").replace("p", ".").replace("P", "."))
+        for k, v in m.groupdict().items()
+    }
+
+
+def _norm(name: str) -> str:
+    return re.sub(r"[^0-9a-z]+", "_", name.strip().lower()).strip("_")
+
+
+@dataclass(frozen=True)
+class ImportOptions:
+    """How to read a rig's own export without editing it.
+
+    Attributes
+    ----------
+    columns : mapping
+        gearte column → the file's column name, e.g. ``{"forward_te": "TE CW [µrad]"}``; beside the
+        built-in aliases (:data:`TE_COLUMN_ALIASES`, :data:`HYSTERESIS_COLUMN_ALIASES`).
+    units : mapping
+        Unit of columns written without one: per gearte column (``forward_te``), per group
+        (``position``, ``te`` for both directions; ``angle``, ``torque`` of hysteresis curves) or
+        per file column name. A unit in the header wins; a ``# te_unit:`` line of a file wins
+        over this mapping.
+    file_name_pattern : str or None
+        Operating point in the file names, e.g. ``"{torque}Nm_{speed}rpm_{temp}C"``
+        (:func:`metadata_from_name`).
+    te_convention : str
+        The file's TE sign: ``"nominal_minus_output"`` (gearte's, :data:`TE_CONVENTION`) or
+        ``"output_minus_nominal"`` (negated on reading).
+    """
+
+    columns: Mapping[str, str] = field(default_factory=dict)
+    units: Mapping[str, str] = field(default_factory=dict)
+    file_name_pattern: str | None = None
+    te_convention: str = TE_CONVENTION
+
+    def __post_init__(self) -> None:
+        known = (*_TE_COLUMNS, *_HYST_COLUMNS)
+        for k, v in self.columns.items():
+            if k not in known:
+                raise ParameterError(f"data.columns.{k}", v, f"unknown gearte column (known: "
+                                     f"{', '.join(known)})")  # fmt: skip
+            if not str(v).strip():
+                raise ParameterError(f"data.columns.{k}", v, "empty column name")
+        targets = [_norm(_split_unit(v)[0] if "[" in v else v) for v in self.columns.values()]
+        for t in set(targets):
+            if targets.count(t) > 1:
+                raise ParameterError("data.columns", dict(self.columns),
+                                     f"the file column {t!r} is mapped twice")  # fmt: skip
+        for k, u in self.units.items():
+            unit_ok = _unit_key(u, "torque") in _TORQUE_UNITS or u.strip().lower() in _ANGLE_UNITS
+            if not unit_ok:
+                raise ParameterError(
+                    f"data.units.{k}", u,
+                    f"not a unit gearte reads (angles: {', '.join(_ANGLE_UNITS)}; torques: "
+                    f"{', '.join(_TORQUE_UNITS)})",
+                )  # fmt: skip
+        if self.te_convention not in _TE_CONVENTIONS:
+            raise ParameterError("data.te_convention", self.te_convention,
+                                 f"must be one of {', '.join(_TE_CONVENTIONS)}")  # fmt: skip
+        if self.file_name_pattern is not None:
+            _pattern_regex(self.file_name_pattern)
+
+    @property
+    def te_sign(self) -> float:
+        """Factor applied to the TE columns on reading (+1 or −1)."""
+        return _TE_CONVENTIONS[self.te_convention]
+
+    def unit_for(self, name: str, raw: str) -> str | None:
+        """Unit from the mapping for gearte column ``name`` written as ``raw`` in the file."""
+        for key in (name, raw, _norm(raw)):
+            if key in self.units:
+                return self.units[key]
+        for group, members in _UNIT_GROUPS.items():
+            if name in members and group in self.units:
+                return self.units[group]
+        return None
+
+
+_DEFAULT_OPTIONS = ImportOptions()
+
+
+def _unit_key(unit: str, what: str) -> str:
+    key = unit.strip().lower().replace(" ", "") if what == "torque" else unit.strip().lower()
+    return "n·m" if key in ("n·m", "n m") else key
 
 
 # ---- parsing -----------------------------------------------------------------------------
@@ -107,6 +328,8 @@ class _Table:
     text: dict  # column index -> list[str]
     data_lines: np.ndarray  # 1-based file line of each row
     header_line: int
+    raw_names: list[str] = field(default_factory=list)  # as the file writes them
+    options: ImportOptions = _DEFAULT_OPTIONS
 
     def col_label(self, j: int) -> str:
         unit = f" [{self.units[j]}]" if self.units[j] else ""
@@ -121,17 +344,32 @@ def _split_unit(cell: str) -> tuple[str, str | None]:
     m = _HEADER.match(cell)
     if m is None:
         return cell.strip(), None
-    name = re.sub(r"[\s\-]+", "_", m.group(1).strip().lower())
-    return name, (m.group(2) if m.group(2) is not None else None)
+    raw, unit = m.group(1).strip(), m.group(2)
+    if unit is None:  # "TE (arcsec)": a unit in parentheses, where it is one gearte knows
+        pm = _PAREN_UNIT.match(raw)
+        if pm and (pm.group(2).lower() in _ANGLE_UNITS or _unit_key(pm.group(2), "torque")
+                   in _TORQUE_UNITS):  # fmt: skip
+            raw, unit = pm.group(1), pm.group(2)
+    name = re.sub(r"[\s\-]+", "_", raw.strip().lower())
+    return name, unit
 
 
-def _parse(path, allowed, aliases, text_columns=()) -> _Table:
+def _raise(problems: list[BenchFileError]) -> None:
+    if len(problems) == 1:
+        raise problems[0]
+    if problems:
+        raise BenchFileErrors(problems)
+
+
+def _parse(path, allowed, aliases, text_columns=(), options=_DEFAULT_OPTIONS) -> _Table:
     src, text = read_text_file(path, BenchFileError, MAX_FILE_BYTES)
     lines = text.splitlines()
     if not any(ln.strip() for ln in lines):
         raise BenchFileError(src, 1, None, "is empty (no header, no data)")
     meta: dict = {}
     meta_lines: dict = {}
+    problems: list[BenchFileError] = []  # header and metadata problems, reported together
+    mapped = {_norm(_split_unit(v)[0]): k for k, v in options.columns.items() if k in allowed}
     i = 0
     while i < len(lines):
         ln = lines[i].strip()
@@ -147,69 +385,82 @@ def _parse(path, allowed, aliases, text_columns=()) -> _Table:
                 close = difflib.get_close_matches(key, _META_NUMERIC + _META_TEXT, 1)
                 hint = f"; did you mean '{close[0]}'?" if close else ""
                 known = ", ".join(_META_NUMERIC + _META_TEXT)
-                raise BenchFileError(
+                problems.append(BenchFileError(
                     src, i + 1, None, f"unknown metadata key '{key}' (known: {known}){hint}"
-                )
+                ))  # fmt: skip
+                i += 1
+                continue
             if key in meta:
-                raise BenchFileError(
-                    src,
-                    i + 1,
-                    None,
+                problems.append(BenchFileError(
+                    src, i + 1, None,
                     f"metadata key '{key}' repeated (first on line {meta_lines[key]})",
-                )
+                ))  # fmt: skip
+                i += 1
+                continue
             if key in _META_NUMERIC:
                 try:
                     v = float(value)
                 except ValueError:
                     v = float("nan")
                 if not np.isfinite(v):
-                    raise BenchFileError(
+                    problems.append(BenchFileError(
                         src, i + 1, None, f"metadata '{key}' must be a finite number, got {value!r}"
-                    )
+                    ))  # fmt: skip
+                    i += 1
+                    continue
                 meta[key] = v
             else:
                 meta[key] = value
             meta_lines[key] = i + 1
         i += 1
-    header_line, header, delim = read_header(lines, i, src, BenchFileError)
+    try:
+        header_line, header, delim = read_header(lines, i, src, BenchFileError)
+    except BenchFileError as exc:
+        _raise([*problems, exc])
+        raise
     cells = header.split(delim)
     names: list[str] = []
+    raw_names: list[str] = []
     units: list[str | None] = []
     for j, c in enumerate(cells):
-        name, unit = _split_unit(c)
-        name = aliases.get(name, name)
+        raw, unit = _split_unit(c)
+        name = mapped.get(_norm(raw)) or aliases.get(raw) or aliases.get(_norm(raw)) or raw
         if not name:
-            raise BenchFileError(src, header_line, str(j + 1), "empty column name")
+            problems.append(BenchFileError(src, header_line, str(j + 1), "empty column name"))
+            continue
         try:
             float(name)
             is_number = True
         except ValueError:
             is_number = False
         if is_number:
-            raise BenchFileError(
+            _raise([*problems, BenchFileError(
                 src,
                 header_line,
                 str(j + 1),
                 f"the first line after the metadata must name the columns, got the number {c!r}",
-            )
+            )])  # fmt: skip
         if name not in allowed:
             close = difflib.get_close_matches(name, allowed, 1)
             hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise BenchFileError(
+            problems.append(BenchFileError(
                 src,
                 header_line,
                 f"{j + 1} {c.strip()!r}",
-                f"unknown column (known: {', '.join(allowed)}){hint}",
-            )
-        if name in names:
-            raise BenchFileError(
+                f"unknown column (known: {', '.join(allowed)}, their aliases, or map it with "
+                f"columns = {{...}}){hint}",
+            ))  # fmt: skip
+        elif name in names:
+            problems.append(BenchFileError(
                 src,
                 header_line,
                 f"{j + 1} {c.strip()!r}",
                 f"column '{name}' appears twice (first as column {names.index(name) + 1})",
-            )
+            ))  # fmt: skip
         names.append(name)
+        raw_names.append(c.strip())
         units.append(unit)
+    _raise(problems)
     body_idx = [k for k in range(i + 1, len(lines)) if lines[k].strip()]
     rows = len(body_idx)
     ncol = len(names)
@@ -267,7 +518,10 @@ def _parse(path, allowed, aliases, text_columns=()) -> _Table:
             _col(names, units, j),
             f"{data[r, j]!r} is not a finite number (NaN/inf: a dropout of the encoder?)",
         )
-    return _Table(src, meta, meta_lines, names, units, data, cells_text, lines_arr, header_line)
+    return _Table(
+        src, meta, meta_lines, names, units, data, cells_text, lines_arr, header_line, raw_names,
+        options,
+    )  # fmt: skip
 
 
 def _col(names, units, j) -> str:
@@ -278,22 +532,24 @@ def _col(names, units, j) -> str:
 def _unit_factor(t: _Table, j: int, table: dict, declared_key: str, what: str) -> float:
     unit = t.units[j]
     col = t.col_label(j)
+    line = t.header_line
     if unit is None:
         unit = t.meta.get(declared_key)
+        if unit is not None:
+            line = t.meta_lines[declared_key]
+        else:
+            raw = _split_unit(t.raw_names[j])[0] if t.raw_names else t.names[j]
+            unit = t.options.unit_for(t.names[j], raw)
         if unit is None:
             raise BenchFileError(
                 t.source,
                 t.header_line,
                 col,
-                f"no unit: write it in the name ('{t.names[j]} [{next(iter(table))}]') or "
-                f"declare '# {declared_key}: ...' (accepted: {', '.join(table)})",
+                f"no unit: write it in the name ('{t.names[j]} [{next(iter(table))}]'), "
+                f"declare '# {declared_key}: ...' or give units = {{{t.names[j]} = ...}} in the "
+                f"case (accepted: {', '.join(table)})",
             )
-        line = t.meta_lines[declared_key]
-    else:
-        line = t.header_line
-    key = unit.strip().lower().replace(" ", "") if what == "torque" else unit.strip().lower()
-    if key in ("n·m", "n m"):
-        key = "n·m"
+    key = _unit_key(unit, what)
     if key not in table:
         raise BenchFileError(
             t.source,
@@ -335,13 +591,15 @@ def _check_kind(t: _Table, want: str) -> None:
 
 
 # ---- TE traces ---------------------------------------------------------------------------
-def read_te_trace(path: str | os.PathLike) -> TETrace:
+def read_te_trace(path: str | os.PathLike, options: ImportOptions | None = None) -> TETrace:
     """Read one angular-TE trace (one operating point) from a CSV file.
 
     Parameters
     ----------
     path : str or path
         CSV file (layout in the module docstring).
+    options : ImportOptions, optional
+        Column mapping, units, file-name pattern and TE sign convention of the rig's export.
 
     Returns
     -------
@@ -356,27 +614,43 @@ def read_te_trace(path: str | os.PathLike) -> TETrace:
         monotone or not covering one output revolution, implausible TE (a unit mistake), bad
         metadata.
     """
-    t = _parse(path, _TE_COLUMNS, _TE_ALIASES)
+    opts = options or _DEFAULT_OPTIONS
+    t = _parse(path, _TE_COLUMNS, _TE_ALIASES, options=opts)
     _check_kind(t, "te_trace")
+    _name_metadata(t, opts)
     cols = {n: j for j, n in enumerate(t.names)}
     arrays: dict[str, np.ndarray | None] = {}
+    problems: list[BenchFileError] = []
+    factors: dict[str, tuple[float, float]] = {}
     for d in ("forward", "backward"):
         pj, tj = cols.get(f"{d}_position"), cols.get(f"{d}_te")
         if (pj is None) != (tj is None):
             missing = f"{d}_te" if tj is None else f"{d}_position"
-            raise BenchFileError(
+            problems.append(BenchFileError(
                 t.source,
                 t.header_line,
                 None,
                 f"column '{missing}' is missing (the {d} direction needs position and TE)",
-            )
+            ))  # fmt: skip
         if pj is None or tj is None:
+            continue
+        got = []
+        for j, key in ((pj, "angle_unit"), (tj, "te_unit")):
+            try:
+                got.append(_unit_factor(t, j, _ANGLE_UNITS, key, "angle"))
+            except BenchFileError as exc:
+                problems.append(exc)
+        if len(got) == 2:
+            factors[d] = (got[0], got[1])
+    _raise(problems)
+    for d in ("forward", "backward"):
+        pj, tj = cols.get(f"{d}_position"), cols.get(f"{d}_te")
+        if d not in factors or pj is None or tj is None:
             arrays[d + "_position"] = arrays[d + "_te"] = None
             continue
-        fp = _unit_factor(t, pj, _ANGLE_UNITS, "angle_unit", "angle")
-        ft = _unit_factor(t, tj, _ANGLE_UNITS, "te_unit", "angle")
+        fp, ft = factors[d]
         pos = t.data[:, pj] * fp
-        te = t.data[:, tj] * ft
+        te = t.data[:, tj] * (ft * opts.te_sign)
         _check_positions(t, pj, pos)
         big = np.abs(te - np.median(te)) > _TE_LIMIT
         if big.any():
@@ -404,9 +678,28 @@ def read_te_trace(path: str | os.PathLike) -> TETrace:
         backward_position=arrays["backward_position"],
         backward_te=arrays["backward_te"],
         serial=t.meta.get("serial"),
-        metadata=dict(t.meta),
+        metadata={**t.meta, "te_convention": opts.te_convention},
         **_meta_fields(t),
     )
+
+
+def _name_metadata(t: _Table, opts: ImportOptions) -> None:
+    """Merge the operating point written in the file name (``opts.file_name_pattern``) into
+    the metadata; a name that does not match, or disagrees with a ``#`` line, is an error."""
+    if opts.file_name_pattern is None:
+        return
+    got = metadata_from_name(t.source, opts.file_name_pattern)
+    if got is None:
+        raise BenchFileError(
+            t.source, None, None,
+            f"the file name does not match file_name_pattern {opts.file_name_pattern!r}",
+        )  # fmt: skip
+    for key, v in got.items():
+        if key in t.meta and not np.isclose(t.meta[key], v, rtol=1e-9, atol=1e-9):
+            raise t.meta_error(key, f"'{key}: {t.meta[key]:g}' contradicts the file name ({v:g})")
+        if key not in t.meta:
+            t.meta[key] = v
+            t.meta_lines[key] = None
 
 
 def _check_positions(t: _Table, j: int, pos: np.ndarray) -> None:
@@ -450,8 +743,10 @@ def _check_positions(t: _Table, j: int, pos: np.ndarray) -> None:
         )
 
 
-def read_te_folder(path: str | os.PathLike, pattern: str = "*.csv") -> list[TETrace]:
-    """Read every TE trace of a folder (one file per operating point), sorted by file name.
+def read_te_folder(
+    path: str | os.PathLike, pattern: str = "*.csv", options: ImportOptions | None = None
+) -> list[TETrace]:
+    """Read every TE trace of a folder (one file per operating point: a series).
 
     Parameters
     ----------
@@ -459,17 +754,21 @@ def read_te_folder(path: str | os.PathLike, pattern: str = "*.csv") -> list[TETr
         The folder.
     pattern : str
         Glob of the trace files in it.
+    options : ImportOptions, optional
+        As :func:`read_te_trace`.
 
     Returns
     -------
     list of TETrace
-        One trace per file, sorted by file name.
+        One trace per file, sorted by file name (the order carries no meaning: analyses pick
+        files by their operating point).
 
     Raises
     ------
     BenchFileError
-        For the folder when it holds no matching file, or the first malformed file's error
-        (nothing of the folder is returned then).
+        For the folder when it holds no matching file; else :class:`BenchFileErrors` with the
+        problems of *every* malformed file (nothing of the folder is returned then), and of
+        the series (:func:`check_series`).
     """
     p = Path(path)
     if not p.is_dir():
@@ -477,20 +776,70 @@ def read_te_folder(path: str | os.PathLike, pattern: str = "*.csv") -> list[TETr
     files = sorted(f for f in p.glob(pattern) if f.is_file())
     if not files:
         raise BenchFileError(str(path), None, None, f"holds no file matching {pattern!r}")
-    return [read_te_trace(f) for f in files]
+    traces, problems = [], []
+    for f in files:
+        try:
+            traces.append(read_te_trace(f, options))
+        except BenchFileErrors as exc:
+            problems.extend(exc.errors)
+        except BenchFileError as exc:
+            problems.append(exc)
+    if not problems:
+        problems = series_problems(traces)
+    _raise(problems)
+    return traces
+
+
+def series_problems(traces: list[TETrace]) -> list[BenchFileError]:
+    """What a series of operating points lacks: every file needs its torque, and speed and oil
+    temperature are given for every file or for none (a file without them cannot be placed
+    in the series). A single trace is not a series (no requirement).
+
+    Parameters
+    ----------
+    traces : list of TETrace
+        The traces of one folder.
+
+    Returns
+    -------
+    list of BenchFileError
+        One error per file and missing key, naming the file; empty when the series is complete.
+    """
+    if len(traces) < 2:
+        return []
+    out = []
+    how = ("write '# {key}: ...' in the file or give file_name_pattern "
+           "(e.g. \"{{torque}}Nm_{{speed}}rpm_{{temp}}C\") in [data]")  # fmt: skip
+    for attr, key, always in (("torque", "torque_Nm", True), ("speed_rpm", "speed_rpm", False),
+                              ("oil_temperature", "oil_temperature_C", False)):  # fmt: skip
+        have = [getattr(t, attr) is not None for t in traces]
+        if not always and not any(have):
+            continue
+        for t, h in zip(traces, have, strict=True):
+            if not h:
+                why = "" if always else " (other files of the series give it)"
+                out.append(BenchFileError(
+                    t.source, None, None,
+                    f"no {key}{why}: a series needs it for every file; " + how.format(key=key),
+                ))  # fmt: skip
+    return out
 
 
 # ---- hysteresis --------------------------------------------------------------------------
 _BRANCH_WORDS = {"ascending": 1, "descending": -1, "loading": 2, "unloading": -2}
 
 
-def read_hysteresis(path: str | os.PathLike) -> HysteresisCurve:
+def read_hysteresis(
+    path: str | os.PathLike, options: ImportOptions | None = None
+) -> HysteresisCurve:
     """Read a hysteresis curve (output torque against output torsion angle, input locked).
 
     Parameters
     ----------
     path : str or os.PathLike
         The CSV file.
+    options : ImportOptions, optional
+        Column mapping and units (the file-name pattern and TE convention do not apply).
 
     Returns
     -------
@@ -504,17 +853,25 @@ def read_hysteresis(path: str | os.PathLike) -> HysteresisCurve:
         As :func:`read_te_trace`, plus: a curve that does not cross zero torque, and unknown
         branch marks.
     """
-    t = _parse(path, _HYST_COLUMNS, _HYST_ALIASES, text_columns=("branch",))
+    opts = options or _DEFAULT_OPTIONS
+    t = _parse(path, _HYST_COLUMNS, _HYST_ALIASES, text_columns=("branch",), options=opts)
     _check_kind(t, "hysteresis")
     cols = {n: j for j, n in enumerate(t.names)}
-    for need in ("torque", "angle"):
-        if need not in cols:
-            raise BenchFileError(
-                t.source, t.header_line, None, f"column '{need}' is missing (got {t.names})"
-            )
+    _raise([
+        BenchFileError(t.source, t.header_line, None, f"column '{need}' is missing (got {t.names})")
+        for need in ("torque", "angle") if need not in cols
+    ])  # fmt: skip
     tj, aj = cols["torque"], cols["angle"]
-    torque = t.data[:, tj] * _unit_factor(t, tj, _TORQUE_UNITS, "torque_unit", "torque")
-    angle = t.data[:, aj] * _unit_factor(t, aj, _ANGLE_UNITS, "angle_unit", "angle")
+    problems, got = [], []
+    for j, table, key, what in ((tj, _TORQUE_UNITS, "torque_unit", "torque"),
+                                (aj, _ANGLE_UNITS, "angle_unit", "angle")):  # fmt: skip
+        try:
+            got.append(_unit_factor(t, j, table, key, what))
+        except BenchFileError as exc:
+            problems.append(exc)
+    _raise(problems)
+    torque = t.data[:, tj] * got[0]
+    angle = t.data[:, aj] * got[1]
     if torque.size < MIN_POINTS:
         raise BenchFileError(
             t.source,

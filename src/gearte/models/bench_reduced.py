@@ -11,8 +11,13 @@ Hysteresis (input locked, output torque ``T`` [N·mm], branch ``s = +1`` for ris
 
     θ(T, s) = θ0 + F(T − s T_fr) + C_rig T
     F(u)    = (β/2) tanh(u / T_β) + (T_r / (f K_nom)) c_p sgn(u) |u/T_r|^p
-    β       = g_cam c_cam + g_car c_car,    c_p = 0.5 / (1 − 0.5^p),   p = 0.9
+    β       = B0 + g_cam (c_cam − c0_cam) + g_car (c_car − c0_car),
+    c_p     = 0.5 / (1 − 0.5^p),   p = 0.9
 
+* ``β`` is the whole model's backlash, linearised in the two crank-bearing clearances about the
+  design: ``B0`` the design's backlash (clearances ``c0``, profile modifications and all), ``g`` the
+  backlash per mm of clearance. So ``c_cam``, ``c_car`` are the bearings' clearances themselves and
+  a calibrated serial written with them does not count the design's backlash twice.
 * ``F`` is the frictionless reducer: free play ``β`` taken up over a transition torque ``T_β``,
   then a stiffening elastic law (Palmgren line contact ``δ ∝ Q^0.9``); ``c_p`` makes the
   catalogue rigidity ``(T_r/2)/(θ(T_r) − θ(T_r/2))`` of the elastic part exactly ``f K_nom``, so
@@ -40,6 +45,7 @@ stated in docs/bench.md.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -47,6 +53,7 @@ from numpy.typing import ArrayLike
 __all__ = [
     "STIFFNESS_EXPONENT",
     "ReducedRV",
+    "play",
     "HYSTERESIS_PARAMETERS",
     "hysteresis_angle",
     "te_trace",
@@ -86,12 +93,18 @@ class ReducedRV:
         ``(g_cam, g_car)`` [rad/mm].
     families : dict
         Error family name → order (integer harmonic of the output revolution).
+    design_backlash : float
+        ``B0`` [rad], the whole model's backlash of the design.
+    design_clearances : (float, float)
+        ``(c0_cam, c0_car)`` [mm], the design's clearances.
     """
 
     rated_torque: float
     nominal_rigidity: float
     backlash_per_clearance: tuple[float, float]
     families: dict[str, int] = field(default_factory=dict)
+    design_backlash: float = 0.0
+    design_clearances: tuple[float, float] = (0.0, 0.0)
 
     def family_parameters(self) -> tuple[str, ...]:
         names: list[str] = []
@@ -117,9 +130,32 @@ def parameter_names(model: ReducedRV) -> tuple[str, ...]:
     return (*HYSTERESIS_PARAMETERS, *TE_COMMON, *model.family_parameters())
 
 
-def _play(p: dict, model: ReducedRV) -> float:
+def play(model: ReducedRV, p: dict) -> Any:
+    """The free play ``β`` [rad] of the parameters ``p`` (module docstring; arrays broadcast).
+
+    Parameters
+    ----------
+    model : ReducedRV
+        Constants of the reducer type (``g``, ``B0``, ``c0``).
+    p : dict
+        Parameters; ``cam_bearing_clearance`` and ``carrier_bearing_clearance`` [mm] are read.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``β = B0 + g_cam (c_cam − c0_cam) + g_car (c_car − c0_car)`` [rad].
+    """
     g_cam, g_car = model.backlash_per_clearance
-    return g_cam * p["cam_bearing_clearance"] + g_car * p["carrier_bearing_clearance"]
+    c0_cam, c0_car = model.design_clearances
+    return (
+        model.design_backlash
+        + g_cam * (p["cam_bearing_clearance"] - c0_cam)
+        + g_car * (p["carrier_bearing_clearance"] - c0_car)
+    )
+
+
+def _play(p: dict, model: ReducedRV) -> Any:
+    return play(model, p)
 
 
 def _loading_branch(

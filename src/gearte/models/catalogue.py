@@ -20,12 +20,32 @@ motion"; the same definitions are in GB/T 35089):
 * **hysteresis loss** ``θ_desc(0) − θ_asc(0)``: the width of the loop at zero torque after
   unloading from ``±T_r`` (free play plus friction) [rad].
 
-Angular TE trace (output angle minus input angle / ratio, one output revolution per direction):
+Angular TE trace (one output revolution per direction), in gearte's sign convention: TE =
+nominal output angle (input angle / ratio) − measured output angle, both in the forward sense, so
+a loaded reducer lags in both directions and the forward trace lies above the backward one
+(:data:`gearte.io.bench.TE_CONVENTION`; a rig writing the other sign is read with a flag):
 
 * **peak-to-peak per direction** ``max TE − min TE`` [rad];
 * **forward–backward difference** ``TE_fwd(φ) − TE_bwd(φ)`` along the revolution, both traces
   interpolated linearly and periodically onto the forward positions [rad]; its mean is the lost
   motion under running conditions.
+
+Load series (TE traces at several output torques ``T_k ≥ 0``, the load opposing the motion in
+both directions as a brake does): the forward trace at ``T`` is the reducer loaded to ``+T``, the
+backward one loaded to ``−T``, so the running curve ``θ_run(+T) = mean TE_fwd(T)``,
+``θ_run(−T) = mean TE_bwd(T)`` is read with the definitions above, ``D(T) = θ_run(+T) −
+θ_run(−T)`` the forward–backward mean (:func:`load_series_values`):
+
+* **torsional rigidity** ``(T_r/2)/(θ_run(T_r) − θ_run(T_r/2))`` averaged with the negative side
+  ``= T_r / (D(T_r) − D(T_r/2))`` (a series peaking short of ``T_r`` is read at its own peak
+  ``T_max``: ``T_max / (D(T_max) − D(T_max/2))``);
+* **lost motion** ``θ_run(+f T_r) − θ_run(−f T_r) = D(f T_r)``;
+* **hysteresis** ``D(0)``: the jump of the running curve at zero load (play + running friction);
+* **backlash** the lost motion less the elastic twist over ``±f T_r`` at that rigidity,
+  ``D(f T_r) − 2 f T_r / K``: the free play (for a mid-curve linear outside the play this is
+  the hysteresis-loop backlash above).
+
+``D`` between the measured torques is interpolated linearly; nothing is extrapolated.
 
 References
 ----------
@@ -57,6 +77,8 @@ __all__ = [
     "hysteresis_values_many",
     "te_peak_to_peak",
     "forward_backward_difference",
+    "LoadSeriesValues",
+    "load_series_values",
 ]
 
 ZERO_TORQUE_FRACTION = 1e-4
@@ -476,3 +498,145 @@ def forward_backward_difference(
     bt = np.asarray(backward_te, dtype=float)
     back = np.interp(np.asarray(forward_position, dtype=float), bp, bt, period=2 * np.pi)
     return np.asarray(forward_te, dtype=float) - back
+
+
+@dataclass(frozen=True)
+class LoadSeriesValues:
+    """Catalogue quantities of one load series (one speed, one temperature) with 95 % intervals.
+
+    ``torsional_rigidity`` [N·mm/rad]; ``lost_motion``, ``hysteresis``, ``backlash`` [rad]; NaN
+    where the series does not reach the torque the definition reads (stated in ``missing``).
+    ``ci`` maps each name to ``(low, high)`` (NaN without standard errors); ``interpolated`` lists
+    the quantities read between measured torques (their interval holds the noise only, not the
+    interpolation error); ``rigidity_range`` the torques ``(T_max/2, T_max)`` [N·mm] the rigidity
+    was read between.
+    """
+
+    torsional_rigidity: float
+    lost_motion: float
+    hysteresis: float
+    backlash: float
+    lost_motion_fraction: float
+    ci: dict
+    interpolated: tuple[str, ...]
+    missing: dict
+    rigidity_range: tuple[float, float]
+
+
+def _series_quantities(t, d, tr, f):
+    """(K, LM, H, B) from the forward−backward means ``d`` at torques ``t`` (sorted)."""
+    t_hi = min(tr, t[-1])
+    lo = 0.5 * t_hi
+    k = np.nan
+    if t[0] <= lo * (1 + 1e-9) and t_hi > 0:
+        dd = np.interp(t_hi, t, d) - np.interp(lo, t, d)
+        k = t_hi / dd if dd > 0 else np.nan
+    lm = float(np.interp(f * tr, t, d)) if t[0] <= f * tr <= t[-1] else np.nan
+    h = float(d[0]) if abs(t[0]) <= ZERO_TORQUE_FRACTION * tr else np.nan
+    b = lm - 2.0 * f * tr / k if np.isfinite(k) else np.nan
+    return np.array([k, lm, h, b])
+
+
+def load_series_values(
+    torque: ArrayLike,
+    difference: ArrayLike,
+    rated_torque: float,
+    *,
+    standard_error: ArrayLike | None = None,
+    lost_motion_fraction: float = 0.03,
+) -> LoadSeriesValues:
+    """Rigidity, lost motion, hysteresis and backlash of a load series of TE traces.
+
+    Parameters
+    ----------
+    torque : array_like, shape (K,)
+        Load torque of each operating point, opposing the motion in both directions [N·mm]
+        (≥ 0; repeated torques are averaged).
+    difference : array_like, shape (K,)
+        ``D``: mean forward TE − mean backward TE of each operating point [rad] (gearte's sign
+        convention: positive for a lagging reducer).
+    rated_torque : float
+        ``T_r`` [N·mm].
+    standard_error : array_like, optional
+        Standard error of each ``D`` [rad] (e.g. from the traces' noise); gives the intervals
+        by linear propagation (the rigidity's through its compliance).
+    lost_motion_fraction : float
+        ``f`` [-].
+
+    Returns
+    -------
+    LoadSeriesValues
+
+    Notes
+    -----
+    Definitions in the module docstring (the hysteresis-curve definitions applied to the running
+    curve of the series). Example: ``D = 2 (b/2 + T/K)`` (play ``b``, linear stiffness ``K``)
+    gives back ``K``, lost motion ``b + 2 f T_r/K``, hysteresis ``b`` and backlash ``b``.
+
+    References
+    ----------
+    Nabtesco Corporation, *Precision Reduction Gear RV* catalogue, "Rigidity (torsional rigidity,
+    lost motion) and hysteresis". GB/T 35089-2018, *Precision gear reducers for robots*.
+    """
+    t = np.asarray(torque, dtype=float).ravel()
+    dv = np.asarray(difference, dtype=float).ravel()
+    if t.size != dv.size or t.size < 2:
+        raise ParameterError("torque", t.size, "needs >= 2 operating points, one D each")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(dv))):
+        raise ParameterError("difference", dv, "must be finite")
+    if np.any(t < 0):
+        raise ParameterError("torque", float(t.min()), "load magnitudes must be >= 0 N·mm")
+    _check_rated_torque(rated_torque)
+    f = float(lost_motion_fraction)
+    se = None if standard_error is None else np.asarray(standard_error, dtype=float).ravel()
+    # average repeated torques (their standard errors combine as for a mean)
+    uniq, inv = np.unique(t, return_inverse=True)
+    cnt = np.bincount(inv)
+    d = np.bincount(inv, dv) / cnt
+    se_u = None if se is None else np.sqrt(np.bincount(inv, se**2)) / cnt
+    if uniq.size < 2:
+        raise ParameterError("torque", uniq.tolist(), "needs >= 2 distinct torques")
+    q = _series_quantities(uniq, d, rated_torque, f)
+    names = ("torsional_rigidity", "lost_motion", "hysteresis", "backlash")
+    ci = {n: (np.nan, np.nan) for n in names}
+    if se_u is not None:
+        # linear propagation; the rigidity through its compliance 1/K (linear in D)
+        jac = np.empty((4, uniq.size))
+        for j in range(uniq.size):
+            h = np.zeros(uniq.size)
+            h[j] = 1e-9 + 1e-6 * abs(d[j])
+            up = _series_quantities(uniq, d + h, rated_torque, f)
+            down = _series_quantities(uniq, d - h, rated_torque, f)
+            jac[:, j] = (up - down) / (2 * h[j])
+        jac[0] = -jac[0] / q[0] ** 2 if np.isfinite(q[0]) else np.nan  # d(1/K)/dD
+        half = 1.959963984540054 * np.sqrt((jac**2) @ se_u**2)
+        c = 1.0 / q[0]
+        ci["torsional_rigidity"] = (1.0 / (c + half[0]), 1.0 / (c - half[0]) if c > half[0]
+                                    else np.inf)  # fmt: skip
+        for i in (1, 2, 3):
+            ci[names[i]] = (q[i] - half[i], q[i] + half[i])
+    missing = {}
+    if not np.isfinite(q[0]):
+        missing["torsional_rigidity"] = (
+            f"needs torques down to T_max/2 = {0.5 * min(rated_torque, uniq[-1]):.6g} N·mm"
+        )
+    if not np.isfinite(q[1]):
+        missing["lost_motion"] = (
+            f"needs torques on both sides of f T_r = {f * rated_torque:.6g} N·mm"
+        )
+    if not np.isfinite(q[2]):
+        missing["hysteresis"] = "needs an operating point at zero load"
+    if not np.isfinite(q[3]) and "lost_motion" not in missing:
+        missing["backlash"] = "needs the rigidity"
+    t_hi = min(rated_torque, uniq[-1])
+    interp = []
+    on_grid = lambda x: bool(np.any(np.isclose(uniq, x, rtol=1e-6, atol=1e-9)))  # noqa: E731
+    if np.isfinite(q[0]) and not (on_grid(t_hi) and on_grid(0.5 * t_hi)):
+        interp.append("torsional_rigidity")
+    if np.isfinite(q[1]) and not on_grid(f * rated_torque):
+        interp += ["lost_motion", "backlash"]
+    return LoadSeriesValues(
+        torsional_rigidity=float(q[0]), lost_motion=float(q[1]), hysteresis=float(q[2]),
+        backlash=float(q[3]), lost_motion_fraction=f, ci=ci, interpolated=tuple(interp),
+        missing=missing, rigidity_range=(0.5 * t_hi, t_hi),
+    )  # fmt: skip

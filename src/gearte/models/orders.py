@@ -26,6 +26,10 @@ __all__ = [
     "rv_characteristic_orders",
     "order_spectrum",
     "labelled_orders",
+    "mean_standard_error",
+    "rv_tooth_orders",
+    "label_order",
+    "unexplained_lines",
 ]
 
 
@@ -167,7 +171,7 @@ def labelled_orders(
     """The ``n_orders`` largest orders (≥ ``min_share`` of the largest), each with its source.
 
     Returns a list of ``{"order", "amplitude", "phase", "source"}`` (amplitude in the spectrum's
-    unit, phase [rad]), largest first; sources by :func:`label_frequency` within half an order.
+    unit, phase [rad]), largest first; sources by :func:`label_order`.
     """
     amp = np.asarray(amplitude)[1:]
     if amp.size == 0 or amp.max() <= 0:
@@ -179,7 +183,143 @@ def labelled_orders(
             "order": int(orders[i]),
             "amplitude": float(amplitude[i]),
             "phase": float(phase[i]),
-            "source": label_frequency(float(orders[i]), sources, 0.5),
+            "source": label_order(int(orders[i]), sources),
         }
         for i in idx
     ]
+
+
+def mean_standard_error(amplitude: ArrayLike) -> float:
+    """Standard error of a trace's mean from the noise floor of its order spectrum.
+
+    Parameters
+    ----------
+    amplitude : array_like
+        Amplitudes of :func:`order_spectrum` (order 0 first, then 1, 2, ...) [any angle unit].
+
+    Returns
+    -------
+    float
+        ``σ/√N`` [unit of ``amplitude``]: ``σ`` of white noise on the ``N`` samples, from the
+        median line amplitude (most orders carry noise only).
+
+    Notes
+    -----
+    White noise of standard deviation ``σ`` on ``N`` samples gives line amplitudes ``2|X_k|/N``
+    that are Rayleigh distributed with scale ``σ √(2/N)``, median ``σ √(2/N) √(2 ln 2)``; so
+    ``σ/√N = median / (2 √(ln 2))``. Over one revolution the periodic content averages out of
+    the mean exactly, so this is the mean's whole noise (not the repeatability between runs).
+    """
+    amp = np.asarray(amplitude, dtype=float)[1:]
+    if amp.size < 8:
+        raise ParameterError("amplitude", amp.size, "needs >= 8 orders")
+    return float(np.median(amp) / (2.0 * np.sqrt(np.log(2.0))))
+
+
+def rv_tooth_orders(sun_teeth: int, planet_teeth: int, pin_count: int) -> dict[str, float]:
+    """Orders of every tooth number of an RV reducer: :func:`rv_characteristic_orders` plus the
+    disc's lobe count ``z_c = z_p − 1`` (``cycloid lobes``).
+
+    A lobe-to-lobe error of a disc (profile or pitch of its ``z_c`` lobes) repeats ``z_c`` times
+    per output revolution; with ``z_p = 40`` pins: 39, its harmonics 78, 156, ... and, around
+    the harmonics of the crank rotation, the sidebands 159 = 4·40 − 1, 318 = 8·40 − 2
+    (:func:`label_order`).
+
+    Parameters
+    ----------
+    sun_teeth, planet_teeth, pin_count : int
+        ``z1``, ``z2``, ``z_p``.
+
+    Returns
+    -------
+    dict
+        Source name → its order per output revolution [-].
+
+    Examples
+    --------
+    >>> rv_tooth_orders(22, 60, 40)["cycloid lobes"]
+    39.0
+    """
+    out = rv_characteristic_orders(sun_teeth, planet_teeth, pin_count)
+    out["cycloid lobes"] = float(pin_count - 1)
+    return out
+
+
+def label_order(order: int, sources: dict[str, float], tol: float = 0.5) -> str:
+    """Physical source of a TE order: a harmonic of a source or a sideband around one.
+
+    Tries, in this order, ``h × source`` (h = 1..8; 1..4 for sources below order 2, the output
+    rotation), then ``h × source ± k × rotation`` (k = 1..3, rotations: the sources named
+    "... rotation" with an integer order, the output rotation first, around the harmonics of the
+    other sources of order ≥ 2), the smallest ``k`` (then ``h``) first. Within ``tol`` orders.
+
+    Parameters
+    ----------
+    order : int
+        The order [-].
+    sources : dict
+        Source name → its order [-] (e.g. :func:`rv_tooth_orders`).
+    tol : float
+        Largest distance accepted [-].
+
+    Returns
+    -------
+    str
+        E.g. ``"4× cycloid lobes"``, ``"4× crank rotation − output rotation (sideband)"``, or
+        ``"unidentified"``.
+
+    Examples
+    --------
+    >>> src = rv_tooth_orders(22, 60, 40)
+    >>> [label_order(n, src) for n in (39, 78, 156, 159, 318)]  # doctest: +NORMALIZE_WHITESPACE
+    ['cycloid lobes', '2× cycloid lobes', '4× cycloid lobes',
+     '4× crank rotation − output rotation (sideband)',
+     '8× crank rotation − 2× output rotation (sideband)']
+    """
+    x = float(order)
+    for h in range(1, 9):
+        for name, f in sources.items():
+            if f < 2 and h > 4:  # low orders (the output rotation): harmonics 1..4 only
+                continue
+            if abs(x - h * f) <= tol:
+                return name if h == 1 else f"{h}× {name}"
+    rots = [(n, f) for n, f in sources.items() if "rotation" in n and abs(f - round(f)) < 1e-9]
+    rots.sort(key=lambda nf: nf[1])
+    for k in (1, 2, 3):
+        for rn, fr in rots:
+            for h in range(1, 9):
+                for name, f in sources.items():
+                    if name == rn or f < 2:  # no sidebands of a low order around itself
+                        continue
+                    for sgn in (-1, +1):
+                        if abs(x - (h * f + sgn * k * fr)) <= tol and h * f + sgn * k * fr > 0:
+                            base = name if h == 1 else f"{h}× {name}"
+                            side = rn if k == 1 else f"{k}× {rn}"
+                            return f"{base} {'+' if sgn > 0 else '−'} {side} (sideband)"
+    return "unidentified"
+
+
+def unexplained_lines(
+    lines: list[dict], peak_to_peak: float, noise: float, *, fraction: float = 0.05
+) -> list[dict]:
+    """Lines of a labelled spectrum that no source explains and that matter for the trace.
+
+    Parameters
+    ----------
+    lines : list of dict
+        :func:`labelled_orders` output (``amplitude`` in the trace's unit).
+    peak_to_peak : float
+        Peak-to-peak of the trace [same unit].
+    noise : float
+        Noise floor of a line's amplitude, e.g. the median amplitude of the spectrum [same unit].
+    fraction : float
+        A line counts when its amplitude is at least this share of the peak-to-peak [-] and at
+        least 4 × the noise floor.
+
+    Returns
+    -------
+    list of dict
+        The unexplained lines, largest first.
+    """
+    limit = max(fraction * peak_to_peak, 4.0 * noise)
+    return [x for x in lines if x["source"] == "unidentified" and x["amplitude"] >= limit]

@@ -47,6 +47,7 @@ __all__ = [
     "TorsionTest",
     "torque_path",
     "torsion_test",
+    "torsion_angles",
     "backlash",
     "CatalogueValues",
     "catalogue_values",
@@ -124,6 +125,39 @@ def _rated(reducer: RVReducer) -> float:
         )
     check_reducer_torque(reducer, reducer.rated_torque, "reducer.rated_torque")
     return float(reducer.rated_torque)
+
+
+def torsion_angles(
+    reducer: RVReducer,
+    torques: ArrayLike,
+    *,
+    theta: float = 0.0,
+    law: PinContactLaw | ContactLaw | None = None,
+) -> np.ndarray:
+    """Output torsion angle [rad] along any torque path [N·mm] (input locked), followed with warm
+    starts: :func:`torsion_test` for a path that is not a sweep between turning points (e.g. the
+    torque the elements see when a friction torque is added, for synthetic benches).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description.
+    torques : array_like, shape (K,)
+        Output torque in path order [N·mm]; an exact zero leaves the output free inside its
+        backlash (give ±1e-4 T_r, the side the path comes from).
+    theta : float
+        Output angle of the test [rad].
+    law : PinContactLaw or ContactLaw, optional
+        Pin-contact law; default the reducer's own.
+
+    Returns
+    -------
+    numpy.ndarray, shape (K,)
+        Output torsion angle [rad], positive with the torque.
+    """
+    t = np.asarray(torques, dtype=float)
+    law = contact_law(reducer) if law is None else law
+    return _follow(reducer, theta, t, law)
 
 
 def _follow(reducer, theta, torques, law):

@@ -18,6 +18,7 @@ import numpy as np
 
 from gearte.models.bench_reduced import STIFFNESS_EXPONENT
 from gearte.runners.bench_calibration import CalibrationResult, hysteresis_play
+from gearte.units import rad_to_arcsec
 
 __all__ = ["FAMILY_PARTS", "Diagnosis", "diagnose"]
 
@@ -29,6 +30,7 @@ FAMILY_PARTS = {
     "2× crank rotation": "crankshafts: cam/bore ovality, phase errors between the two cams",
     "involute mesh": "first stage: sun/planet tooth profile and pitch",
     "cycloid mesh": "cycloid discs / pins: profile and pitch",
+    "cycloid lobes": "cycloid discs: lobe-to-lobe profile or pitch errors (z_c lobes)",
     "encoder eccentricity": "rig: output encoder eccentricity or mounting",
 }
 """Error family (source name of its order) → the parts it points to."""
@@ -102,6 +104,7 @@ def diagnose(
     draws: int = 2000,
     seed: int = 0,
     correlation_limit: float = 0.95,
+    unexplained_limit: float | None = None,
 ) -> Diagnosis:
     """Rank the error families behind the TE and the contributors to the lost motion.
 
@@ -117,6 +120,18 @@ def diagnose(
         Parameter draws for the confidences (seeded: the same serial gives the same answer).
     correlation_limit : float
         Two lost-motion contributors whose parameters correlate beyond this are merged [-].
+    unexplained_limit : float, optional
+        Amplitude [rad] from which a line of ``spectrum`` that no source explains is stated
+        (e.g. a share of the trace's peak-to-peak, :func:`gearte.models.orders.unexplained_lines`);
+        without it no such statement is made.
+
+    Notes
+    -----
+    Data only: a ranking is made only from the data that can decide it. Without a hysteresis
+    curve no lost-motion culprit is named (the TE traces see the play only together with the
+    running wind-up), without a TE trace no TE culprit; the statements say which file would
+    decide it. A candidate whose parameters were neither fitted nor held at a measured value
+    (``cal.fixed``) is left out.
 
     Returns
     -------
@@ -127,9 +142,13 @@ def diagnose(
     model = cal.model
     sample = _draws(cal, draws, seed)
     diag = Diagnosis()
+    has_hyst = "hysteresis" in cal.residuals
+    has_te = any(k.startswith("te ") for k in cal.residuals)
+    known = set(cal.fitted) | set(cal.fixed)
 
     # --- TE: one candidate per distinct order (families sharing it cannot be told apart)
-    groups, amp = _te_candidates(cal)
+    groups, amp = _te_candidates(cal) if has_te else ([], None)
+    groups = [g for g in groups if all(f"{k}_cos" in known for k in g[2])]
     te_c = []
     for n, fams, keys in groups:
         te_c.append({
@@ -172,7 +191,15 @@ def diagnose(
         "reducer contact stiffness": "pin–disc contacts and bearings softer than designed",
         "rig compliance": "rig: shafts, couplings, encoder mount (not the reducer)",
     }
-    if any(k in cal.fitted for _, ks in terms.values() for k in ks):
+    if not has_hyst:
+        diag.statements.append(
+            "lost motion: no culprit named — without a hysteresis curve the data cannot separate "
+            "the play (bearing clearances), the reducer's contact stiffness and the rig's "
+            "compliance; a hysteresis file (output torque against torsion angle, input locked: "
+            "[data] hysteresis) would decide it"
+        )
+    elif any(k in cal.fitted for _, ks in terms.values() for k in ks):
+        terms = {n: v for n, v in terms.items() if all(k in known for k in v[1])}
         names = list(terms)
         merged: list[list[str]] = [[n] for n in names]
         fitted = list(cal.fitted)
@@ -222,12 +249,17 @@ def diagnose(
                     f"{title}: the data cannot tell apart {' and '.join(c['indistinguishable'])}"
                     + (" (same order)" if "order" in c else "")
                 )
-    if spectrum:
-        explained = max((c["contribution"] for c in diag.te), default=0.0)
+    if not has_te:
+        diag.statements.append(
+            "TE: no culprit named — no TE trace; a TE file (forward/backward over one output "
+            "revolution: [data] te) would decide it"
+        )
+    if spectrum and unexplained_limit is not None:
         for line in spectrum:
-            if line["source"] == "unidentified" and line["amplitude"] > 0.5 * explained > 0:
+            if line["source"] == "unidentified" and line["amplitude"] >= unexplained_limit:
                 diag.statements.append(
-                    f"TE: order {line['order']} carries {line['amplitude']:.3g} rad and matches no "
-                    "characteristic order of this drive (the rig, or a part not modelled)"
+                    f"TE: order {line['order']} carries {rad_to_arcsec(line['amplitude']):.3g}″ "
+                    f"(limit {rad_to_arcsec(unexplained_limit):.3g}″) and matches no order of "
+                    "this drive's tooth numbers (the rig, or a part not modelled)"
                 )
     return diag

@@ -923,10 +923,54 @@ _NEEDS = {
 }
 
 
+class CalibratedParameter(StrictModel):
+    """One estimate of a bench calibration (gearte units, named by ``unit``)."""
+
+    value: float
+    ci95: float | None = Field(default=None, description="95 % half-width (None: not identified)")
+    unit: str
+    identified: bool
+    note: str = ""
+
+
+class BenchCalibrationSection(StrictModel):
+    """What a bench calibration (kind ``rv_bench``) found for this serial, as values.
+
+    The clearances and the stiffness scale are applied in ``[reducer]`` (the bearing, support
+    and mesh stiffnesses and the Young's modulus are the design's times ``stiffness_scale``);
+    the friction and the rig's compliance are not parts of the reducer model and are recorded
+    here. Informational: the rv_reducer analyses do not read this section.
+    """
+
+    source: str = Field(description="The bench case and data it was calibrated from.")
+    stiffness_scale: float = Field(gt=0, description="Factor applied to every stiffness [-].")
+    contact_stiffness_factor: float | None = Field(
+        default=None, description="Reduced model's f on the design's rigidity [-]."
+    )
+    friction_torque_Nm: float | None = Field(default=None, description="Coulomb friction [N*m].")
+    rig_compliance_arcsec_per_kNm: float | None = Field(
+        default=None, description="Rig compliance between torque sensor and encoder."
+    )
+    clearances_identified: bool = Field(
+        description="False: the bench sees only the play of both crank bearings together (one "
+        "common clearance written) or not even that (the design's clearances kept)."
+    )
+    parameters: dict[str, CalibratedParameter] = Field(default_factory=dict)
+    round_trip: dict[str, dict[str, float | None]] = Field(
+        default_factory=dict,
+        description="Bench value, this serial through the whole model (+ the rig's twist), "
+        "relative difference, per catalogue quantity.",
+    )
+    not_written: list[str] = Field(default_factory=list)
+
+
 class Case(CaseBase):
     reducer: ReducerSection
     operation: OperationSection | None = None
     analyses: Analyses
+    bench_calibration: BenchCalibrationSection | None = Field(
+        default=None, description="A bench calibration's findings (written by rv_bench)."
+    )
 
     @model_validator(mode="after")
     def _inputs(self):
