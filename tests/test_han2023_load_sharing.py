@@ -24,7 +24,7 @@ from gearte.models.rv_load_sharing import (
     load_sharing,
     output_positions,
 )
-from gearte.solvers.rv_equilibrium import _law_delta, solve_positions, solve_reference
+from gearte.solvers.rv_equilibrium import law_delta, solve_positions, solve_reference
 from gearte.studies.rv_reducer import build_reducer
 
 # paper 003, section 4.2 and abstract
@@ -175,22 +175,27 @@ def test_han2023_solver_matches_scipy_fsolve_reference(reducers):
 def test_han2023_kernel_contact_law_is_the_cycloid_stage_law(reducers):
     """The RV solver evaluates the contact-law module's coefficients: with ``"hu2020"`` its
     per-contact approach equals the cycloid-stage analysis' eq 38 at ρ(φ0); with
-    ``"line_contact"`` the textbook law at each contact's own flank curvature."""
+    ``"line_contact"`` the textbook law at each contact's own flank curvature; with
+    ``"palmgren"`` Palmgren's closed form."""
     red, _ = reducers
     st = cycloid_stage(red)
     system = assemble(red, output_positions(2))
     hu = contact_law(red, "hu2020").for_system(system)
     line = contact_law(red, "line_contact").for_system(system)
+    palmgren = contact_law(red, "palmgren").for_system(system)
     rho = st.curvature_radius(system.contact_phase)
     for f in (10.0, 500.0, 1713.0, 5000.0):
         ref = max_normal_deformation(f, st.rho0, st.r, 2.06e5, 0.3, st.b, law="hu2020")
-        a0, a1 = hu.coefficients(2, system.contact_gap.shape[1])[1, 7]
-        assert _law_delta(f, a0, a1) == pytest.approx(float(ref), rel=1e-12)
+        a0, a1, a2, a3 = hu.coefficients(2, system.contact_gap.shape[1])[1, 7]
+        assert law_delta(f, a0, a1, a2, a3) == pytest.approx(float(ref), rel=1e-12)
         ref_line = approach(
             f, "line_contact", rho[1, 7], st.r, 2.06e5, 0.3, st.b, rho_cap=st.curvature_cap
         )
-        a0, a1 = line.coefficients(2, system.contact_gap.shape[1])[1, 7]
-        assert _law_delta(f, a0, a1) == pytest.approx(float(ref_line), rel=1e-12)
+        a0, a1, a2, a3 = line.coefficients(2, system.contact_gap.shape[1])[1, 7]
+        assert law_delta(f, a0, a1, a2, a3) == pytest.approx(float(ref_line), rel=1e-12)
+        ref_palmgren = 3.84e-5 * f**0.9 / st.b**0.8  # Palmgren's closed form (δ mm, F N, l mm)
+        a0, a1, a2, a3 = palmgren.coefficients(2, system.contact_gap.shape[1])[1, 7]
+        assert law_delta(f, a0, a1, a2, a3) == pytest.approx(ref_palmgren, rel=1e-12)
 
 
 def test_han2023_first_stage_is_valid_gear_geometry(reducers):

@@ -57,7 +57,7 @@ from gearte.models.contact_law import (
     check_law,
     check_pin_pressure,
     implausible_pin_pressure,
-    log_law_coefficients,
+    law_coefficients,
     max_contact_pressure,
 )
 from gearte.solvers.rv_batch import solve_positions, solve_system
@@ -217,11 +217,12 @@ class PinContactLaw:
 
     Attributes
     ----------
-    name : {"line_contact", "hu2020", "linear"}
+    name : {"line_contact", "hu2020", "palmgren", "linear"}
         ``"line_contact"``: the textbook law (:mod:`gearte.models.contact_law`) with each contact's
         own flank curvature, secant stiffness per contact. ``"hu2020"``: Hu 2020 eq 38–39 as
         printed with ρ(φ0) for every pin, one secant stiffness per disc (the paper's scheme).
-        ``"linear"``: constant ``stiffness``.
+        ``"palmgren"``: Palmgren's steel line-contact law ``δ = 3.84e-5 F^0.9 / b^0.8`` (Han
+        2023's), secant stiffness per contact. ``"linear"``: constant ``stiffness``.
     stage : CycloidStage
         The reducer's cycloid stage (K1, ρ(φ), pin radius r_rp + Δr_rp).
     youngs_modulus, poisson_ratio, face_width : float
@@ -248,14 +249,27 @@ class PinContactLaw:
         return self.stage.curvature_radius(phase)
 
     def coefficients(self, phase: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """(a0, a1) of ``δ = F (a0 − a1 ln F)`` per contact at meshing phase ``phase`` [mm/N]."""
+        """(a0, a1) of ``δ = F (a0 − a1 ln F)`` per contact at meshing phase ``phase`` [mm/N]
+        (the logarithmic laws; :meth:`law_coefficients` for every law)."""
+        a0, a1, a2, _ = self.law_coefficients(phase)
+        if np.any(a2 != 0.0):
+            raise ParameterError(
+                "contact_law", self.name, "is a power law: use law_coefficients (a0, a1, a2, a3)"
+            )
+        return a0, a1
+
+    def law_coefficients(
+        self, phase: ArrayLike
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(a0, a1, a2, a3) of ``δ = F (a0 − a1 ln F) + a2 F^a3`` per contact at meshing phase
+        ``phase`` (:func:`gearte.models.contact_law.law_coefficients`)."""
         phase = np.asarray(phase, dtype=float)
         rho = (
             np.full(phase.shape, self.stage.rho0)
             if self.name == "hu2020"
             else self.flank_curvature(phase)
         )
-        return log_law_coefficients(
+        return law_coefficients(
             self.name,
             rho,
             self.stage.r,
@@ -269,15 +283,17 @@ class PinContactLaw:
         """The solver's :class:`~gearte.solvers.rv_equilibrium.ContactLaw` for ``system``."""
         if self.name == "linear":
             return ContactLaw(kind="linear", stiffness=self.stiffness, name="linear")
-        a0, a1 = self.coefficients(contact_phase(system))
+        a0, a1, a2, a3 = self.law_coefficients(contact_phase(system))
         kind = "secant_per_disc" if self.name == "hu2020" else "secant_per_contact"
-        return ContactLaw(kind=kind, stiffness=self.stiffness, a0=a0, a1=a1, name=self.name)
+        return ContactLaw(kind=kind, stiffness=self.stiffness, a0=a0, a1=a1, a2=a2, a3=a3,
+                          name=self.name)  # fmt: skip
 
 
 def contact_law(
     reducer: RVReducer, law: str | None = None, stiffness: float = 2.0e5
 ) -> PinContactLaw:
-    """Pin-contact law of the reducer by name (``"line_contact"``, ``"hu2020"`` or ``"linear"``).
+    """Pin-contact law of the reducer by name (``"line_contact"``, ``"hu2020"``, ``"palmgren"``
+    or ``"linear"``).
 
     ``None`` takes the reducer's own law (``reducer.discs.contact_law``, default the textbook
     ``"line_contact"``).
@@ -289,7 +305,7 @@ def contact_law(
     ----------
     reducer : RVReducer
         The reducer description (:class:`gearte.geometry.rv.RVReducer`).
-    law : {"line_contact", "hu2020", "linear"}, optional
+    law : {"line_contact", "hu2020", "palmgren", "linear"}, optional
         The law's name; ``None``: the reducer's own.
     stiffness : float
         Constant pin-contact stiffness of ``"linear"`` [N/mm] (finite, at least the floor of a

@@ -635,13 +635,23 @@ class DynamicsSection(StrictModel):
         return out
 
 
+#: The error of an RV case without ``[reducer] contact_law`` (it had a silent default).
+CONTACT_LAW_REQUIRED = (
+    "contact_law is required: name the pin-contact law, one of 'line_contact', 'hu2020', "
+    "'palmgren' (docs/contact-law.md); contact_law = \"line_contact\" gives the results of a "
+    "case written before the key was required"
+)
+
+
 class ReducerSection(StrictModel):
     rated_torque_Nm: float | None = floored(
         "load_torque", None, le=1e6, description="catalogue rated torque (virtual torsion test)"
     )
-    contact_law: Literal["line_contact", "hu2020"] = Field(
-        default="line_contact",
-        description="pin-contact law (gearte.models.contact_law; docs/contact-law.md)",
+    contact_law: Literal["line_contact", "hu2020", "palmgren"] | None = Field(
+        default=None,
+        description="pin-contact law, required: 'line_contact' (Johnson), 'hu2020' (Hu 2020 eq "
+        "38-39 as printed) or 'palmgren' (Palmgren's steel line contact) "
+        "(gearte.models.contact_law; docs/contact-law.md)",
     )
     allowable_contact_pressure_MPa: float | None = Field(
         default=None, gt=0, le=1e5, description="warn when the Hertz pin pressure exceeds it"
@@ -669,6 +679,8 @@ class ReducerSection(StrictModel):
     @model_validator(mode="after")
     def _build(self):
         problems = []
+        if self.contact_law is None:
+            raise ValueError(CONTACT_LAW_REQUIRED)
         if self.material is not None and self.density_kg_per_m3 is not None:
             problems.append("give material or density_kg_per_m3, not both")
         if self.first_stage.planets != self.cranks.count:
@@ -1012,6 +1024,8 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         c.shaft_length_mm,
     )
     d = sec.discs
+    if sec.contact_law is None:
+        raise ParameterError("reducer.contact_law", None, CONTACT_LAW_REQUIRED)
     discs = Discs(
         d.count,
         d.face_width_mm,

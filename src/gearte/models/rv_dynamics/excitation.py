@@ -36,6 +36,7 @@ from gearte.geometry.rv import (
     RVReducer,
     pin_contacts,
 )
+from gearte.models.contact_law import LOG_LAWS
 from gearte.solvers.contact import solve_rotation
 
 __all__ = ["disc_rotation_error", "has_pin_errors", "loaded_disc_rotation"]
@@ -182,6 +183,13 @@ def disc_rotation_error(
     k = int(samples_per_mesh) * zp * zc
     theta = 2.0 * np.pi * np.arange(k) / k
     law = contact_law(reducer)
+    if law.name not in LOG_LAWS:
+        raise ParameterError(
+            "contact_law",
+            law.name,
+            "the disc-rotation excitation of pin and disc-profile errors solves the logarithmic "
+            f"laws {', '.join(repr(x) for x in LOG_LAWS)} only",
+        )
     nominal = reducer.replace(
         pins=PinRing(reducer.pins.count, reducer.pins.pin_radius, reducer.pins.circle_radius),
         errors=ManufacturingErrors.none(reducer.cranks.count, n_discs),
