@@ -54,13 +54,19 @@ from gearte.geometry.rv import RVReducer, pin_contacts
 from gearte.limits import check_floor
 from gearte.models.contact_law import (
     DEFAULT_LAW,
+    HU2020_HALF_WIDTH_FACTOR,
+    PALMGREN_COEFFICIENT,
+    PALMGREN_FORCE_EXPONENT,
+    PALMGREN_LENGTH_EXPONENT,
     check_law,
     check_pin_pressure,
+    hertz_half_width,
     implausible_pin_pressure,
     law_coefficients,
     max_contact_pressure,
 )
 from gearte.solvers.rv_batch import solve_positions, solve_system
+from gearte.units import rad_to_deg
 from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
     ContactLaw,
@@ -80,6 +86,11 @@ __all__ = [
     "assemble",
     "LoadSharing",
     "load_sharing",
+    "check_conformal",
+    "CONFORMAL_HALF_WIDTH_LIMIT",
+    "PeakPin",
+    "peak_pin",
+    "ROOT_SQUEEZE_SIN",
     "output_positions",
     "TransmissionError",
     "mesh_period",
@@ -243,6 +254,31 @@ class PinContactLaw:
         if not math.isfinite(self.stiffness):
             raise ParameterError("stiffness", self.stiffness, "must be finite [N/mm]")
         check_floor("stiffness", self.stiffness, "linear_stiffness")
+
+    def describe(self) -> str:
+        """The law and the constants it uses, in one line (echoed in results)."""
+        st, E, nu, b = self.stage, self.youngs_modulus, self.poisson_ratio, self.face_width
+        if self.name == "palmgren":
+            return (
+                f"palmgren: δ = {PALMGREN_COEFFICIENT:g} F^{PALMGREN_FORCE_EXPONENT:g} / "
+                f"l^{PALMGREN_LENGTH_EXPONENT:g} (δ mm, F N), l = b = {b:g} mm, secant "
+                "stiffness per contact (Palmgren 1959; Harris & Kotzalas 2007 ch. 7)"
+            )
+        if self.name == "hu2020":
+            return (
+                f"hu2020: Hu 2020 eq 38-39 as printed (constant {HU2020_HALF_WIDTH_FACTOR:g}), "
+                f"ρ(φ0) = {st.rho0:.4g} mm for every pin, r = {st.r:g} mm, E = {E:g} MPa, "
+                f"ν = {nu:g}, b = {b:g} mm, one secant stiffness per disc"
+            )
+        if self.name == "line_contact":
+            return (
+                "line_contact: Johnson 1985 §5.6 two-cylinder approach with each contact's "
+                f"flank curvature, |ρ| capped at {st.curvature_cap:.4g} mm, r = {st.r:g} mm, "
+                f"E = {E:g} MPa, ν = {nu:g}, b = {b:g} mm, secant stiffness per contact; "
+                f"refused on a concave flank where the Hertz half-width exceeds "
+                f"{CONFORMAL_HALF_WIDTH_LIMIT:g} r"
+            )
+        return f"linear: constant {self.stiffness:g} N/mm"
 
     def flank_curvature(self, phase: ArrayLike) -> np.ndarray:
         """Signed flank curvature radius [mm] where each pin touches, at meshing phase ``phase``."""
@@ -692,6 +728,8 @@ class LoadSharing:
     contact_pressure : (P, N, z_p) Hertz pressure of every pin with its own flank curvature [MPa].
     contact_law : str
         Name of the pin-contact law used.
+    pin_phase : (P, N, z_p) meshing phase of every pin [rad]: its angle from the line of
+        centres (the disc's eccentric direction), as :func:`contact_phase`.
     """
 
     theta: np.ndarray
@@ -707,6 +745,7 @@ class LoadSharing:
     q: np.ndarray
     contact_pressure: np.ndarray
     contact_law: str
+    pin_phase: np.ndarray | None = None
 
     @property
     def peak_pin_load(self) -> float:
@@ -765,6 +804,7 @@ def _postprocess(
         q=sol.q,
         contact_pressure=pressure,
         contact_law=law_name,
+        pin_phase=contact_phase(system).reshape(P, N, zp),
     )
 
 
@@ -823,7 +863,161 @@ def load_sharing(
     slaw, sol = _equilibrium(
         reducer, system, torque, law, solve_positions, compiled=compiled, q0=q0, k0=k0
     )
-    return _postprocess(reducer, system, sol, torque, slaw.name)
+    out = _postprocess(reducer, system, sol, torque, slaw.name)
+    if slaw.name == "line_contact":
+        check_conformal(reducer, out)
+    return out
+
+
+#: Largest Hertz half-width on a concave flank, relative to the pin radius, for which Johnson's
+#: convex line-contact approach (``"line_contact"``) is applied: Hertz's theory needs the contact
+#: strip small against the bodies (Johnson 1985 §4.1); on a concave flank of radius close to the
+#: pin's (near the tooth root) R* = r ρ/(ρ − r) grows without bound, the strip widens and the
+#: law's ln(4ρ/a) term of the disc (a convex cylinder of radius ρ) no longer describes the body.
+CONFORMAL_HALF_WIDTH_LIMIT = 0.1
+
+
+def check_conformal(reducer: RVReducer, load: LoadSharing) -> None:
+    """Refuse ``"line_contact"`` results that contain a near-conformal concave contact.
+
+    Every loaded pin on a concave flank (ρ > 0, the root side) must have a Hertz half-width
+    ``a ≤ CONFORMAL_HALF_WIDTH_LIMIT · r`` (:data:`CONFORMAL_HALF_WIDTH_LIMIT`, r the pin radius,
+    a from :func:`gearte.models.contact_law.hertz_half_width` with the pin's force and flank
+    curvature). Beyond it Johnson's convex formula (§5.6) is outside its domain.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description.
+    load : LoadSharing
+        A solved load sharing (its pin forces and phases).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``contact_law`` and, in the reason, the worst pin: disc, pin, output angle, its
+        flank radius, the pin radius and the half-width; with the laws to select instead.
+
+    References
+    ----------
+    Johnson K.L. (1985). Contact Mechanics, §4.1 (Hertz's assumptions), §5.6.
+    doi:10.1017/CBO9781139171731
+    """
+    if load.pin_phase is None:
+        return
+    stage = cycloid_stage(reducer)
+    d = reducer.discs
+    rho = stage.curvature_radius(load.pin_phase)
+    concave = (rho > 0.0) & (load.pin_force > 0.0)
+    if not np.any(concave):
+        return
+    a = hertz_half_width(
+        np.where(concave, load.pin_force, 0.0),
+        np.where(concave, rho, -1.0),
+        stage.r,
+        d.youngs_modulus,
+        d.poisson_ratio,
+        d.face_width,
+    )
+    ratio = np.where(concave, a / stage.r, 0.0)
+    if ratio.max() <= CONFORMAL_HALF_WIDTH_LIMIT:
+        return
+    p, j, k = np.unravel_index(np.argmax(ratio), ratio.shape)
+    raise ParameterError(
+        "contact_law",
+        "line_contact",
+        f"disc {j + 1}, pin {k + 1} at output angle {rad_to_deg(float(load.theta[p])):.1f}° "
+        f"touches a concave flank of radius {rho[p, j, k]:.3f} mm with pin radius "
+        f"{stage.r:.3f} mm under {load.pin_force[p, j, k]:.0f} N: Hertz half-width "
+        f"{a[p, j, k]:.3f} mm > {CONFORMAL_HALF_WIDTH_LIMIT:g} r, a near-conformal contact "
+        "outside Johnson's convex line-contact formula; select contact_law 'palmgren' "
+        "(independent of the curvatures) or 'hu2020' (docs/contact-law.md)",
+    )
+
+
+#: Below this share of its force turning the disc (sin of the angle between the pin force and
+#: the radial direction through the pin), the most loaded pin is squeezed radially at the tooth
+#: root rather than driving the disc.
+ROOT_SQUEEZE_SIN = 0.5
+
+
+@dataclass(frozen=True)
+class PeakPin:
+    """The most loaded pin of a load sharing and the direction of its force.
+
+    Attributes
+    ----------
+    position : int
+        Index of the output position [-].
+    output_angle : float
+        Output angle there [rad].
+    disc, pin : int
+        Disc and pin numbers, from 1 [-].
+    force : float
+        Its force [N].
+    phase : float
+        Its angle from the line of centres (the disc's eccentric direction), in (−π, π] [rad].
+    force_angle_from_radial : float
+        Angle between its force (the contact normal, through the pitch point) and the radial
+        direction through the pin [rad]; ``sin`` of it is ``K1 |sin φ| / S``.
+    """
+
+    position: int
+    output_angle: float
+    disc: int
+    pin: int
+    force: float
+    phase: float
+    force_angle_from_radial: float
+
+    @property
+    def root_squeeze(self) -> bool:
+        """Whether the force is mostly a radial squeeze at the tooth root
+        (``sin(force_angle_from_radial) < ROOT_SQUEEZE_SIN``)."""
+        return math.sin(self.force_angle_from_radial) < ROOT_SQUEEZE_SIN
+
+    def describe(self) -> str:
+        """One line naming the pin and its angles (for warnings)."""
+        return (
+            f"disc {self.disc}, pin {self.pin} at output angle "
+            f"{rad_to_deg(self.output_angle):.1f}°: {self.force:.0f} N, "
+            f"{abs(rad_to_deg(self.phase)):.1f}° from the line of centres, force "
+            f"{rad_to_deg(self.force_angle_from_radial):.1f}° from radial"
+        )
+
+
+def peak_pin(reducer: RVReducer, load: LoadSharing) -> PeakPin:
+    """The most loaded pin of ``load`` (:class:`PeakPin`).
+
+    The contact normal of pin ``k`` passes through the pitch point ``K1 r_p`` on the line of
+    centres (Hu 2020 eq 36), so its angle α from the radial direction through the pin has
+    ``sin α = K1 |sin φ| / S``, ``S = (1 + K1² − 2 K1 cos φ)^½``: 0 on the line of centres (a
+    pure radial squeeze), 1 where ``cos φ = K1`` (the largest arm).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description.
+    load : LoadSharing
+        A solved load sharing with its ``pin_phase``.
+
+    Returns
+    -------
+    PeakPin
+
+    References
+    ----------
+    Hu Y. et al. (2020). Applied Sciences 10(2), 481, eq 36. doi:10.3390/app10020481
+    """
+    if load.pin_phase is None:
+        raise ParameterError("load.pin_phase", None, "needed: a load sharing from load_sharing()")
+    p, j, k = np.unravel_index(np.argmax(load.pin_force), load.pin_force.shape)
+    phi = float(np.angle(np.exp(1j * load.pin_phase[p, j, k])))
+    K1 = cycloid_stage(reducer).K1
+    S = math.sqrt(1.0 + K1 * K1 - 2.0 * K1 * math.cos(phi))
+    alpha = math.asin(min(1.0, K1 * abs(math.sin(phi)) / S))
+    return PeakPin(int(p), float(load.theta[p]), int(j) + 1, int(k) + 1,
+                   float(load.pin_force[p, j, k]), phi, alpha)  # fmt: skip
 
 
 def _equilibrium(reducer, system, torque, law, solve, **kwargs):

@@ -1132,17 +1132,27 @@ def build_stage_case(case: Case):
 # ------------------------------------------------------------------------------------------
 def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
     from gearte.models.cycloid_contact import tooth_contact
-    from gearte.models.rv_load_sharing import cycloid_stage, load_sharing, output_positions
+    from gearte.models.rv_load_sharing import (
+        cycloid_stage,
+        load_sharing,
+        output_positions,
+        peak_pin,
+    )
 
     th = output_positions(sec.positions)
     T = Nm_to_Nmm(sec.torque_Nm)
     ls = load_sharing(red, T, th, law=law)
     has_errors = red0 is not None
     p_peak = np.unravel_index(np.argmax(ls.pin_force), ls.pin_force.shape)
+    pk = peak_pin(red, ls)
     values = {
         "peak_pin_load [N]": ls.peak_pin_load,
         "max_contact_pressure [MPa]": ls.max_contact_pressure,
         "contact_law": ls.contact_law,
+        "contact_law_form": law.describe() if hasattr(law, "describe") else ls.contact_law,
+        "peak_pin": f"disc {pk.disc}, pin {pk.pin}",
+        "peak_pin_angle_from_line_of_centres [deg]": abs(float(rad_to_deg(pk.phase))),
+        "peak_pin_force_angle_from_radial [deg]": float(rad_to_deg(pk.force_angle_from_radial)),
         "pairs_in_mesh_min": int(ls.pairs_in_mesh.min()),
         "pairs_in_mesh_max": int(ls.pairs_in_mesh.max()),
         "pairs_in_mesh_at_peak": int(ls.pairs_in_mesh[p_peak[0], p_peak[1]]),
@@ -1155,6 +1165,12 @@ def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
             float((ls.disc_torque / ls.disc_torque.sum(axis=1, keepdims=True)).max()),
         ],
     }
+    if pk.root_squeeze:
+        values["root_squeeze_warning"] = (
+            f"the peak pin load is a radial squeeze at the tooth root, near the line of centres "
+            f"({pk.describe()}; less than half of its force turns the disc): the load there "
+            "depends on the root geometry and on the pin-contact law more than on the torque path"
+        )
     data = {"load": ls}
     notes = [
         "Pin loads from the quasi-static equilibrium of all parts (springs + unilateral pin "
@@ -1512,6 +1528,9 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
         if r.name in ("load_sharing", "transmission_error", "catalogue", "compensation"):
             if r.values.get("contact_law") != case.reducer.contact_law:
                 r.values["contact_law"] = case.reducer.contact_law
+    for r in out:
+        if r.name == "load_sharing" and r.values.get("root_squeeze_warning"):
+            warnings.append(f"load_sharing: {r.values['root_squeeze_warning']}")
     if not out:
         warnings.append("no analyses requested: add [analyses.load_sharing] etc.")
     allowable = case.reducer.allowable_contact_pressure_MPa
