@@ -536,7 +536,9 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     ``F̃_c = F_c + (d_c − δ(F_c))/δ'(F_c)``. ``ln F_c`` is computed at the first iteration and
     where a contact closes, then carried along the force updates (:func:`_log_update`: a
     series where the force changed by less than 2⁻¹⁰ relative). The approaches follow the
-    steps (``d ← d − B Δq``) and are recomputed from ``q`` at the end.
+    steps (``d ← d − B Δq``) once the steps are small (below 1e-6), are recomputed from ``q``
+    after larger ones (the rounding of a huge first step from a cold start would stay in
+    them: 1e-3 relative errors of Palmgren's law) and at the end.
     A contact opens where its updated force is not positive; an open one closes where its
     approach is positive (start force :func:`_law_force_start`). Converged when the step in
     ``q`` is below 1e-9 and every force moved by less than 1e-7 of the largest, with no contact
@@ -550,9 +552,12 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     nc = gc.size
     H, L, grad, dq = wm[0], wm[1], wv[0], wv[1]
     Ft, Bdq, lf = wc[0], wc[1], wc[2]
+    big = np.inf
     for it in range(maxit):
         changed = False
-        if it == 0:
+        if big > 1e-6:
+            # from q itself after a large step (the first, from a cold start, can be huge: an
+            # update by −B dq would keep its rounding, ~1e-16 of the step, in every approach)
             _rows_times(cidx, cval, q, d)
             for c in range(nc):
                 d[c] -= gc[c]
