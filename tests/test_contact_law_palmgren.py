@@ -141,7 +141,9 @@ def test_near_conformal_concave_contact_is_refused_for_johnson_naming_the_pin(ha
     Hertz strip of Johnson's law is wider than 0.1 r there; the load sharing refuses it,
     naming the pin."""
     with pytest.raises(ParameterError) as exc:
-        load_sharing(han, han.rated_torque, output_positions(360), law=contact_law(han, "line_contact"))
+        load_sharing(
+            han, han.rated_torque, output_positions(360), law=contact_law(han, "line_contact")
+        )
     msg = str(exc.value)
     assert msg.startswith("contact_law = 'line_contact'")
     assert "disc 1, pin 9 at output angle 275.0°" in msg

@@ -40,9 +40,9 @@ from gearte.geometry.cycloid import CycloidStage, geometry_radii
 from gearte.geometry.cycloid_kernels import pin_mesh_table
 from gearte.limits import check_floor, check_load_torque
 from gearte.models.contact_law import (
-    LOG_LAWS,
     DEFAULT_LAW,
     HU2020_HALF_WIDTH_FACTOR,
+    LOG_LAWS,
     approach,
     check_law,
     check_material,

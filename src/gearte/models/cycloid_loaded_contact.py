@@ -434,7 +434,7 @@ def solve_rotation(
     rtol : float
         Relative tolerance on Δφ [-].
     power : (ndarray, ndarray), optional
-        ``(a2, a3)`` of a power law ``δ = a2 F^a3`` (Palmgren's; a0 = a1 = 0), as
+        ``(a2, a3)`` [mm/N^a3, -] of a power law ``δ = a2 F^a3`` (Palmgren's; a0 = a1 = 0), as
         :func:`gearte.solvers.contact.solve_rotation`.
 
     Returns

@@ -66,12 +66,12 @@ from gearte.models.contact_law import (
     max_contact_pressure,
 )
 from gearte.solvers.rv_batch import solve_positions, solve_system
-from gearte.units import rad_to_deg
 from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
     ContactLaw,
     as_solver_law,
 )
+from gearte.units import rad_to_deg
 
 __all__ = [
     "DofLayout",

@@ -635,7 +635,8 @@ def solve_rotation(
     implementation : {"numba", "plain"}
         The compiled kernel or its plain twin (the readable reference it is tested against).
     power : (ndarray, ndarray), optional
-        ``(a2, a3)``: the pins follow the power law ``δ = a2 F^a3`` instead (Palmgren's line
+        ``(a2, a3)`` [mm/N^a3, -]: the pins follow the power law ``δ = a2 F^a3`` instead
+        (Palmgren's line
         contact, ``gearte.models.contact_law.law_coefficients``; ``a0``, ``a1`` must then be 0),
         inverted in closed form, ``F = (δ/a2)^(1/a3)``; solved by the plain implementation.
 

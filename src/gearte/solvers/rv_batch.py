@@ -116,7 +116,8 @@ class BatchProblem:
     bearing_k, bearing_c : (nm,) stiffness [N/mm] and radial clearance [mm] of those bearings.
     group : (nc,) disc of each contact; law : solver law code
         (:data:`~gearte.solvers.rv_equilibrium.LAW_LINEAR` …); coef : (G, nc, 4) law
-        coefficients (a0, a1, a2, a3) of ``δ = F (a0 − a1 ln F) + a2 F^a3``; start_stiffness : start (or constant) stiffness [N/mm].
+        coefficients (a0, a1, a2, a3) of ``δ = F (a0 − a1 ln F) + a2 F^a3``;
+        start_stiffness : start (or constant) stiffness [N/mm].
     output : index of the output rotation in ``q``.
     """
 

@@ -13,8 +13,9 @@ The contact stiffness is load dependent: a contact law
 ``δ(F) = F (a0 − a1 ln F) + a2 F^a3`` whose coefficients ``(a0, a1, a2, a3)`` per position and
 contact are computed by the caller (:func:`gearte.models.contact_law.law_coefficients`, the one
 implementation of every pin law; this solver only evaluates that form: the logarithmic laws have
-``a2 = 0``, Palmgren's power law ``a0 = a1 = 0``, and a linear series compliance adds to ``a0``). Two secant schemes: ``"secant_per_disc"`` — one stiffness
-per disc ``k_g = F_max,g / δ(F_max,g)`` (Hu et al. 2020 section 4, with ρ(φ0)) — and
+``a2 = 0``, Palmgren's power law ``a0 = a1 = 0``, and a linear series compliance adds to
+``a0``). Two secant schemes: ``"secant_per_disc"`` — one stiffness per disc
+``k_g = F_max,g / δ(F_max,g)`` (Hu et al. 2020 section 4, with ρ(φ0)) — and
 ``"secant_per_contact"`` — each contact its own ``k_c = F_c / δ_c(F_c)`` with its own
 coefficients (its own flank curvature). This outer fixed point is a contraction (the secant
 stiffness varies with ``ln F``) and is iterated to a relative change below ``tol``. Positions are

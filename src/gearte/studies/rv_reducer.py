@@ -1104,6 +1104,13 @@ def build_stage_case(case: Case):
     tc = None
     if a.tooth_contact is not None:
         t = a.tooth_contact
+        if r.contact_law not in ("line_contact", "hu2020"):
+            raise ParameterError(
+                "reducer.contact_law",
+                r.contact_law,
+                "analyses.tooth_contact (the cycloid-stage tooth contact) solves 'line_contact' "
+                "and 'hu2020' only; select one of them or drop [analyses.tooth_contact]",
+            )
         tc = cs.ToothContactOptions(
             torque_Nm=t.torque_Nm,
             disc_share=t.disc_share,

@@ -86,7 +86,8 @@ def loaded_disc_rotation(
     rtol : float
         Relative tolerance on the elastic rotation [-].
     power : (numpy.ndarray, numpy.ndarray), optional
-        ``(a2, a3)`` per contact, ``(P, N, z_p)``, of a power law ``δ = a2 F^a3`` (Palmgren's;
+        ``(a2, a3)`` [mm/N^a3, -] per contact, ``(P, N, z_p)``, of a power law
+        ``δ = a2 F^a3`` (Palmgren's;
         ``a0 = a1 = 0``; :meth:`gearte.models.rv_load_sharing.PinContactLaw.law_coefficients`).
 
     Returns
@@ -120,6 +121,8 @@ def loaded_disc_rotation(
     first = np.min(ratio, axis=1)
     clear = np.where(lv > 0.0, g - first[:, None] * lv, 0.0)
 
+    flat_power = None if power is None else (power[0].reshape(P * N, zp),
+                                             power[1].reshape(P * N, zp))  # fmt: skip
     try:
         rot, _ = solve_rotation(
             lv,
@@ -129,7 +132,7 @@ def loaded_disc_rotation(
             torque_per_disc,
             rtol=rtol,
             rot_start=None if guess is None else np.asarray(guess, dtype=float).reshape(P * N),
-            power=None if power is None else tuple(x.reshape(P * N, zp) for x in power),
+            power=flat_power,
         )
     except ParameterError as exc:
         raise ParameterError("torque_per_disc", torque_per_disc, exc.reason) from None
