@@ -281,8 +281,10 @@ class PinContactLaw:
         return f"linear: constant {self.stiffness:g} N/mm"
 
     def flank_curvature(self, phase: ArrayLike) -> np.ndarray:
-        """Signed flank curvature radius [mm] where each pin touches, at meshing phase ``phase``."""
-        return self.stage.curvature_radius(phase)
+        """Signed flank curvature radius [mm] where each pin touches, at meshing phase ``phase``
+        (at the true contact point of the modified profile:
+        :meth:`gearte.geometry.cycloid.CycloidStage.contact_curvature_radius`)."""
+        return self.stage.contact_curvature_radius(phase)
 
     def coefficients(self, phase: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """(a0, a1) of ``δ = F (a0 − a1 ln F)`` per contact at meshing phase ``phase`` [mm/N]
@@ -786,7 +788,7 @@ def _postprocess(
     disc_torque = -np.sum(pin * arm, axis=-1)
     stage = cycloid_stage(reducer)
     d = reducer.discs
-    rho = stage.curvature_radius(contact_phase(system)).reshape(P, N, zp)
+    rho = stage.contact_curvature_radius(contact_phase(system)).reshape(P, N, zp)
     pressure = max_contact_pressure(
         pin, rho, stage.r, d.youngs_modulus, d.poisson_ratio, d.face_width
     )
@@ -907,7 +909,7 @@ def check_conformal(reducer: RVReducer, load: LoadSharing) -> None:
         return
     stage = cycloid_stage(reducer)
     d = reducer.discs
-    rho = stage.curvature_radius(load.pin_phase)
+    rho = stage.contact_curvature_radius(load.pin_phase)
     concave = (rho > 0.0) & (load.pin_force > 0.0)
     if not np.any(concave):
         return
