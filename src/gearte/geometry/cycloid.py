@@ -453,7 +453,9 @@ def true_contact(
     real pin (radius r_rp, centre on the circle r_p) at meshing phase φ touches that profile
     where the profile's normal passes through the pin's centre — at the profile parameter t,
     not at φ (on a modified profile they differ by 1–3° near the root). The equidistant
-    modification Δr_rp moves the profile along its normal and does not change t.
+    modification Δr_rp moves the profile along its normal and does not change t. The RV load
+    sharing reads the curvature there (:meth:`CycloidStage.contact_curvature_radius`); its rows
+    keep the arm of eq 36 (docs/contact-law.md, "Modified profiles").
 
     Parameters
     ----------

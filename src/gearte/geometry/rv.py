@@ -851,10 +851,7 @@ def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
     Disc ``j``'s eccentric points along ``χ_j = −z_c θ + 2π j / N`` (module conventions); its
     pitch point is ``P_j = a z_p ê(χ_j)``; the normal of pin ``k`` (centre ``p_k`` at
     ``α_k = 2π k / z_p``) passes through ``P_j`` and ``p_k`` (Hu 2020 eq 36), the contact point
-    lies ``r_rp`` inside the pin centre on it. On a shifted profile (Δr_p ≠ 0, nominal plus the
-    disc's modification error) the normal is turned to where the real pin touches the ground
-    profile (:func:`gearte.geometry.cycloid.true_contact`: through the pin's centre, not the
-    pitch point), and the arm is that normal's. The clearance of the modified profile is Hu 2020
+    lies ``r_rp`` inside the pin centre on it. The clearance of the modified profile is Hu 2020
     eq 32 (:func:`gearte.geometry.cycloid.normal_clearance_unclosed`). Disc errors are in the
     disc frame, which turns with the carrier (angle ``θ``): the run-out ``r`` translates the
     profile (gap ``−n·r``); the cumulative pitch deviation ``s(ψ) = ΔF_p/2 sin(ψ − angle)`` at
@@ -866,7 +863,7 @@ def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
     Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481, eq 32, 36.
     doi:10.3390/app10020481
     """
-    from gearte.geometry.cycloid import normal_clearance_unclosed, true_contact
+    from gearte.geometry.cycloid import normal_clearance_unclosed
 
     th = np.atleast_1d(np.asarray(theta, dtype=float))
     P = th.size
@@ -901,22 +898,6 @@ def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
         ],
         -1,
     )  # (N, 2): dr_rp, dr_p
-    if np.any(mods[:, 1] != 0.0):
-        # a shifted profile: the real pin touches it where its normal passes through the pin's
-        # centre (gearte.geometry.cycloid.true_contact), not through the pitch point; the normal
-        # turns by up to a few degrees near the root and the arm changes by up to ~20 %
-        turn = np.empty((P, N, zp))
-        for j in range(N):
-            turn[:, j] = true_contact(
-                phi[:, j], z_p=zp, r_p=pins.circle_radius, a=a, dr_p=mods[j, 1]
-            )[2]
-        ct, st = np.cos(turn), np.sin(turn)
-        nx, ny = ct * nx - st * ny, st * nx + ct * ny
-        lx = pin_pos[:, 0] - pins.pin_radius * nx - a * cx
-        ly = pin_pos[:, 1] - pins.pin_radius * ny - a * cy
-        n = np.stack([nx, ny], -1)
-        lever = np.stack([lx, ly], -1)
-        arm = lx * ny - ly * nx
     if np.all(mods.view(np.int64) == mods[:1].view(np.int64)):  # one profile, bit for bit
         gap = normal_clearance_unclosed(
             phi, z_p=zp, r_p=pins.circle_radius, a=a, dr_rp=mods[0, 0], dr_p=mods[0, 1]
