@@ -235,8 +235,12 @@ def law_columns(coef: np.ndarray) -> np.ndarray:
     ``F*`` (:func:`law_limit`) and ``δ* = δ(F*)`` (``a1 F*`` for the log law, ``inf`` for a
     power law) — (…, 6)."""
     a0, a1 = coef[..., :1], coef[..., 1:2]
-    fstar = law_limit(a0, a1)
-    dstar = np.where(a1 > 0.0, a1 * np.where(a1 > 0.0, fstar, 0.0), np.inf)
+    if np.all(a1 > 0.0):  # every contact on the log law (the usual case: two passes less)
+        fstar = np.exp(np.minimum((a0 - a1) / a1, 700.0))
+        dstar = a1 * fstar
+    else:
+        fstar = law_limit(a0, a1)
+        dstar = np.where(a1 > 0.0, a1 * np.where(a1 > 0.0, fstar, 0.0), np.inf)
     return np.ascontiguousarray(np.concatenate([coef, fstar, dstar], axis=-1))
 
 
@@ -537,7 +541,7 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     ``F̃_c = F_c + (d_c − δ(F_c))/δ'(F_c)``. ``ln F_c`` is computed at the first iteration and
     where a contact closes, then carried along the force updates (:func:`_log_update`: a
     series where the force changed by less than 2⁻¹⁰ relative). The approaches follow the
-    steps (``d ← d − B Δq``) once the steps are small (below 1e-6), are recomputed from ``q``
+    steps (``d ← d − B Δq``) once the steps are small (below 1e-3), are recomputed from ``q``
     after larger ones (the rounding of a huge first step from a cold start would stay in
     them: 1e-3 relative errors of Palmgren's law) and at the end.
     A contact opens where its updated force is not positive; an open one closes where its
@@ -556,9 +560,10 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     big = np.inf
     for it in range(maxit):
         changed = False
-        if big > 1e-6:
+        if big > 1e-3:
             # from q itself after a large step (the first, from a cold start, can be huge: an
-            # update by −B dq would keep its rounding, ~1e-16 of the step, in every approach)
+            # update by −B dq would keep its rounding, ~1e-16 of the step, in every approach;
+            # below 1e-3 that rounding is under 1e-17 mm)
             _rows_times(cidx, cval, q, d)
             for c in range(nc):
                 d[c] -= gc[c]
@@ -971,7 +976,10 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
     that start a sweep."""
     p = problem
     cd = _condensed(p)
-    coef3 = law_columns(p.coef) if p.law != LAW_LINEAR else np.zeros(p.coef.shape[:-1] + (6,))
+    coef3 = p.__dict__.get("_law_columns")  # computed once per problem, as its condensation
+    if coef3 is None:
+        coef3 = law_columns(p.coef) if p.law != LAW_LINEAR else np.zeros(p.coef.shape[:-1] + (6,))
+        object.__setattr__(p, "_law_columns", coef3)
     h = np.asarray(h, dtype=float)
     # condensed loads (S, G, m), one small product per sample and geometry: a sample's value
     # does not depend on its place in the batch (a BLAS product over the samples rounds rows

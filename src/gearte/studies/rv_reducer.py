@@ -1535,6 +1535,7 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
         if r.name in ("load_sharing", "transmission_error", "catalogue", "compensation"):
             if r.values.get("contact_law") != case.reducer.contact_law:
                 r.values["contact_law"] = case.reducer.contact_law
+            r.values.setdefault("contact_law_form", law.describe())
     for r in out:
         if r.name == "load_sharing" and r.values.get("root_squeeze_warning"):
             warnings.append(f"load_sharing: {r.values['root_squeeze_warning']}")
