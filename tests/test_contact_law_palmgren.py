@@ -154,3 +154,34 @@ def test_near_conformal_concave_contact_is_refused_for_johnson_naming_the_pin(ha
     ls0 = load_sharing(red0, red0.rated_torque, output_positions(36),
                        law=contact_law(red0, "line_contact"))  # fmt: skip
     assert ls0.peak_pin_load > 0
+
+
+def test_tooth_contact_refuses_palmgren_by_name():
+    """The cycloid-stage tooth contact solves the logarithmic laws only: Palmgren's is refused
+    naming the key, in the model and in an rv_reducer case asking for [analyses.tooth_contact]."""
+    from gearte.geometry.cycloid import CycloidStage
+    from gearte.models.cycloid_contact import tooth_contact
+
+    st = CycloidStage(z_p=40, r_p=82.0, r_rp=3.5, a=1.5, b=13.0)
+    with pytest.raises(ParameterError, match="contact_law = 'palmgren'.*logarithmic laws"):
+        tooth_contact(st, 4.0e5, disc_share=0.5, E=2.06e5, mu=0.3, contact_law="palmgren")
+    data = copy.deepcopy(_data("han2023_rv110e_no_errors"))
+    data["analyses"] = {"tooth_contact": {"torque_Nm": 500.0, "disc_share": 0.5}}
+    from gearte.studies import run_case
+
+    with pytest.raises((ParameterError, CaseFileError), match="reducer.contact_law"):
+        run_case(load_case(data))
+
+
+def test_every_rv_result_names_the_law_form():
+    from gearte.studies import run_case
+
+    data = copy.deepcopy(_data("han2023_rv110e_no_errors"))
+    data["analyses"] = {
+        "transmission_error": {"torque_Nm": 1078.0, "positions": 36},
+        "catalogue": {"position_deg": 0.0, "torque_sweep": [0.0, 1.0, 0.0, -1.0, 0.0]},
+    }
+    res = run_case(load_case(data))
+    for name in ("transmission_error", "catalogue"):
+        assert res[name].values["contact_law"] == "palmgren"
+        assert res[name].values["contact_law_form"].startswith("palmgren: δ = 3.84e-05 F^0.9")
