@@ -45,8 +45,8 @@ from gearte.solvers.rv_batch import (  # noqa: E402
     solve_positions,
 )
 from gearte.solvers.rv_equilibrium import (  # noqa: E402
-    _law_delta,
     _linear_parts,
+    law_delta,
 )
 from gearte.studies.rv_reducer import build_reducer  # noqa: E402
 
@@ -82,8 +82,8 @@ def baseline(system, torque, law):
             for g in range(ng):
                 fm = f[group == g].max()
                 if fm > 0:
-                    a0, a1 = coef[p][group == g][np.argmax(f[group == g])]
-                    knew[g] = fm / _law_delta(fm, a0, a1)
+                    a0, a1, a2, a3 = coef[p][group == g][np.argmax(f[group == g])]
+                    knew[g] = fm / law_delta(fm, a0, a1, a2, a3)
             done = np.max(np.abs(knew / k - 1.0)) < 1e-9
             k = knew
             if done:
@@ -103,7 +103,7 @@ def _best(fn, reps: int) -> float:
 
 def part2(red, system, T) -> None:
     """Strong baselines on the line-contact law (see the module docstring)."""
-    law = contact_law(red).for_system(system)
+    law = contact_law(red, "line_contact").for_system(system)  # the law the baselines code
     P = system.theta.size
     sol = solve_positions(system, T, law, method="per_position")  # compiles / loads the cache
     solve_positions(system, T, law)

@@ -48,6 +48,7 @@ __all__ = [
     "curvature_radius",
     "min_convex_curvature_radius",
     "normal_arm",
+    "true_contact",
     "normal_clearance_unclosed",
     "initial_clearance",
     "closing_rotation",
@@ -424,6 +425,109 @@ def normal_arm(phi: ArrayLike, *, z_p: int, a: float, K1: float) -> np.ndarray:
     """
     phi = np.asarray(phi, dtype=float)
     return a * (z_p - 1) * np.sin(phi) / _S(K1, phi)
+
+
+def _centre_path(t: np.ndarray, R: float, a: float, z_p: int) -> tuple[np.ndarray, ...]:
+    """Pin-centre path in the disc frame and its unit normal at parameter ``t`` (eq 1–2 with
+    r = 0): ``(x, y, n_x, n_y)``; the profile of a pin of radius r is ``(x, y) − r n``."""
+    i_h = z_p / (z_p - 1.0)
+    A, B = (1.0 - i_h) * t, i_h * t
+    K1 = a * z_p / R
+    S = _S(K1, t)
+    cA, sA, cB, sB = np.cos(A), np.sin(A), np.cos(B), np.sin(B)
+    return (R * cA - a * cB, R * sA + a * sB, (cA - K1 * cB) / S, (sA + K1 * sB) / S)
+
+
+def true_contact(
+    phi: ArrayLike,
+    *,
+    z_p: int,
+    r_p: float,
+    a: float,
+    dr_p: float = 0.0,
+    tol: float = 1e-13,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where a pin really touches a modified profile: profile parameter, arm and normal turn.
+
+    The disc is ground by pins of radius ``r_rp + Δr_rp`` on the circle ``R = r_p + Δr_p``; the
+    real pin (radius r_rp, centre on the circle r_p) at meshing phase φ touches that profile
+    where the profile's normal passes through the pin's centre — at the profile parameter t,
+    not at φ (on a modified profile they differ by 1–3° near the root). The equidistant
+    modification Δr_rp moves the profile along its normal and does not change t. The RV load
+    sharing reads the curvature there (:meth:`CycloidStage.contact_curvature_radius`); its rows
+    keep the arm of eq 36 (docs/contact-law.md, "Modified profiles").
+
+    Parameters
+    ----------
+    phi : array_like
+        Meshing phase φ of the pin [rad] (disc frame; :func:`profile_xy`'s parameter).
+    z_p : int
+        Number of pins [-].
+    r_p : float
+        Pin-centre-circle radius [mm].
+    a : float
+        Eccentricity [mm].
+    dr_p : float
+        Shifted modification Δr_p [mm].
+    tol : float
+        Tolerance on t [rad].
+
+    Returns
+    -------
+    t : numpy.ndarray
+        Profile parameter of the contact point [rad] (= φ on an unshifted profile): its
+        curvature is ``curvature_radius(t)`` (eq 40).
+    arm : numpy.ndarray
+        Arm of the contact normal about the disc centre [mm], signed as :func:`normal_arm`
+        (eq 36, which it equals on an unshifted profile).
+    turn : numpy.ndarray
+        Angle [rad] from the unmodified normal (through the pitch point) to the true normal,
+        counter-clockwise in the disc frame.
+
+    Notes
+    -----
+    With the pin-centre paths ``C(t; R)`` and their unit normals ``n(t; R)`` (eq 1–2 with the
+    pin radius set to 0), t solves ``(C(φ; r_p) − C(t; R)) × n(t; R) = 0`` (Newton from t = φ,
+    derivative by central differences); ``arm = C(φ; r_p) × n(t; R)``. The disc's closing
+    rotation (a few 1e-4 rad) is neglected, as in eq 32.
+
+    Examples
+    --------
+    >>> t, arm, turn = true_contact(0.2, z_p=40, r_p=76.0, a=1.5, dr_p=-0.0437)
+    >>> round(float(np.degrees(t - 0.2)), 2), round(float(arm), 2)
+    (2.84, 47.35)
+
+    References
+    ----------
+    Hu et al. (2020) eq 1–4, 36, 40, doi:10.3390/app10020481; Litvin F.L., Fuentes A. (2004).
+    Gear Geometry and Applied Theory, 2nd ed., ch. 6 (envelope: the normal through the
+    generating centre). doi:10.1017/CBO9780511547126
+    """
+    phi_in = np.asarray(phi, dtype=float)
+    # the profile repeats from tooth to tooth: solve within the tooth, φ in (−π, π]
+    phi = np.angle(np.exp(1j * phi_in))
+    R = r_p + dr_p
+    cx, cy, mx, my = _centre_path(phi, r_p, a, z_p)
+
+    def g(t: np.ndarray) -> np.ndarray:
+        x, y, nx, ny = _centre_path(t, R, a, z_p)
+        return (cx - x) * ny - (cy - y) * nx
+
+    t = phi.copy()
+    if dr_p != 0.0:
+        h = 1e-6
+        for _ in range(50):
+            step = g(t) / ((g(t + h) - g(t - h)) / (2.0 * h))
+            t = t - step
+            if np.all(np.abs(step) <= tol):
+                break
+        else:  # pragma: no cover - Newton from φ converges in a few steps
+            bad = float(phi_in.flat[int(np.argmax(np.abs(step)))])
+            raise ParameterError("phi", bad, "no true contact point found near φ")
+    _, _, nx, ny = _centre_path(t, R, a, z_p)
+    arm = cx * ny - cy * nx
+    turn = np.arctan2(mx * ny - my * nx, mx * nx + my * ny)
+    return phi_in + (t - phi), arm, turn
 
 
 def normal_clearance_unclosed(
@@ -920,6 +1024,18 @@ class CycloidStage:
     def S(self, phi: ArrayLike) -> np.ndarray:  # noqa: N802 - paper symbol
         """S(φ) = (1 + K1² − 2 K1 cos φ)^½ [-] (eq 4); |pitch point − pin centre| = r_p S."""
         return _S(self.K1, phi)
+
+    def true_contact(self, phi: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Profile parameter, arm [mm] and normal turn [rad] of the true contact of the real pin
+        at phase φ on the ground profile (:func:`true_contact`)."""
+        return true_contact(phi, z_p=self.z_p, r_p=self.r_p, a=self.a, dr_p=self.dr_p)
+
+    def contact_curvature_radius(self, phi: ArrayLike) -> np.ndarray:
+        """Curvature radius (eq 40) [mm] of the ground profile where the real pin at phase φ
+        touches it (at :func:`true_contact`'s parameter; ``curvature_radius(φ)`` without a
+        shifted modification)."""
+        t = self.true_contact(phi)[0] if self.dr_p != 0.0 else phi
+        return self.curvature_radius(t)
 
     def normal_arm(self, phi: ArrayLike) -> np.ndarray:
         """Arm of the contact normal l(φ) [mm] (eq 36)."""

@@ -28,9 +28,22 @@ by name:
     on the Hu 2020 stage the pin approach is 1.95× the textbook value. Kept because it is what
     reproduces Hu 2020's Tables 4–5 and 7–8. See docs/contact-law.md.
 
-Both laws have the form ``δ(F) = F (a0 − a1 ln F)`` with ``a1 = 2 (1 − ν²)/(π E b)`` (F in N,
-δ in mm); :func:`log_law_coefficients` returns ``(a0, a1)`` so that solvers can evaluate any law
-without knowing which one it is.
+``"palmgren"``
+    Palmgren's empirical line-contact law of a steel roller on a steel raceway (Palmgren 1959;
+    Harris & Kotzalas 2007, eq 7.4), the law Han et al. 2023 name for their springs::
+
+        δ = 3.84e-5 · F^0.9 / l^0.8        (δ in mm, F in N, l in mm)
+
+    l the contact length (here the face width b). It does not depend on the curvatures, nor on
+    E and ν: it is a fit to steel, and is refused for a material whose E is not a steel's
+    (:data:`PALMGREN_STEEL_E_RANGE_MPA`).
+
+Both logarithmic laws have the form ``δ(F) = F (a0 − a1 ln F)`` with
+``a1 = 2 (1 − ν²)/(π E b)`` (F in N, δ in mm); :func:`log_law_coefficients` returns ``(a0, a1)``.
+Every law, Palmgren's included, has the form ``δ(F) = F (a0 − a1 ln F) + a2 F^a3``
+(:func:`law_coefficients` returns ``(a0, a1, a2, a3)``; Palmgren: ``a0 = a1 = 0``,
+``a2 = 3.84e-5 / l^0.8``, ``a3 = 0.9``), so that solvers can evaluate any law without knowing
+which one it is; a linear series compliance adds to ``a0``.
 
 Units: mm, N, MPa. Every function checks its material (:func:`check_material`): E from the
 plausibility floor of a Young's modulus (1 000 MPa, ``gearte.limits.FLOORS``) to
@@ -45,6 +58,11 @@ case 2. McGraw-Hill. ISBN 0-07-072542-X
 Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/app10020481
 Li X., Huang J., Ding C., Guo R., Niu W. (2023). Machines 11(6), 626.
 doi:10.3390/machines11060626
+Palmgren A. (1959). Ball and Roller Bearing Engineering, 3rd ed. SKF Industries, Philadelphia.
+Harris T.A., Kotzalas M.N. (2007). Rolling Bearing Analysis, 5th ed., Essential Concepts of
+Bearing Technology, ch. 7 (roller–raceway line contact, δ = 3.84e-5 Q^0.9 / l^0.8).
+doi:10.1201/9781420006612
+Han L., Xu W., Wang Y., Zhang Y. (2023). JERR 25(8). doi:10.9734/JERR/2023/v25i8970
 """
 
 from __future__ import annotations
@@ -76,6 +94,13 @@ __all__ = [
     "implausible_pin_pressure",
     "check_pin_pressure",
     "log_law_coefficients",
+    "law_coefficients",
+    "palmgren_approach",
+    "PALMGREN_COEFFICIENT",
+    "PALMGREN_FORCE_EXPONENT",
+    "PALMGREN_LENGTH_EXPONENT",
+    "PALMGREN_STEEL_E_RANGE_MPA",
+    "LOG_LAWS",
     "approach",
     "force",
     "force_from_coefficients",
@@ -85,9 +110,22 @@ __all__ = [
     "max_contact_pressure_scalar",
 ]
 
-#: Names of the contact laws; the first is the default for user drives.
-LAWS = ("line_contact", "hu2020")
+#: Names of the contact laws; the first is the default of the Python functions (case files
+#: must name theirs).
+LAWS = ("line_contact", "hu2020", "palmgren")
+#: The laws of the form δ = F (a0 − a1 ln F) (:func:`log_law_coefficients`).
+LOG_LAWS = ("line_contact", "hu2020")
 DEFAULT_LAW = "line_contact"
+#: Palmgren's constant of δ = C F^0.9 / l^0.8 [mm^1.7 N^-0.9] (δ mm, F N, l mm; Palmgren 1959,
+#: Harris & Kotzalas 2007 ch. 7).
+PALMGREN_COEFFICIENT = 3.84e-5
+#: Exponent of the force in Palmgren's law [-].
+PALMGREN_FORCE_EXPONENT = 0.9
+#: Exponent of the contact length in Palmgren's law [-].
+PALMGREN_LENGTH_EXPONENT = 0.8
+#: Young's moduli [MPa] for which Palmgren's steel-on-steel fit is accepted (bearing and tool
+#: steels: about 1.9e5 to 2.2e5 MPa).
+PALMGREN_STEEL_E_RANGE_MPA = (1.9e5, 2.2e5)
 #: The constant of Hu 2020 eq 39 as printed.
 HU2020_HALF_WIDTH_FACTOR = 4.99e-3
 #: Roark's constant of the contact band width of two cylinders, b = 1.60 (p K_D C_E)^½
@@ -106,7 +144,7 @@ def check_law(law: str, field: str = "contact_law") -> str:
     Parameters
     ----------
     law : str
-        ``"line_contact"`` or ``"hu2020"``.
+        ``"line_contact"``, ``"hu2020"`` or ``"palmgren"``.
     field : str
         Name of the input that carried the law (for the error message).
 
@@ -459,6 +497,12 @@ def log_law_coefficients(
     Johnson (1985) §5.6; Hu et al. (2020) eq 38–39, doi:10.3390/app10020481.
     """
     check_law(law)
+    if law not in LOG_LAWS:
+        raise ParameterError(
+            "contact_law",
+            law,
+            "is not of the form δ = F (a0 − a1 ln F) (a power law): use law_coefficients",
+        )
     _check_material(E, nu, b)
     if not (math.isfinite(r) and r > 0.0):
         raise ParameterError("pin_radius", r, "must be finite and > 0")
@@ -478,6 +522,104 @@ def log_law_coefficients(
         q = 4.0 * rs / (math.pi * b * contact_modulus(E, nu))
         a0 = a1 * (np.log(16.0 * rho_abs * r) - np.log(q) - 1.0)
     return a0, np.broadcast_to(a1, np.shape(a0)).copy()
+
+
+def palmgren_approach(F: ArrayLike, length: float) -> np.ndarray:
+    """Palmgren's approach of a steel roller and a steel raceway in line contact [mm].
+
+    ``δ = 3.84e-5 F^0.9 / l^0.8`` (δ mm, F N, l mm).
+
+    Parameters
+    ----------
+    F : array_like
+        Contact force [N] (≤ 0 gives 0).
+    length : float
+        Contact length l [mm] (the face width of a pin on a disc), > 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        δ [mm].
+
+    Examples
+    --------
+    >>> round(1e3 * float(palmgren_approach(1000.0, 13.0)), 3)
+    2.473
+
+    References
+    ----------
+    Palmgren A. (1959). Ball and Roller Bearing Engineering, 3rd ed., SKF Industries.
+    Harris T.A., Kotzalas M.N. (2007). Rolling Bearing Analysis, 5th ed., ch. 7.
+    doi:10.1201/9781420006612
+    """
+    if not (math.isfinite(length) and length > 0.0):
+        raise ParameterError("length", length, "must be finite and > 0 [mm]")
+    f = np.maximum(np.asarray(F, dtype=float), 0.0)
+    return PALMGREN_COEFFICIENT * f**PALMGREN_FORCE_EXPONENT / length**PALMGREN_LENGTH_EXPONENT
+
+
+def law_coefficients(
+    law: str,
+    rho: ArrayLike,
+    r: float,
+    E: float,
+    nu: float,
+    b: float,
+    *,
+    rho_cap: float | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Coefficients of ``δ(F) = F (a0 − a1 ln F) + a2 F^a3`` for a named law (every law).
+
+    Parameters
+    ----------
+    law : {"line_contact", "hu2020", "palmgren"}
+        The contact law (module docstring).
+    rho, r, E, nu, b, rho_cap
+        As in :func:`log_law_coefficients` ([mm], [mm], [MPa], [-], [mm], [mm]).
+        ``"palmgren"`` reads only b (the contact length) and checks that E is a steel's
+        (:data:`PALMGREN_STEEL_E_RANGE_MPA`).
+
+    Returns
+    -------
+    a0, a1 : numpy.ndarray
+        [mm/N]: those of :func:`log_law_coefficients`; 0 for ``"palmgren"``.
+    a2 : numpy.ndarray
+        [mm/N^0.9]: ``3.84e-5 / b^0.8`` for ``"palmgren"``; 0 for the logarithmic laws.
+    a3 : numpy.ndarray
+        [-]: 0.9 for ``"palmgren"``; 1 for the logarithmic laws.
+
+    Raises
+    ------
+    ParameterError
+        An unknown law, a material out of range, or ``"palmgren"`` with E outside a steel's.
+
+    References
+    ----------
+    Johnson (1985) §5.6; Hu et al. (2020) eq 38–39; Palmgren (1959); Harris & Kotzalas (2007)
+    ch. 7, doi:10.1201/9781420006612.
+    """
+    check_law(law)
+    if law in LOG_LAWS:
+        a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
+        return a0, a1, np.zeros_like(a0), np.ones_like(a0)
+    _check_material(E, nu, b)
+    lo, hi = PALMGREN_STEEL_E_RANGE_MPA
+    if not lo <= E <= hi:
+        raise ParameterError(
+            "youngs_modulus_MPa",
+            E,
+            f"contact_law 'palmgren' is Palmgren's fit for steel on steel (E in [{lo:g}, "
+            f"{hi:g}] MPa); select 'line_contact' for another material",
+        )
+    shape = np.shape(np.asarray(rho, dtype=float))
+    a2 = PALMGREN_COEFFICIENT / b**PALMGREN_LENGTH_EXPONENT
+    return (np.zeros(shape), np.zeros(shape), np.full(shape, a2),
+            np.full(shape, PALMGREN_FORCE_EXPONENT))  # fmt: skip
+
+
+def _approach_from(F: np.ndarray, coef) -> np.ndarray:
+    a0, a1, a2, a3 = coef
+    return F * (a0 - a1 * np.log(F)) + a2 * F**a3
 
 
 def approach(
@@ -514,15 +656,16 @@ def approach(
     5.51
     >>> round(1e3 * float(approach(1810.0, "hu2020", **kw)), 2)
     10.98
+    >>> round(1e3 * float(approach(1810.0, "palmgren", **kw)), 2)
+    4.82
 
     References
     ----------
     Johnson (1985) §5.6, doi:10.1017/CBO9781139171731; Hu et al. (2020) eq 38–39,
-    doi:10.3390/app10020481.
+    doi:10.3390/app10020481; Palmgren (1959), Harris & Kotzalas (2007) ch. 7.
     """
     F = np.asarray(F, dtype=float)
-    a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
-    return F * (a0 - a1 * np.log(F))
+    return _approach_from(F, law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap))
 
 
 def secant_stiffness(
@@ -542,7 +685,7 @@ def secant_stiffness(
     ----------
     F : array_like
         Contact force [N], > 0.
-    law : {"line_contact", "hu2020"}
+    law : {"line_contact", "hu2020", "palmgren"}
         The contact law (:data:`LAWS`).
     rho : array_like
         Curvature radius of the flank at the contact [mm] (ρ < 0 convex).
@@ -567,8 +710,8 @@ def secant_stiffness(
     See :func:`approach`.
     """
     F = np.asarray(F, dtype=float)
-    a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
-    return 1.0 / (a0 - a1 * np.log(F))
+    a0, a1, a2, a3 = law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
+    return 1.0 / (a0 - a1 * np.log(F) + a2 * F ** (a3 - 1.0))
 
 
 def tangent_stiffness(
@@ -582,13 +725,13 @@ def tangent_stiffness(
     *,
     rho_cap: float | None = None,
 ) -> np.ndarray:
-    """Tangent contact stiffness k_t = dF/dδ = 1 / (a0 − a1 ln F − a1) [N/mm].
+    """Tangent contact stiffness k_t = dF/dδ = 1 / (a0 − a1 ln F − a1 + a3 a2 F^(a3−1)) [N/mm].
 
     Parameters
     ----------
     F : array_like
         Contact force [N], > 0.
-    law : {"line_contact", "hu2020"}
+    law : {"line_contact", "hu2020", "palmgren"}
         The contact law (:data:`LAWS`).
     rho : array_like
         Curvature radius of the flank at the contact [mm] (ρ < 0 convex).
@@ -613,8 +756,8 @@ def tangent_stiffness(
     See :func:`approach`.
     """
     F = np.asarray(F, dtype=float)
-    a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
-    return 1.0 / (a0 - a1 * np.log(F) - a1)
+    a0, a1, a2, a3 = law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
+    return 1.0 / (a0 - a1 * np.log(F) - a1 + a3 * a2 * F ** (a3 - 1.0))
 
 
 def force_from_coefficients(
@@ -680,6 +823,11 @@ def force(
     ----------
     See :func:`approach`.
     """
+    if law not in LOG_LAWS:
+        check_law(law)
+        a0, a1, a2, a3 = law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
+        d = np.maximum(np.asarray(delta, dtype=float), 0.0)
+        return (d / a2) ** (1.0 / a3)  # the power law inverted in closed form (a0 = a1 = 0)
     a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
     return force_from_coefficients(delta, a0, a1, rtol=rtol)
 

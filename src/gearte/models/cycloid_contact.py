@@ -42,6 +42,7 @@ from gearte.limits import check_floor, check_load_torque
 from gearte.models.contact_law import (
     DEFAULT_LAW,
     HU2020_HALF_WIDTH_FACTOR,
+    LOG_LAWS,
     approach,
     check_law,
     check_material,
@@ -434,6 +435,14 @@ def tooth_contact(
     if clearance_model not in ("eq32", "envelope"):
         raise ParameterError("clearance_model", clearance_model, "must be 'eq32' or 'envelope'")
     check_law(contact_law, "contact_law")
+    if contact_law not in LOG_LAWS:
+        raise ParameterError(
+            "contact_law",
+            contact_law,
+            "the cycloid-stage tooth contact solves the logarithmic laws "
+            f"{', '.join(repr(x) for x in LOG_LAWS)}; 'palmgren' is available in the "
+            "rv_reducer analyses",
+        )
     T_c = disc_share * torque
     theta = np.atleast_1d(np.asarray(mesh_angle, dtype=float))
     if not np.all(np.isfinite(theta)):

@@ -35,7 +35,7 @@ from gearte.models.contact_law import (
     check_law,
     check_material,
     force_from_coefficients,
-    log_law_coefficients,
+    law_coefficients,
     max_contact_pressure,
 )
 from gearte.solvers.contact import solve_rotation as _solve_rotation
@@ -96,7 +96,7 @@ class CycloidPinPair:
     k1_definition : {"ground", "nominal"}
         K1 = e z_p / (r_p + Δr_p) as for every other analysis of the stage (default) or Li's
         e z_p / r_p (:data:`gearte.geometry.cycloid.K1_DEFINITIONS`).
-    contact_law : {"line_contact", "hu2020"}
+    contact_law : {"line_contact", "hu2020", "palmgren"}
         The pin contact law (:mod:`gearte.models.contact_law`); eq 2 of the paper is the
         textbook line contact.
     """
@@ -283,8 +283,11 @@ def profile_curvature_radius(pair: CycloidPinPair, phi: ArrayLike) -> np.ndarray
     return pair.stage.curvature_radius(phi)
 
 
-def _law_coefficients(pair: CycloidPinPair, rho_c: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    return log_law_coefficients(
+def _law_coefficients(
+    pair: CycloidPinPair, rho_c: ArrayLike
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(a0, a1, a2, a3) of the pair's law, ``δ = F (a0 − a1 ln F) + a2 F^a3``."""
+    return law_coefficients(
         pair.contact_law,
         rho_c,
         pair.stage.r,
@@ -332,8 +335,8 @@ def hertz_line_deflection(pair: CycloidPinPair, force_N: ArrayLike, rho_c: Array
     doi:10.1017/CBO9781139171731.
     """
     f = np.asarray(force_N, dtype=float)
-    a0, a1 = _law_coefficients(pair, rho_c)
-    return f * (a0 - a1 * np.log(f))
+    a0, a1, a2, a3 = _law_coefficients(pair, rho_c)
+    return f * (a0 - a1 * np.log(f)) + a2 * f**a3
 
 
 def hertz_line_force(
@@ -359,7 +362,9 @@ def hertz_line_force(
     numpy.ndarray
         F [N].
     """
-    a0, a1 = _law_coefficients(pair, rho_c)
+    a0, a1, a2, a3 = _law_coefficients(pair, rho_c)
+    if np.any(a2 != 0.0):  # the power law (Palmgren's): inverted in closed form (a0 = a1 = 0)
+        return (np.maximum(np.asarray(deflection_mm, dtype=float), 0.0) / a2) ** (1.0 / a3)
     return force_from_coefficients(deflection_mm, a0, a1, rtol=rtol)
 
 
@@ -406,6 +411,7 @@ def solve_rotation(
     torque_Nmm: float,
     *,
     rtol: float = 1e-11,
+    power: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Disc rotation and pin forces that carry ``torque_Nmm`` (compatibility + equilibrium).
 
@@ -427,6 +433,9 @@ def solve_rotation(
         Torque on the disc [N·mm], > 0.
     rtol : float
         Relative tolerance on Δφ [-].
+    power : (ndarray, ndarray), optional
+        ``(a2, a3)`` [mm/N^a3, -] of a power law ``δ = a2 F^a3`` (Palmgren's; a0 = a1 = 0), as
+        :func:`gearte.solvers.contact.solve_rotation`.
 
     Returns
     -------
@@ -444,7 +453,7 @@ def solve_rotation(
     doi:10.3390/app10020481.
     """
     try:
-        return _solve_rotation(arm, clearance, a0, a1, torque_Nmm, rtol=rtol)
+        return _solve_rotation(arm, clearance, a0, a1, torque_Nmm, rtol=rtol, power=power)
     except ParameterError as exc:  # the solver names its own argument, "torque"
         raise ParameterError("torque_Nmm", torque_Nmm, exc.reason) from None
 
@@ -513,9 +522,10 @@ def loaded_contact(
     ang = np.where(loaded, gap / np.where(loaded, arm, 1.0), np.inf)
     backlash = np.where(loaded, ang - np.min(ang, axis=1, keepdims=True), 0.0)
     rho = profile_curvature_radius(pair, phi)
-    a0, a1 = _law_coefficients(pair, rho)
+    a0, a1, a2, a3 = _law_coefficients(pair, rho)
     la = np.where(loaded, arm, 0.0)
-    rot, force = solve_rotation(la, backlash * la, a0, a1, torque_Nmm, rtol=rtol)
+    power = (a2, a3) if np.any(a2 != 0.0) else None
+    rot, force = solve_rotation(la, backlash * la, a0, a1, torque_Nmm, rtol=rtol, power=power)
     rc = pair.pitch_radius_mm
     f_t = np.sum(force * la, axis=1) / rc
     f_r = np.sum(force * np.sqrt(np.clip(1.0 - (la / rc) ** 2, 0.0, None)), axis=1)

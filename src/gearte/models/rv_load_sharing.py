@@ -54,10 +54,15 @@ from gearte.geometry.rv import RVReducer, pin_contacts
 from gearte.limits import check_floor
 from gearte.models.contact_law import (
     DEFAULT_LAW,
+    HU2020_HALF_WIDTH_FACTOR,
+    PALMGREN_COEFFICIENT,
+    PALMGREN_FORCE_EXPONENT,
+    PALMGREN_LENGTH_EXPONENT,
     check_law,
     check_pin_pressure,
+    hertz_half_width,
     implausible_pin_pressure,
-    log_law_coefficients,
+    law_coefficients,
     max_contact_pressure,
 )
 from gearte.solvers.rv_batch import solve_positions, solve_system
@@ -66,6 +71,7 @@ from gearte.solvers.rv_equilibrium import (
     ContactLaw,
     as_solver_law,
 )
+from gearte.units import rad_to_deg
 
 __all__ = [
     "DofLayout",
@@ -80,6 +86,11 @@ __all__ = [
     "assemble",
     "LoadSharing",
     "load_sharing",
+    "check_conformal",
+    "CONFORMAL_HALF_WIDTH_LIMIT",
+    "PeakPin",
+    "peak_pin",
+    "ROOT_SQUEEZE_SIN",
     "output_positions",
     "TransmissionError",
     "mesh_period",
@@ -217,11 +228,12 @@ class PinContactLaw:
 
     Attributes
     ----------
-    name : {"line_contact", "hu2020", "linear"}
+    name : {"line_contact", "hu2020", "palmgren", "linear"}
         ``"line_contact"``: the textbook law (:mod:`gearte.models.contact_law`) with each contact's
         own flank curvature, secant stiffness per contact. ``"hu2020"``: Hu 2020 eq 38–39 as
         printed with ρ(φ0) for every pin, one secant stiffness per disc (the paper's scheme).
-        ``"linear"``: constant ``stiffness``.
+        ``"palmgren"``: Palmgren's steel line-contact law ``δ = 3.84e-5 F^0.9 / b^0.8`` (Han
+        2023's), secant stiffness per contact. ``"linear"``: constant ``stiffness``.
     stage : CycloidStage
         The reducer's cycloid stage (K1, ρ(φ), pin radius r_rp + Δr_rp).
     youngs_modulus, poisson_ratio, face_width : float
@@ -243,19 +255,59 @@ class PinContactLaw:
             raise ParameterError("stiffness", self.stiffness, "must be finite [N/mm]")
         check_floor("stiffness", self.stiffness, "linear_stiffness")
 
+    def describe(self) -> str:
+        """The law and the constants it uses, in one line (echoed in results)."""
+        st, E, nu, b = self.stage, self.youngs_modulus, self.poisson_ratio, self.face_width
+        if self.name == "palmgren":
+            return (
+                f"palmgren: δ = {PALMGREN_COEFFICIENT:g} F^{PALMGREN_FORCE_EXPONENT:g} / "
+                f"l^{PALMGREN_LENGTH_EXPONENT:g} (δ mm, F N), l = b = {b:g} mm, secant "
+                "stiffness per contact (Palmgren 1959; Harris & Kotzalas 2007 ch. 7)"
+            )
+        if self.name == "hu2020":
+            return (
+                f"hu2020: Hu 2020 eq 38-39 as printed (constant {HU2020_HALF_WIDTH_FACTOR:g}), "
+                f"ρ(φ0) = {st.rho0:.4g} mm for every pin, r = {st.r:g} mm, E = {E:g} MPa, "
+                f"ν = {nu:g}, b = {b:g} mm, one secant stiffness per disc"
+            )
+        if self.name == "line_contact":
+            return (
+                "line_contact: Johnson 1985 §5.6 two-cylinder approach with each contact's "
+                f"flank curvature, |ρ| capped at {st.curvature_cap:.4g} mm, r = {st.r:g} mm, "
+                f"E = {E:g} MPa, ν = {nu:g}, b = {b:g} mm, secant stiffness per contact; "
+                f"refused on a concave flank where the Hertz half-width exceeds "
+                f"{CONFORMAL_HALF_WIDTH_LIMIT:g} r"
+            )
+        return f"linear: constant {self.stiffness:g} N/mm"
+
     def flank_curvature(self, phase: ArrayLike) -> np.ndarray:
-        """Signed flank curvature radius [mm] where each pin touches, at meshing phase ``phase``."""
-        return self.stage.curvature_radius(phase)
+        """Signed flank curvature radius [mm] where each pin touches, at meshing phase ``phase``
+        (at the true contact point of the modified profile:
+        :meth:`gearte.geometry.cycloid.CycloidStage.contact_curvature_radius`)."""
+        return self.stage.contact_curvature_radius(phase)
 
     def coefficients(self, phase: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """(a0, a1) of ``δ = F (a0 − a1 ln F)`` per contact at meshing phase ``phase`` [mm/N]."""
+        """(a0, a1) of ``δ = F (a0 − a1 ln F)`` per contact at meshing phase ``phase`` [mm/N]
+        (the logarithmic laws; :meth:`law_coefficients` for every law)."""
+        a0, a1, a2, _ = self.law_coefficients(phase)
+        if np.any(a2 != 0.0):
+            raise ParameterError(
+                "contact_law", self.name, "is a power law: use law_coefficients (a0, a1, a2, a3)"
+            )
+        return a0, a1
+
+    def law_coefficients(
+        self, phase: ArrayLike
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(a0, a1, a2, a3) of ``δ = F (a0 − a1 ln F) + a2 F^a3`` per contact at meshing phase
+        ``phase`` (:func:`gearte.models.contact_law.law_coefficients`)."""
         phase = np.asarray(phase, dtype=float)
         rho = (
             np.full(phase.shape, self.stage.rho0)
             if self.name == "hu2020"
             else self.flank_curvature(phase)
         )
-        return log_law_coefficients(
+        return law_coefficients(
             self.name,
             rho,
             self.stage.r,
@@ -269,15 +321,17 @@ class PinContactLaw:
         """The solver's :class:`~gearte.solvers.rv_equilibrium.ContactLaw` for ``system``."""
         if self.name == "linear":
             return ContactLaw(kind="linear", stiffness=self.stiffness, name="linear")
-        a0, a1 = self.coefficients(contact_phase(system))
+        a0, a1, a2, a3 = self.law_coefficients(contact_phase(system))
         kind = "secant_per_disc" if self.name == "hu2020" else "secant_per_contact"
-        return ContactLaw(kind=kind, stiffness=self.stiffness, a0=a0, a1=a1, name=self.name)
+        return ContactLaw(kind=kind, stiffness=self.stiffness, a0=a0, a1=a1, a2=a2, a3=a3,
+                          name=self.name)  # fmt: skip
 
 
 def contact_law(
     reducer: RVReducer, law: str | None = None, stiffness: float = 2.0e5
 ) -> PinContactLaw:
-    """Pin-contact law of the reducer by name (``"line_contact"``, ``"hu2020"`` or ``"linear"``).
+    """Pin-contact law of the reducer by name (``"line_contact"``, ``"hu2020"``, ``"palmgren"``
+    or ``"linear"``).
 
     ``None`` takes the reducer's own law (``reducer.discs.contact_law``, default the textbook
     ``"line_contact"``).
@@ -289,7 +343,7 @@ def contact_law(
     ----------
     reducer : RVReducer
         The reducer description (:class:`gearte.geometry.rv.RVReducer`).
-    law : {"line_contact", "hu2020", "linear"}, optional
+    law : {"line_contact", "hu2020", "palmgren", "linear"}, optional
         The law's name; ``None``: the reducer's own.
     stiffness : float
         Constant pin-contact stiffness of ``"linear"`` [N/mm] (finite, at least the floor of a
@@ -676,6 +730,8 @@ class LoadSharing:
     contact_pressure : (P, N, z_p) Hertz pressure of every pin with its own flank curvature [MPa].
     contact_law : str
         Name of the pin-contact law used.
+    pin_phase : (P, N, z_p) meshing phase of every pin [rad]: its angle from the line of
+        centres (the disc's eccentric direction), as :func:`contact_phase`.
     """
 
     theta: np.ndarray
@@ -691,6 +747,7 @@ class LoadSharing:
     q: np.ndarray
     contact_pressure: np.ndarray
     contact_law: str
+    pin_phase: np.ndarray | None = None
 
     @property
     def peak_pin_load(self) -> float:
@@ -731,7 +788,7 @@ def _postprocess(
     disc_torque = -np.sum(pin * arm, axis=-1)
     stage = cycloid_stage(reducer)
     d = reducer.discs
-    rho = stage.curvature_radius(contact_phase(system)).reshape(P, N, zp)
+    rho = stage.contact_curvature_radius(contact_phase(system)).reshape(P, N, zp)
     pressure = max_contact_pressure(
         pin, rho, stage.r, d.youngs_modulus, d.poisson_ratio, d.face_width
     )
@@ -749,6 +806,7 @@ def _postprocess(
         q=sol.q,
         contact_pressure=pressure,
         contact_law=law_name,
+        pin_phase=contact_phase(system).reshape(P, N, zp),
     )
 
 
@@ -807,7 +865,161 @@ def load_sharing(
     slaw, sol = _equilibrium(
         reducer, system, torque, law, solve_positions, compiled=compiled, q0=q0, k0=k0
     )
-    return _postprocess(reducer, system, sol, torque, slaw.name)
+    out = _postprocess(reducer, system, sol, torque, slaw.name)
+    if slaw.name == "line_contact":
+        check_conformal(reducer, out)
+    return out
+
+
+#: Largest Hertz half-width on a concave flank, relative to the pin radius, for which Johnson's
+#: convex line-contact approach (``"line_contact"``) is applied: Hertz's theory needs the contact
+#: strip small against the bodies (Johnson 1985 §4.1); on a concave flank of radius close to the
+#: pin's (near the tooth root) R* = r ρ/(ρ − r) grows without bound, the strip widens and the
+#: law's ln(4ρ/a) term of the disc (a convex cylinder of radius ρ) no longer describes the body.
+CONFORMAL_HALF_WIDTH_LIMIT = 0.1
+
+
+def check_conformal(reducer: RVReducer, load: LoadSharing) -> None:
+    """Refuse ``"line_contact"`` results that contain a near-conformal concave contact.
+
+    Every loaded pin on a concave flank (ρ > 0, the root side) must have a Hertz half-width
+    ``a ≤ CONFORMAL_HALF_WIDTH_LIMIT · r`` (:data:`CONFORMAL_HALF_WIDTH_LIMIT`, r the pin radius,
+    a from :func:`gearte.models.contact_law.hertz_half_width` with the pin's force and flank
+    curvature). Beyond it Johnson's convex formula (§5.6) is outside its domain.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description.
+    load : LoadSharing
+        A solved load sharing (its pin forces and phases).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``contact_law`` and, in the reason, the worst pin: disc, pin, output angle, its
+        flank radius, the pin radius and the half-width; with the laws to select instead.
+
+    References
+    ----------
+    Johnson K.L. (1985). Contact Mechanics, §4.1 (Hertz's assumptions), §5.6.
+    doi:10.1017/CBO9781139171731
+    """
+    if load.pin_phase is None:
+        return
+    stage = cycloid_stage(reducer)
+    d = reducer.discs
+    rho = stage.contact_curvature_radius(load.pin_phase)
+    concave = (rho > 0.0) & (load.pin_force > 0.0)
+    if not np.any(concave):
+        return
+    a = hertz_half_width(
+        np.where(concave, load.pin_force, 0.0),
+        np.where(concave, rho, -1.0),
+        stage.r,
+        d.youngs_modulus,
+        d.poisson_ratio,
+        d.face_width,
+    )
+    ratio = np.where(concave, a / stage.r, 0.0)
+    if ratio.max() <= CONFORMAL_HALF_WIDTH_LIMIT:
+        return
+    p, j, k = np.unravel_index(np.argmax(ratio), ratio.shape)
+    raise ParameterError(
+        "contact_law",
+        "line_contact",
+        f"disc {j + 1}, pin {k + 1} at output angle {rad_to_deg(float(load.theta[p])):.1f}° "
+        f"touches a concave flank of radius {rho[p, j, k]:.3f} mm with pin radius "
+        f"{stage.r:.3f} mm under {load.pin_force[p, j, k]:.0f} N: Hertz half-width "
+        f"{a[p, j, k]:.3f} mm > {CONFORMAL_HALF_WIDTH_LIMIT:g} r, a near-conformal contact "
+        "outside Johnson's convex line-contact formula; select contact_law 'palmgren' "
+        "(independent of the curvatures) or 'hu2020' (docs/contact-law.md)",
+    )
+
+
+#: Below this share of its force turning the disc (sin of the angle between the pin force and
+#: the radial direction through the pin), the most loaded pin is squeezed radially at the tooth
+#: root rather than driving the disc.
+ROOT_SQUEEZE_SIN = 0.5
+
+
+@dataclass(frozen=True)
+class PeakPin:
+    """The most loaded pin of a load sharing and the direction of its force.
+
+    Attributes
+    ----------
+    position : int
+        Index of the output position [-].
+    output_angle : float
+        Output angle there [rad].
+    disc, pin : int
+        Disc and pin numbers, from 1 [-].
+    force : float
+        Its force [N].
+    phase : float
+        Its angle from the line of centres (the disc's eccentric direction), in (−π, π] [rad].
+    force_angle_from_radial : float
+        Angle between its force (the contact normal, through the pitch point) and the radial
+        direction through the pin [rad]; ``sin`` of it is ``K1 |sin φ| / S``.
+    """
+
+    position: int
+    output_angle: float
+    disc: int
+    pin: int
+    force: float
+    phase: float
+    force_angle_from_radial: float
+
+    @property
+    def root_squeeze(self) -> bool:
+        """Whether the force is mostly a radial squeeze at the tooth root
+        (``sin(force_angle_from_radial) < ROOT_SQUEEZE_SIN``)."""
+        return math.sin(self.force_angle_from_radial) < ROOT_SQUEEZE_SIN
+
+    def describe(self) -> str:
+        """One line naming the pin and its angles (for warnings)."""
+        return (
+            f"disc {self.disc}, pin {self.pin} at output angle "
+            f"{rad_to_deg(self.output_angle):.1f}°: {self.force:.0f} N, "
+            f"{abs(rad_to_deg(self.phase)):.1f}° from the line of centres, force "
+            f"{rad_to_deg(self.force_angle_from_radial):.1f}° from radial"
+        )
+
+
+def peak_pin(reducer: RVReducer, load: LoadSharing) -> PeakPin:
+    """The most loaded pin of ``load`` (:class:`PeakPin`).
+
+    The contact normal of pin ``k`` passes through the pitch point ``K1 r_p`` on the line of
+    centres (Hu 2020 eq 36), so its angle α from the radial direction through the pin has
+    ``sin α = K1 |sin φ| / S``, ``S = (1 + K1² − 2 K1 cos φ)^½``: 0 on the line of centres (a
+    pure radial squeeze), 1 where ``cos φ = K1`` (the largest arm).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description.
+    load : LoadSharing
+        A solved load sharing with its ``pin_phase``.
+
+    Returns
+    -------
+    PeakPin
+
+    References
+    ----------
+    Hu Y. et al. (2020). Applied Sciences 10(2), 481, eq 36. doi:10.3390/app10020481
+    """
+    if load.pin_phase is None:
+        raise ParameterError("load.pin_phase", None, "needed: a load sharing from load_sharing()")
+    p, j, k = np.unravel_index(np.argmax(load.pin_force), load.pin_force.shape)
+    phi = float(np.angle(np.exp(1j * load.pin_phase[p, j, k])))
+    K1 = cycloid_stage(reducer).K1
+    S = math.sqrt(1.0 + K1 * K1 - 2.0 * K1 * math.cos(phi))
+    alpha = math.asin(min(1.0, K1 * abs(math.sin(phi)) / S))
+    return PeakPin(int(p), float(load.theta[p]), int(j) + 1, int(k) + 1,
+                   float(load.pin_force[p, j, k]), phi, alpha)  # fmt: skip
 
 
 def _equilibrium(reducer, system, torque, law, solve, **kwargs):

@@ -311,13 +311,11 @@ def linear_te_model(design: RVReducer, torque: float, theta: np.ndarray) -> Line
     k, c = system.spring_k, system.spring_c if system.spring_c is not None else 0 * system.spring_k
     w = np.einsum("psi,pi->ps", system.spring_B, sol.q) + system.spring_e
     F = sol.contact_force
-    # tangent of the pin law δ = F (a0 − a1 ln F): dF/dδ = 1 / (a0 − a1 (ln F + 1))
+    # tangent of the pin law δ(F): dF/dδ = 1/δ'(F) (the solver law's own)
     kc = np.zeros_like(F)
     act = F > 0
     if law.kind == "secant_per_contact":
-        a0 = np.broadcast_to(np.asarray(law.a0, dtype=float), F.shape)
-        a1 = np.broadcast_to(np.asarray(law.a1, dtype=float), F.shape)
-        kc[act] = 1.0 / (a0[act] - a1[act] * (np.log(F[act]) + 1.0))
+        kc[act] = law.tangent_stiffness(np.where(act, F, 1.0))[act]
     else:
         assert sol.pin_stiffness is not None  # noqa: S101 - the solver fills it in
         kc[act] = sol.pin_stiffness[act]

@@ -600,6 +600,7 @@ def solve_rotation(
     force_rtol: float = 1e-12,
     max_iter: int = 200,
     implementation: str = "numba",
+    power: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Disc rotation and pin forces that carry ``torque`` (compatibility + equilibrium).
 
@@ -633,6 +634,11 @@ def solve_rotation(
         Newton/bisection steps allowed per position.
     implementation : {"numba", "plain"}
         The compiled kernel or its plain twin (the readable reference it is tested against).
+    power : (ndarray, ndarray), optional
+        ``(a2, a3)`` [mm/N^a3, -]: the pins follow the power law ``δ = a2 F^a3`` instead
+        (Palmgren's line
+        contact, ``gearte.models.contact_law.law_coefficients``; ``a0``, ``a1`` must then be 0),
+        inverted in closed form, ``F = (δ/a2)^(1/a3)``; solved by the plain implementation.
 
     Returns
     -------
@@ -656,7 +662,16 @@ def solve_rotation(
     if implementation not in ("numba", "plain"):
         raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
     arm, clearance, a0, a1 = _rotation_inputs(arm, clearance, a0, a1, torque)
-    if implementation == "plain":
+    if power is not None:
+        if np.any(a0 != 0.0) or np.any(a1 != 0.0):
+            raise ParameterError("a0/a1", (a0, a1), "must be 0 with a power law (power=)")
+        a2, a3 = (np.broadcast_to(np.asarray(x, dtype=float), arm.shape) for x in power)
+        if not (np.all(a2 > 0.0) and np.all((a3 > 0.0) & (a3 <= 1.0))):
+            raise ParameterError("power", power, "needs a2 > 0 and 0 < a3 <= 1")
+        rot, force = _solve_rotation_plain(
+            arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter, (a2, a3)
+        )
+    elif implementation == "plain":
         rot, force = _solve_rotation_plain(
             arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter
         )
@@ -731,16 +746,28 @@ def solve_rotation_plain(
     return solve_rotation(arm, clearance, a0, a1, torque, implementation="plain", **kw)
 
 
-def _solve_rotation_plain(arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter):
-    """All positions at once in numpy: bracket by doubling, then safeguarded Newton."""
+def _solve_rotation_plain(arm, clearance, a0, a1, torque, rtol, rot_start, force_rtol, max_iter,
+                          power=None):  # fmt: skip
+    """All positions at once in numpy: bracket by doubling, then safeguarded Newton
+    (``power``: ``(a2, a3)`` of the power law ``δ = a2 F^a3`` instead of the log law)."""
     n = arm.shape[0]
     loaded = arm > 0.0
     la = np.where(loaded, arm, 0.0)
 
     def torque_at(rot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         delta = np.where(loaded, rot[:, None] * la - clearance, 0.0)
-        f = _log_law_force_plain(delta, a0, a1, force_rtol)
+        if power is None:
+            f = _log_law_force_plain(delta, a0, a1, force_rtol)
+        else:
+            f = (np.maximum(delta, 0.0) / power[0]) ** (1.0 / power[1])
         return np.sum(f * la, axis=1), f
+
+    def tangent(f: np.ndarray) -> np.ndarray:
+        pos = f > 0.0
+        fp = np.where(pos, f, 1.0)
+        if power is None:
+            return np.where(pos, 1.0 / (a0 - a1 * np.log(fp) - a1), 0.0)
+        return np.where(pos, fp ** (1.0 - power[1]) / (power[1] * power[0]), 0.0)
 
     lo = np.zeros(n)
     hi = np.full(n, 1e-6) if rot_start is None else np.broadcast_to(rot_start, (n,)).copy()
@@ -760,7 +787,7 @@ def _solve_rotation_plain(arm, clearance, a0, a1, torque, rtol, rot_start, force
         hi = np.where(above, rot, hi)
         lo = np.where(above, lo, rot)
         with np.errstate(divide="ignore", invalid="ignore"):
-            kt = np.where(f > 0.0, 1.0 / (a0 - a1 * np.log(np.where(f > 0.0, f, 1.0)) - a1), 0.0)
+            kt = tangent(f)
         slope = np.sum(kt * la * la, axis=1)
         step = np.where(slope > 0.0, (t_mid - torque) / np.where(slope > 0.0, slope, 1.0), 0.0)
         new = rot - step

@@ -44,6 +44,7 @@ from gearte.solvers.rv_equilibrium import (
     NEWTON_MAXIT,
     _bearing_terms,
     _secant_update,
+    law_terms,
 )
 
 __all__ = [
@@ -114,8 +115,9 @@ class BatchProblem:
     bearings : SparseRows of the clearance-bearing rows, x and y interleaved (G, 2 nm, ·).
     bearing_k, bearing_c : (nm,) stiffness [N/mm] and radial clearance [mm] of those bearings.
     group : (nc,) disc of each contact; law : solver law code
-        (:data:`~gearte.solvers.rv_equilibrium.LAW_LINEAR` …); coef : (G, nc, 2) law
-        coefficients (a0, a1) [mm/N]; start_stiffness : start (or constant) stiffness [N/mm].
+        (:data:`~gearte.solvers.rv_equilibrium.LAW_LINEAR` …); coef : (G, nc, 4) law
+        coefficients (a0, a1, a2, a3) of ``δ = F (a0 − a1 ln F) + a2 F^a3``;
+        start_stiffness : start (or constant) stiffness [N/mm].
     output : index of the output rotation in ``q``.
     """
 
@@ -222,37 +224,56 @@ def _rows_times(idx, val, x, out):
 
 def law_limit(a0: np.ndarray, a1: np.ndarray) -> np.ndarray:
     """``F* = exp((a0 − a1)/a1)`` [N], where the log law's ``δ'(F)`` vanishes (its range ends);
-    capped at ``exp(700)``."""
-    return np.exp(np.minimum((a0 - a1) / a1, 700.0))
+    capped at ``exp(700)``; ``inf`` where ``a1 = 0`` (a power law: no end)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(a1 > 0.0, np.exp(np.minimum((a0 - a1) / np.where(a1 > 0.0, a1, 1.0),
+                                                    700.0)), np.inf)  # fmt: skip
+
+
+def law_columns(coef: np.ndarray) -> np.ndarray:
+    """The kernel's per-contact law columns: ``coef`` (…, 4) and the end of its range,
+    ``F*`` (:func:`law_limit`) and ``δ* = δ(F*)`` (``a1 F*`` for the log law, ``inf`` for a
+    power law) — (…, 6)."""
+    a0, a1 = coef[..., :1], coef[..., 1:2]
+    if np.all(a1 > 0.0):  # every contact on the log law (the usual case: two passes less)
+        fstar = np.exp(np.minimum((a0 - a1) / a1, 700.0))
+        dstar = a1 * fstar
+    else:
+        fstar = law_limit(a0, a1)
+        dstar = np.where(a1 > 0.0, a1 * np.where(a1 > 0.0, fstar, 0.0), np.inf)
+    return np.ascontiguousarray(np.concatenate([coef, fstar, dstar], axis=-1))
 
 
 @njit(cache=True, nogil=True)
-def _law_force(d, a0, a1, fstar, f_prev, d_prev):
-    """Force ``F`` with ``δ(F) = F (a0 − a1 ln F) = d`` for an approach ``d > 0`` [N].
+def _law_force(d, a0, a1, a2, a3, fstar, dstar, f_prev, d_prev):
+    """Force ``F`` with ``δ(F) = F (a0 − a1 ln F) + a2 F^a3 = d`` for an approach ``d > 0`` [N].
 
-    δ is increasing and concave up to ``F* = exp((a0 − a1)/a1)`` (where δ' = 0; δ(F*) = a1 F*).
-    Start: the tangent predictor from a known point ``(d_prev, f_prev)`` of the law (where
-    ``f_prev > 0``; ``1/δ'(F) = 1/(d/F − a1)`` needs no logarithm), else a one-term estimate;
-    then Newton until a relative step below 1e-8 (the error is then ~1e-17: quadratic
-    convergence). ``fstar``: F* (:func:`law_limit`). Returns -1 when ``d ≥ a1 F*`` (beyond the
-    law's range).
+    ``a0 … dstar``: the contact's law columns (:func:`law_columns`). δ is
+    increasing and concave up to ``F*`` (where δ' = 0; the log law's ``exp((a0 − a1)/a1)``, no
+    end for a power law). Start: the tangent predictor from a known point ``(d_prev, f_prev)``
+    of the law (where ``f_prev > 0``), else a one-term estimate; then Newton until a relative
+    step below 1e-8 (the error is then ~1e-17: quadratic convergence). Returns -1 when
+    ``d ≥ δ*`` (beyond the law's range).
     """
-    if d >= a1 * fstar:
+    if d >= dstar:
         return -1.0
     F = -1.0
     if f_prev > 0.0 and d_prev > 0.0:
-        slope = d_prev / f_prev - a1
+        if a2 == 0.0:
+            slope = d_prev / f_prev - a1  # δ'(F) of the log law without a logarithm
+        else:
+            slope = law_terms(np.log(f_prev), a0, a1, a2, a3)[1]
         if slope > 0.0:
             F = f_prev + (d - d_prev) / slope
     if not (F > 0.0 and F < fstar):
-        F = _law_force_start(d, a0, a1, fstar)
+        F = _law_force_start(d, a0, a1, a2, a3, fstar)
     for _ in range(100):
         lf = np.log(F)
-        gp = a0 - a1 * lf - a1
+        rest, gp = law_terms(lf, a0, a1, a2, a3)
         if not gp > 0.0:
             F = 0.5 * F
             continue
-        Fn = F - (F * (a0 - a1 * lf) - d) / gp
+        Fn = F - (F * rest - d) / gp
         if not Fn > 0.0:
             Fn = 0.1 * F
         # quadratic convergence: after a relative step below 1e-8 the error is ~1e-17
@@ -263,10 +284,15 @@ def _law_force(d, a0, a1, fstar, f_prev, d_prev):
 
 
 @njit(cache=True, nogil=True)
-def _law_force_start(d, coef0, coef1, fstar):
-    """One-term estimate of the force at approach ``d > 0`` (``F ≈ d / (a0 − a1 ln(d/a))``)."""
-    den = coef0 - coef1 * np.log(max(d / max(coef0, coef1), 1e-300))
-    return d / den if den > 0.0 else 0.5 * fstar
+def _law_force_start(d, a0, a1, a2, a3, fstar):
+    """One-term estimate of the force at approach ``d > 0``: ``F ≈ d / (a0 − a1 ln(d/a))`` for
+    the log law; for a power law the force of its power part, ``(d/a2)^(1/a3)``, combined with
+    the linear part ``d/a0`` as compliances in series."""
+    if a2 == 0.0:
+        den = a0 - a1 * np.log(max(d / max(a0, a1), 1e-300))
+        return d / den if den > 0.0 else 0.5 * fstar
+    fp = (d / a2) ** (1.0 / a3)
+    return fp if a0 <= 0.0 else 1.0 / (1.0 / fp + a0 / d)
 
 
 @njit(cache=True, nogil=True)
@@ -275,8 +301,9 @@ def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, 
     """Π at ``q``; fills the approaches ``d``, contact forces ``F`` and tangent stiffnesses
     ``kt`` of every contact (0 where open).
 
-    ``exact``: the log law (forces from the known pairs ``Fp``, ``dp``;
-    ``φ(d) = ∫F dd = F d/2 − a1 F²/4``, tangent ``1/δ'(F)``; +inf beyond the law's range),
+    ``exact``: the exact law (forces from the known pairs ``Fp``, ``dp``;
+    ``φ(d) = ∫F dd = F d/2 − a1 F²/4 + a2 F^(a3+1) (a3 − 1)/(2 (a3 + 1))``, tangent
+    ``1/δ'(F)``; +inf beyond the law's range),
     else the fixed stiffnesses ``kc`` (``φ = kc d²/2``). ``exact_law``: ``None`` where the
     batch solves no exact per-contact law (``exact`` is then always False: numba prunes that
     branch, and :func:`_law_force` is not compiled for the per-disc and linear laws); any
@@ -298,12 +325,19 @@ def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, 
             if exact_law is not None:
                 if exact:
                     fixed = False
-                    f = _law_force(dc, coef[c, 0], coef[c, 1], coef[c, 2], Fp[c], dp[c])
+                    a1, a2, a3 = coef[c, 1], coef[c, 2], coef[c, 3]
+                    f = _law_force(dc, coef[c, 0], a1, a2, a3, coef[c, 4], coef[c, 5], Fp[c],
+                                   dp[c])  # fmt: skip
                     if f < 0.0:
                         return np.inf
                     F[c] = f
-                    kt[c] = 1.0 / (dc / f - coef[c, 1])  # 1/δ'(F), δ' = a0 − a1 ln F − a1
-                    e += 0.5 * f * dc - 0.25 * coef[c, 1] * f * f
+                    if a2 == 0.0:
+                        kt[c] = 1.0 / (dc / f - a1)  # 1/δ'(F), δ' = a0 − a1 ln F − a1
+                        e += 0.5 * f * dc - 0.25 * a1 * f * f
+                    else:
+                        kt[c] = 1.0 / law_terms(np.log(f), coef[c, 0], a1, a2, a3)[1]
+                        e += (0.5 * f * dc - 0.25 * a1 * f * f
+                              + a2 * f ** (a3 + 1.0) * (a3 - 1.0) / (2.0 * (a3 + 1.0)))  # fmt: skip
             if fixed:
                 F[c] = kc[c] * dc
                 kt[c] = kc[c]
@@ -507,7 +541,9 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     ``F̃_c = F_c + (d_c − δ(F_c))/δ'(F_c)``. ``ln F_c`` is computed at the first iteration and
     where a contact closes, then carried along the force updates (:func:`_log_update`: a
     series where the force changed by less than 2⁻¹⁰ relative). The approaches follow the
-    steps (``d ← d − B Δq``) and are recomputed from ``q`` at the end.
+    steps (``d ← d − B Δq``) once the steps are small (below 1e-3), are recomputed from ``q``
+    after larger ones (the rounding of a huge first step from a cold start would stay in
+    them: 1e-3 relative errors of Palmgren's law) and at the end.
     A contact opens where its updated force is not positive; an open one closes where its
     approach is positive (start force :func:`_law_force_start`). Converged when the step in
     ``q`` is below 1e-9 and every force moved by less than 1e-7 of the largest, with no contact
@@ -521,9 +557,13 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     nc = gc.size
     H, L, grad, dq = wm[0], wm[1], wv[0], wv[1]
     Ft, Bdq, lf = wc[0], wc[1], wc[2]
+    big = np.inf
     for it in range(maxit):
         changed = False
-        if it == 0:
+        if big > 1e-3:
+            # from q itself after a large step (the first, from a cold start, can be huge: an
+            # update by −B dq would keep its rounding, ~1e-16 of the step, in every approach;
+            # below 1e-3 that rounding is under 1e-17 mm)
             _rows_times(cidx, cval, q, d)
             for c in range(nc):
                 d[c] -= gc[c]
@@ -535,7 +575,8 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
             f = F[c]
             if not f > 0.0:
                 if dc > 0.0:
-                    f = _law_force_start(dc, coef[c, 0], coef[c, 1], coef[c, 2])
+                    f = _law_force_start(dc, coef[c, 0], coef[c, 1], coef[c, 2], coef[c, 3],
+                                         coef[c, 4])  # fmt: skip
                     changed = True
                     lf[c] = np.log(f)
                 else:
@@ -545,9 +586,8 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
                     continue
             elif it == 0:
                 lf[c] = np.log(f)
-            a1 = coef[c, 1]
-            rest = coef[c, 0] - a1 * lf[c]  # δ/F = a0 − a1 ln F
-            slope = rest - a1  # δ'(F)
+            # δ/F and δ'(F)
+            rest, slope = law_terms(lf[c], coef[c, 0], coef[c, 1], coef[c, 2], coef[c, 3])
             if not slope > 0.0:
                 return it, False  # beyond the law's range
             k = 1.0 / slope
@@ -936,11 +976,10 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
     that start a sweep."""
     p = problem
     cd = _condensed(p)
-    coef3 = np.ascontiguousarray(
-        np.concatenate([p.coef, law_limit(p.coef[..., :1], p.coef[..., 1:2])], axis=-1)
-        if p.law != LAW_LINEAR
-        else np.zeros(p.coef.shape[:-1] + (3,))
-    )
+    coef3 = p.__dict__.get("_law_columns")  # computed once per problem, as its condensation
+    if coef3 is None:
+        coef3 = law_columns(p.coef) if p.law != LAW_LINEAR else np.zeros(p.coef.shape[:-1] + (6,))
+        object.__setattr__(p, "_law_columns", coef3)
     h = np.asarray(h, dtype=float)
     # condensed loads (S, G, m), one small product per sample and geometry: a sample's value
     # does not depend on its place in the batch (a BLAS product over the samples rounds rows
@@ -1140,8 +1179,7 @@ def solve_system(
         sweep = steps // L
         seg = sweep * L
         loaded = F > 0.0
-        a0, a1 = problem.coef[..., 0], problem.coef[..., 1]
-        sec = np.where(loaded, 1.0 / (a0 - a1 * np.log(np.where(loaded, F, 1.0))), 0.0)
+        sec = np.where(loaded, law.secant_stiffness(np.where(loaded, F, 1.0)), 0.0)
         last = np.maximum.accumulate(np.where(loaded, steps[:, None], seg[:, None] - 1), axis=0)
         KC = np.where(last >= seg[:, None], sec[np.maximum(last, 0), np.arange(F.shape[1])],
                       kg0[:, group][sweep])  # fmt: skip
@@ -1157,7 +1195,7 @@ _KERNELS = ("_solve_batch", "_newton", "_newton_mixed", "_energy", "_assemble",
             "_assemble_rows3", "_add_block3", "_rows_times",
             "_spd_solve", "_copy", "_rows_dot", "_law_force", "_law_force_start",
             "_log_update",
-            "_bearing_terms", "_secant_update")  # fmt: skip
+            "_bearing_terms", "_secant_update", "law_terms")  # fmt: skip
 
 
 def _twin(kernel):

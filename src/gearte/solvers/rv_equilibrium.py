@@ -9,11 +9,13 @@ unilateral pin contacts. For a fixed contact stiffness Π is convex and piecewis
 is minimised by an active-set (semismooth) Newton method with a backtracking line search on Π,
 which terminates when the active set repeats — the solution is then exact to round-off.
 
-The contact stiffness is load dependent: a contact law ``δ(F) = F (a0 − a1 ln F)`` whose
-coefficients ``(a0, a1)`` per position and contact are computed by the caller
-(:func:`gearte.models.contact_law.log_law_coefficients`, the one implementation of every pin law;
-this solver only evaluates that form). Two secant schemes: ``"secant_per_disc"`` — one stiffness
-per disc ``k_g = F_max,g / δ(F_max,g)`` (Hu et al. 2020 section 4, with ρ(φ0)) — and
+The contact stiffness is load dependent: a contact law
+``δ(F) = F (a0 − a1 ln F) + a2 F^a3`` whose coefficients ``(a0, a1, a2, a3)`` per position and
+contact are computed by the caller (:func:`gearte.models.contact_law.law_coefficients`, the one
+implementation of every pin law; this solver only evaluates that form: the logarithmic laws have
+``a2 = 0``, Palmgren's power law ``a0 = a1 = 0``, and a linear series compliance adds to
+``a0``). Two secant schemes: ``"secant_per_disc"`` — one stiffness per disc
+``k_g = F_max,g / δ(F_max,g)`` (Hu et al. 2020 section 4, with ρ(φ0)) — and
 ``"secant_per_contact"`` — each contact its own ``k_c = F_c / δ_c(F_c)`` with its own
 coefficients (its own flank curvature). This outer fixed point is a contraction (the secant
 stiffness varies with ``ln F``) and is iterated to a relative change below ``tol``. Positions are
@@ -72,8 +74,12 @@ class ContactLaw:
     stiffness : float
         Constant stiffness for ``"linear"`` [N/mm]; starting value otherwise.
     a0, a1 : array_like
-        Coefficients of ``δ(F) = F (a0 − a1 ln F)`` [mm/N], broadcastable to (positions,
-        contacts); from :func:`gearte.models.contact_law.log_law_coefficients`.
+        Coefficients of the logarithmic part ``F (a0 − a1 ln F)`` of ``δ(F)`` [mm/N],
+        broadcastable to (positions, contacts); from
+        :func:`gearte.models.contact_law.law_coefficients`.
+    a2, a3 : array_like
+        Coefficient [mm/N^a3] and exponent [-] of the power part ``a2 F^a3`` of ``δ(F)``
+        (Palmgren's line contact: ``a3 = 0.9``); ``a2 = 0`` for the logarithmic laws.
     name : str
         Name of the physical law (echoed in results; ``"linear"`` for a constant stiffness).
     """
@@ -83,6 +89,8 @@ class ContactLaw:
     a0: np.ndarray | float = 0.0
     a1: np.ndarray | float = 0.0
     name: str = ""
+    a2: np.ndarray | float = 0.0
+    a3: np.ndarray | float = 1.0
 
     @property
     def code(self) -> int:
@@ -91,15 +99,41 @@ class ContactLaw:
         return _SCHEMES[self.kind]
 
     def coefficients(self, n_positions: int, n_contacts: int) -> np.ndarray:
-        """``(P, nc, 2)`` array of (a0, a1) per position and contact."""
+        """``(P, nc, 4)`` array of (a0, a1, a2, a3) per position and contact.
+
+        Accepted: all finite; either the logarithmic law (``a1 > 0``, ``a2 = 0``) or a power
+        law (``a1 = 0``, ``a2 > 0``, ``0 < a3 ≤ 1``, ``a0 ≥ 0``: a linear series compliance),
+        so that δ(F) increases from 0 (the power law without a limit, the logarithmic one up to
+        ``F* = exp(a0/a1 − 1)``)."""
         shape = (n_positions, n_contacts)
         if self.code == LAW_LINEAR:
-            return np.zeros(shape + (2,))
-        a0 = np.broadcast_to(np.asarray(self.a0, dtype=float), shape)
-        a1 = np.broadcast_to(np.asarray(self.a1, dtype=float), shape)
-        if not (np.all(np.isfinite(a0)) and np.all(a1 > 0.0)):
-            raise ParameterError("contact_law.a0/a1", (self.a0, self.a1), "must be finite, a1 > 0")
-        return np.ascontiguousarray(np.stack([a0, a1], axis=-1))
+            return np.zeros(shape + (N_COEF,))
+        cols = [np.broadcast_to(np.asarray(x, dtype=float), shape)
+                for x in (self.a0, self.a1, self.a2, self.a3)]  # fmt: skip
+        a0, a1, a2, a3 = cols
+        log_law = (a1 > 0.0) & (a2 == 0.0)
+        power_law = (a1 == 0.0) & (a2 > 0.0) & (a3 > 0.0) & (a3 <= 1.0) & (a0 >= 0.0)
+        if not (all(np.all(np.isfinite(x)) for x in cols) and np.all(log_law | power_law)):
+            raise ParameterError(
+                "contact_law.a0/a1/a2/a3",
+                (self.a0, self.a1, self.a2, self.a3),
+                "must be finite: a1 > 0 and a2 = 0 (logarithmic law), or a1 = 0, a2 > 0, "
+                "0 < a3 <= 1 and a0 >= 0 (power law)",
+            )
+        return np.ascontiguousarray(np.stack(cols, axis=-1))
+
+    def secant_stiffness(self, F: np.ndarray) -> np.ndarray:
+        """Secant stiffness ``F/δ(F)`` [N/mm] at forces ``F`` > 0 (broadcast with the
+        coefficients; not for ``"linear"``)."""
+        lf = np.log(F)
+        return 1.0 / (self.a0 - self.a1 * lf + self.a2 * np.exp((self.a3 - 1.0) * lf))
+
+    def tangent_stiffness(self, F: np.ndarray) -> np.ndarray:
+        """Tangent stiffness ``1/δ'(F)`` [N/mm] at forces ``F`` > 0 (as
+        :meth:`secant_stiffness`)."""
+        lf = np.log(F)
+        power = self.a2 * np.exp((self.a3 - 1.0) * lf)
+        return 1.0 / (self.a0 - self.a1 * lf - self.a1 + self.a3 * power)
 
 
 @dataclass(frozen=True)
@@ -123,15 +157,35 @@ class EquilibriumSolution:
     pin_stiffness: np.ndarray | None = None
 
 
+#: Columns of a contact's coefficients: (a0, a1, a2, a3) of δ(F) = F (a0 − a1 ln F) + a2 F^a3.
+N_COEF = 4
+
+
 @njit(cache=True, nogil=True)
-def _law_delta(f, a0, a1):
-    """Approach δ = F (a0 − a1 ln F) [mm] of the log contact law."""
-    return f * (a0 - a1 * np.log(f))
+def law_terms(lf, a0, a1, a2, a3):
+    """``(δ/F, δ'(F))`` of the law ``δ(F) = F (a0 − a1 ln F) + a2 F^a3`` at ``lf = ln F``.
+
+    ``δ/F = a0 − a1 ln F + a2 F^(a3−1)`` [mm/N] and ``δ' = a0 − a1 ln F − a1 + a3 a2 F^(a3−1)``
+    [mm/N]; the power part (one ``exp``) only where ``a2 ≠ 0``. Shared by this module's
+    kernels and the batched solver (:mod:`gearte.solvers.rv_batch`)."""
+    rest = a0 - a1 * lf
+    slope = rest - a1
+    if a2 != 0.0:
+        p = a2 * np.exp((a3 - 1.0) * lf)
+        rest += p
+        slope += a3 * p
+    return rest, slope
+
+
+@njit(cache=True, nogil=True)
+def law_delta(f, a0, a1, a2, a3):
+    """Approach ``δ = F (a0 − a1 ln F) + a2 F^a3`` [mm] of the solver's law form at ``F = f``."""
+    return f * law_terms(np.log(f), a0, a1, a2, a3)[0]
 
 
 @njit(cache=True, nogil=True)
 def _secant_update(law, force, coef, group, ngroups, k, kc):
-    """One step of the secant fixed point of the log law: the new stiffnesses from ``force``.
+    """One step of the secant fixed point of the law: the new stiffnesses from ``force``.
 
     ``LAW_SECANT_PER_DISC``: each disc (``group``) its secant ``F/δ(F)`` at its largest pin
     force (that contact's coefficients), copied to its contacts' ``kc``; otherwise
@@ -151,9 +205,11 @@ def _secant_update(law, force, coef, group, ngroups, k, kc):
                     fmax = force[c]
                     cm = c
             if fmax > 0.0:
-                if coef[cm, 0] - coef[cm, 1] * np.log(fmax) <= coef[cm, 1]:
+                rest, slope = law_terms(np.log(fmax), coef[cm, 0], coef[cm, 1], coef[cm, 2],
+                                        coef[cm, 3])  # fmt: skip
+                if slope <= 0.0:
                     return change, False
-                knew = fmax / _law_delta(fmax, coef[cm, 0], coef[cm, 1])
+                knew = 1.0 / rest
                 change = max(change, abs(knew / k[g] - 1.0))
                 k[g] = knew
         for c in range(nc):
@@ -161,9 +217,11 @@ def _secant_update(law, force, coef, group, ngroups, k, kc):
     else:
         for c in range(nc):
             if force[c] > 0.0:
-                if coef[c, 0] - coef[c, 1] * np.log(force[c]) <= coef[c, 1]:
+                rest, slope = law_terms(np.log(force[c]), coef[c, 0], coef[c, 1], coef[c, 2],
+                                        coef[c, 3])  # fmt: skip
+                if slope <= 0.0:
                     return change, False
-                knew = force[c] / _law_delta(force[c], coef[c, 0], coef[c, 1])
+                knew = 1.0 / rest
                 change = max(change, abs(knew / kc[c] - 1.0))
                 kc[c] = knew
         for g in range(ngroups):
@@ -481,7 +539,7 @@ def solve_positions(
         # lock for the duration of the call; compiled callers do not look these names up)
         g = _solve_all.py_func.__globals__
         _TWIN_LOCK.acquire()
-        saved = {n: g[n] for n in ("_newton", "_energy", "_law_delta", "_secant_update")}
+        saved = {n: g[n] for n in ("_newton", "_energy", "law_terms", "_secant_update")}
         for n in saved:
             g[n] = saved[n].py_func
         try:

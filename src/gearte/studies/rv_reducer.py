@@ -635,13 +635,23 @@ class DynamicsSection(StrictModel):
         return out
 
 
+#: The error of an RV case without ``[reducer] contact_law`` (it had a silent default).
+CONTACT_LAW_REQUIRED = (
+    "contact_law is required: name the pin-contact law, one of 'line_contact', 'hu2020', "
+    "'palmgren' (docs/contact-law.md); contact_law = \"line_contact\" gives the results of a "
+    "case written before the key was required"
+)
+
+
 class ReducerSection(StrictModel):
     rated_torque_Nm: float | None = floored(
         "load_torque", None, le=1e6, description="catalogue rated torque (virtual torsion test)"
     )
-    contact_law: Literal["line_contact", "hu2020"] = Field(
-        default="line_contact",
-        description="pin-contact law (gearte.models.contact_law; docs/contact-law.md)",
+    contact_law: Literal["line_contact", "hu2020", "palmgren"] | None = Field(
+        default=None,
+        description="pin-contact law, required: 'line_contact' (Johnson), 'hu2020' (Hu 2020 eq "
+        "38-39 as printed) or 'palmgren' (Palmgren's steel line contact) "
+        "(gearte.models.contact_law; docs/contact-law.md)",
     )
     allowable_contact_pressure_MPa: float | None = Field(
         default=None, gt=0, le=1e5, description="warn when the Hertz pin pressure exceeds it"
@@ -669,6 +679,8 @@ class ReducerSection(StrictModel):
     @model_validator(mode="after")
     def _build(self):
         problems = []
+        if self.contact_law is None:
+            raise ValueError(CONTACT_LAW_REQUIRED)
         if self.material is not None and self.density_kg_per_m3 is not None:
             problems.append("give material or density_kg_per_m3, not both")
         if self.first_stage.planets != self.cranks.count:
@@ -1056,6 +1068,8 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         c.shaft_length_mm,
     )
     d = sec.discs
+    if sec.contact_law is None:
+        raise ParameterError("reducer.contact_law", None, CONTACT_LAW_REQUIRED)
     discs = Discs(
         d.count,
         d.face_width_mm,
@@ -1189,6 +1203,13 @@ def build_stage_case(case: Case):
     tc = None
     if a.tooth_contact is not None:
         t = a.tooth_contact
+        if r.contact_law not in ("line_contact", "hu2020"):
+            raise ParameterError(
+                "reducer.contact_law",
+                r.contact_law,
+                "analyses.tooth_contact (the cycloid-stage tooth contact) solves 'line_contact' "
+                "and 'hu2020' only; select one of them or drop [analyses.tooth_contact]",
+            )
         tc = cs.ToothContactOptions(
             torque_Nm=t.torque_Nm,
             disc_share=t.disc_share,
@@ -1217,17 +1238,27 @@ def build_stage_case(case: Case):
 # ------------------------------------------------------------------------------------------
 def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
     from gearte.models.cycloid_contact import tooth_contact
-    from gearte.models.rv_load_sharing import cycloid_stage, load_sharing, output_positions
+    from gearte.models.rv_load_sharing import (
+        cycloid_stage,
+        load_sharing,
+        output_positions,
+        peak_pin,
+    )
 
     th = output_positions(sec.positions)
     T = Nm_to_Nmm(sec.torque_Nm)
     ls = load_sharing(red, T, th, law=law)
     has_errors = red0 is not None
     p_peak = np.unravel_index(np.argmax(ls.pin_force), ls.pin_force.shape)
+    pk = peak_pin(red, ls)
     values = {
         "peak_pin_load [N]": ls.peak_pin_load,
         "max_contact_pressure [MPa]": ls.max_contact_pressure,
         "contact_law": ls.contact_law,
+        "contact_law_form": law.describe() if hasattr(law, "describe") else ls.contact_law,
+        "peak_pin": f"disc {pk.disc}, pin {pk.pin}",
+        "peak_pin_angle_from_line_of_centres [deg]": abs(float(rad_to_deg(pk.phase))),
+        "peak_pin_force_angle_from_radial [deg]": float(rad_to_deg(pk.force_angle_from_radial)),
         "pairs_in_mesh_min": int(ls.pairs_in_mesh.min()),
         "pairs_in_mesh_max": int(ls.pairs_in_mesh.max()),
         "pairs_in_mesh_at_peak": int(ls.pairs_in_mesh[p_peak[0], p_peak[1]]),
@@ -1240,6 +1271,12 @@ def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
             float((ls.disc_torque / ls.disc_torque.sum(axis=1, keepdims=True)).max()),
         ],
     }
+    if pk.root_squeeze:
+        values["root_squeeze_warning"] = (
+            f"the peak pin load is a radial squeeze at the tooth root, near the line of centres "
+            f"({pk.describe()}; less than half of its force turns the disc): the load there "
+            "depends on the root geometry and on the pin-contact law more than on the torque path"
+        )
     data = {"load": ls}
     notes = [
         "Pin loads from the quasi-static equilibrium of all parts (springs + unilateral pin "
@@ -1597,6 +1634,10 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
         if r.name in ("load_sharing", "transmission_error", "catalogue", "compensation"):
             if r.values.get("contact_law") != case.reducer.contact_law:
                 r.values["contact_law"] = case.reducer.contact_law
+            r.values.setdefault("contact_law_form", law.describe())
+    for r in out:
+        if r.name == "load_sharing" and r.values.get("root_squeeze_warning"):
+            warnings.append(f"load_sharing: {r.values['root_squeeze_warning']}")
     if not out:
         warnings.append("no analyses requested: add [analyses.load_sharing] etc.")
     allowable = case.reducer.allowable_contact_pressure_MPa

@@ -67,6 +67,7 @@ def loaded_disc_rotation(
     guess: np.ndarray | None = None,
     *,
     rtol: float = 1e-10,
+    power: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Rotation (lag) of each disc about its fixed centre that carries ``torque_per_disc``.
 
@@ -84,6 +85,10 @@ def loaded_disc_rotation(
         of each Newton iteration; by default each row starts from the previous row's answer.
     rtol : float
         Relative tolerance on the elastic rotation [-].
+    power : (numpy.ndarray, numpy.ndarray), optional
+        ``(a2, a3)`` [mm/N^a3, -] per contact, ``(P, N, z_p)``, of a power law
+        ``δ = a2 F^a3`` (Palmgren's;
+        ``a0 = a1 = 0``; :meth:`gearte.models.rv_load_sharing.PinContactLaw.law_coefficients`).
 
     Returns
     -------
@@ -116,6 +121,8 @@ def loaded_disc_rotation(
     first = np.min(ratio, axis=1)
     clear = np.where(lv > 0.0, g - first[:, None] * lv, 0.0)
 
+    flat_power = None if power is None else (power[0].reshape(P * N, zp),
+                                             power[1].reshape(P * N, zp))  # fmt: skip
     try:
         rot, _ = solve_rotation(
             lv,
@@ -125,6 +132,7 @@ def loaded_disc_rotation(
             torque_per_disc,
             rtol=rtol,
             rot_start=None if guess is None else np.asarray(guess, dtype=float).reshape(P * N),
+            power=flat_power,
         )
     except ParameterError as exc:
         raise ParameterError("torque_per_disc", torque_per_disc, exc.reason) from None
@@ -182,6 +190,11 @@ def disc_rotation_error(
     k = int(samples_per_mesh) * zp * zc
     theta = 2.0 * np.pi * np.arange(k) / k
     law = contact_law(reducer)
+
+    def coefficients(phase):  # (a0, a1, power): the power part only for a power law
+        a0, a1, a2, a3 = law.law_coefficients(phase)
+        return a0, a1, ((a2, a3) if np.any(a2 != 0.0) else None)
+
     nominal = reducer.replace(
         pins=PinRing(reducer.pins.count, reducer.pins.pin_radius, reducer.pins.circle_radius),
         errors=ManufacturingErrors.none(reducer.cranks.count, n_discs),
@@ -189,17 +202,17 @@ def disc_rotation_error(
     # without errors the pattern repeats every mesh period: solve one, tile it
     m = int(samples_per_mesh)
     pc0 = pin_contacts(nominal, theta[:m])
-    a0, a1 = law.coefficients(pc0.phase)
-    rot0, ela0 = loaded_disc_rotation(pc0, a0, a1, torque_per_disc)
+    a0, a1, power = coefficients(pc0.phase)
+    rot0, ela0 = loaded_disc_rotation(pc0, a0, a1, torque_per_disc, power=power)
     reps = k // m
     out = np.empty((n_discs, k))
     chunk = 512 * m
     for s in range(0, k, chunk):
         th = theta[s : s + chunk]
         pc = pin_contacts(reducer, th)
-        a0, a1 = law.coefficients(pc.phase)
+        a0, a1, power = coefficients(pc.phase)
         r0 = np.tile(rot0, (reps, 1))[s : s + chunk]
         e0 = np.tile(ela0, (reps, 1))[s : s + chunk]
-        rot, _ = loaded_disc_rotation(pc, a0, a1, torque_per_disc, guess=e0)
+        rot, _ = loaded_disc_rotation(pc, a0, a1, torque_per_disc, guess=e0, power=power)
         out[:, s : s + chunk] = -(rot - r0).T
     return out
