@@ -1,5 +1,5 @@
 """Study kind ``rv_bench``: one RV serial's bench data → catalogue numbers, labelled TE orders,
-calibrated reduced model, likely culprit parts (issue 17).
+calibrated reduced model, likely culprit parts (docs/bench.md).
 
 Case file::
 
@@ -24,7 +24,7 @@ Definitions: docs/bench.md. Results: ``angular_te_peak_to_peak_forward [arcsec]`
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
@@ -198,7 +198,7 @@ def _reducer(ref: ReducerRef):
     from gearte.io.case_file import load_case
     from gearte.studies.rv_reducer import build_reducer
 
-    rcase = load_case(ref.case)
+    rcase: Any = load_case(ref.case)  # an rv_reducer Case (checked at validation)
     return build_reducer(rcase.reducer), rcase
 
 

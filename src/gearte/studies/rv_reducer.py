@@ -1385,7 +1385,7 @@ def load_dynamic_model(name: str):
     """
     from gearte.io.case_file import load_case
 
-    case = load_case(name)
+    case: Any = load_case(name)  # an rv_reducer Case
     red = build_reducer(case.reducer)
     return dyn.build_dynamic_model(case, red)[0], red
 
