@@ -253,6 +253,9 @@ def _numba_timer() -> Iterator[dict[str, float]]:
 
         timer.append(event.TimingListener())
         event.register("numba:compiler_lock", timer[0])
+        from gearte.execution.heartbeat import numba_ready
+
+        numba_ready()  # a status line names the kernels numba compiles from now on
 
     hook = None
     if "numba" in sys.modules:

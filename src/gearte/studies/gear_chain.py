@@ -506,6 +506,11 @@ def _drive_stage(st: StageSpec, drive, confidence: float):
     )
     k = drive.torsional_stiffness()
     values["torsional_stiffness [N*m/arcmin]"] = None if k is None else _nm_per_arcmin(k)
+    pair = getattr(st.drive.validated_case, "pair", None)
+    if pair is not None and pair.min_backlash_limit_um > 0:  # a gear pair with a limit
+        s = summarise_backlash(pair.backlash_stack(), confidence=confidence)
+        values["backlash_min [um]"] = float(mm_to_um(s.min))
+        values["min_backlash_limit [um]"] = pair.min_backlash_limit_um  # the report checks it
     result = AnalysisResult(
         name=f"{_slug(st.name)}_drive",
         title=f"{st.name}: {drive.kind} drive (its own model)",
@@ -890,6 +895,12 @@ def run(case: Case, options) -> StudyResult:
                         "lost_motion_mean_dms": format_dms(mean),
                         "lost_motion_min_dms": format_dms(lo),
                         "lost_motion_max_dms": format_dms(mx),
+                        # the case's limit (0: none), so that the report checks against it
+                        **(
+                            {"min_backlash_limit [um]": st.min_backlash_limit_um}
+                            if st.min_backlash_limit_um > 0
+                            else {}
+                        ),
                     },
                     references=["jiang2024"],
                     notes=[
