@@ -47,6 +47,8 @@ LABELS: dict[str, str] = {
     "sobol_first_order": "Sobol first-order index",
     "sobol_total": "Sobol total index",
     "speeds": "Speeds",
+    "rhs_evaluations": "ODE right-hand-side evaluations",
+    "solver_residual_evaluations": "Solver residual evaluations",
 }
 
 #: Word-by-word readings of abbreviations inside names.

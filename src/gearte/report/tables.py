@@ -263,14 +263,25 @@ def is_run_metadata(name: str) -> bool:
 
 def run_metadata_table(result: Any) -> Table | None:
     """The report's "Run metadata" table: every :data:`RUN_METADATA` value of every analysis
-    (analysis, quantity, value) and the run's total analysis time; ``None`` if there is none."""
+    (analysis, quantity, value) and the run's total analysis time.
+
+    Parameters
+    ----------
+    result : StudyResult
+        The study result whose report it is.
+
+    Returns
+    -------
+    Table or None
+        ``None`` if the result holds no run metadata.
+    """
     rows: list[list[Any]] = []
     for a in result.analyses:
         for k, v in a.values.items():
             if is_run_metadata(k) and _is_scalar(v):
                 rows.append([a.title, label(k), _scalar_text(v, split_unit(k)[1])])
     if getattr(result, "elapsed_s", 0.0):
-        rows.append(["(all)", "Analyses", format_quantity(result.elapsed_s, "s")])
+        rows.append(["(whole run)", "Time of the analyses", format_quantity(result.elapsed_s, "s")])
     if not rows:
         return None
     return Table("run_metadata", "Run metadata", ["analysis", "quantity", "value"], rows, csv=False)
