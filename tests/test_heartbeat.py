@@ -27,14 +27,16 @@ def _wait_for(pred, timeout=5.0):
     return False
 
 
-def test_a_stage_is_named_once_it_lasts():
+def test_a_quiet_stretch_is_named_once_it_lasts():
     out = _Terminal()
     with Heartbeat(stream=out, after=0.2, interval=0.02) as beat:
         beat.stage("running the analyses")
-        assert beat.text(now=beat._since + 0.1) is None  # too short to name
+        assert beat.text(now=beat._quiet + 0.1) is None  # too short a quiet stretch
         assert _wait_for(lambda: "running the analyses" in out.getvalue())
         text = beat.text(now=beat._since + 7.4)
         assert text == "… running the analyses (7 s)"
+        beat.stage("writing the report")  # the line goes on, with the new stage
+        assert beat.text() is not None and beat.text().startswith("… writing the report (")
     assert out.getvalue().endswith("\r\033[K")  # the line is cleared at the end
 
 

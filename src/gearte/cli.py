@@ -236,18 +236,14 @@ def main() -> None:
 
 
 def _wall_since_start() -> float:
-    """Wall time since this process started [s] (Linux: from /proc; elsewhere since the CLI
+    """Wall time since this process started [s] (where the system does not say: since the CLI
     module was imported)."""
     import time
 
-    try:
-        with open("/proc/self/stat", encoding="ascii") as fh:
-            start_ticks = int(fh.read().rsplit(")", 1)[1].split()[19])
-        with open("/proc/uptime", encoding="ascii") as fh:
-            uptime = float(fh.read().split()[0])
-        return max(0.0, uptime - start_ticks / os.sysconf("SC_CLK_TCK"))
-    except (OSError, ValueError, IndexError):
-        return time.perf_counter() - _T_START
+    from gearte.execution.heartbeat import process_age
+
+    age = process_age()
+    return age if age is not None else time.perf_counter() - _T_START
 
 
 def _final_line(result: Any, total_s: float) -> str:
@@ -317,7 +313,8 @@ def run(
         t0 = time.perf_counter()
         from gearte.execution.heartbeat import Heartbeat
 
-        beat = Heartbeat(enabled=not no_progress)
+        # quiet since the process started: interpreter start-up and imports count
+        beat = Heartbeat(enabled=not no_progress, quiet_since=t0 - _wall_since_start())
         try:
             _run_with(beat, t0)
         finally:
@@ -623,7 +620,7 @@ def warm_cache_cmd(kinds: tuple[str, ...], processes: int | None, debug: bool) -
         t0 = time.perf_counter()
         total = len(warm_case_names(list(kinds) or None))
         click.echo(f"==> compiling gearte's numba kernels, one line per case ({n} at a time)")
-        with Heartbeat() as beat:
+        with Heartbeat(quiet_since=time.perf_counter()) as beat:
             done = [0]
 
             def line(kind: str, case: str, wall: float, cpu_s: float) -> None:

@@ -2,13 +2,14 @@
 
 ``gearte run`` and ``gearte warm-cache`` spend seconds on work that has no progress bar of its own:
 importing, compiling numba kernels on their first use, the analyses between two progress bars,
-waiting for the report's figures. :class:`Heartbeat` names the current stage once it has lasted
-:data:`AFTER_S` seconds, with its elapsed time, and what numba is compiling right then (numba's
-``numba:compile`` event fires only when a kernel is not in its cache). On a terminal it is one line
-of stderr rewritten in place and cleared when the stage ends; elsewhere (a log, a pipe) it is off
-unless ``GEARTE_HEARTBEAT=1``, and then prints one plain line when a stage passes :data:`AFTER_S`
-and another every :data:`LOG_EVERY_S`. A chunk progress bar (:class:`ChunkProgress`) hides it
-while the bar shows.
+waiting for the report's figures. Once the command has printed nothing for :data:`AFTER_S`
+seconds, :class:`Heartbeat` names the stage it is in, with the stage's elapsed time and the numba
+kernel being compiled right then (numba's ``numba:compile`` event fires only when a kernel is not
+in its cache). On a terminal it is one line of stderr rewritten in place, kept up to date through
+the stages that follow and cleared before the command's own output; a chunk progress bar
+(:class:`~gearte.execution.progress.ChunkProgress`) hides it while the bar shows. Elsewhere (a
+log, a pipe) it is off unless ``GEARTE_HEARTBEAT=1``, and then prints one plain line per stage
+reached in a quiet stretch, and again every :data:`LOG_EVERY_S` while a stage lasts.
 """
 
 from __future__ import annotations
@@ -19,7 +20,15 @@ import threading
 import time
 from typing import IO, Any
 
-__all__ = ["AFTER_S", "LOG_EVERY_S", "Heartbeat", "hide_status", "numba_ready", "show_status"]
+__all__ = [
+    "AFTER_S",
+    "LOG_EVERY_S",
+    "Heartbeat",
+    "hide_status",
+    "numba_ready",
+    "process_age",
+    "show_status",
+]
 
 #: A stage is named once it has lasted this long [s].
 AFTER_S = 2.0
@@ -48,9 +57,12 @@ def hide_status() -> None:
 
 
 def show_status() -> None:
-    """Let the status line show again (the progress bar is gone)."""
+    """Let the status line show again (the progress bar is gone; it counts as output, so the
+    line waits for the next quiet stretch)."""
     with _LOCK:
         _HIDDEN[0] = max(0, _HIDDEN[0] - 1)
+        for hb in _ACTIVE:
+            hb._quiet = time.perf_counter()
 
 
 class _CompileListener:
@@ -94,6 +106,9 @@ class Heartbeat:
         Seconds a stage lasts before it is named [s].
     interval : float
         How often the line is redrawn [s].
+    quiet_since : float, optional
+        ``time.perf_counter()`` of the command's last output before this (e.g. the process's
+        start, :func:`process_age`); default now.
     """
 
     def __init__(
@@ -103,6 +118,7 @@ class Heartbeat:
         *,
         after: float = AFTER_S,
         interval: float = 0.25,
+        quiet_since: float | None = None,
     ) -> None:
         self.stream = stream if stream is not None else sys.stderr
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
@@ -112,8 +128,13 @@ class Heartbeat:
         self.interval = interval
         self.compile_s = 0.0  # time numba spent compiling (cache misses) while this ran [s]
         self._stage: str | None = None
-        self._since = 0.0
-        self._logged = 0.0  # when the stage was last printed (off a terminal)
+        self._since = 0.0  # when the current stage started
+        # when the command last showed something (its own output, a progress bar, a status
+        # line printed to a log): a status line shows once the command has been quiet for
+        # ``after`` seconds, whichever stages the quiet stretch went through
+        self._quiet = time.perf_counter() if quiet_since is None else quiet_since
+        self._logged: str | None = None  # the stage last printed (off a terminal)
+        self._logged_at = 0.0
         self._shown = False
         self._compiling: list[tuple[str, float]] = []
         self._numba: _CompileListener | None = None
@@ -127,11 +148,13 @@ class Heartbeat:
 
     # -- the command's side ---------------------------------------------------------------------
     def stage(self, text: str | None) -> None:
-        """Start a stage named ``text`` (``None``: none); its clock starts now."""
+        """Start a stage named ``text`` (``None``: none, the line is cleared); its clock starts
+        now. A line already showing goes on showing, with the new stage."""
         with _LOCK:
-            self._clear()
+            if text is None:
+                self._clear()
             self._stage = text
-            self._since = self._logged = time.perf_counter()
+            self._since = time.perf_counter()
         self._listen_to_numba()
 
     def echo(self, text: str, file: IO[str] | None = None) -> None:
@@ -140,6 +163,7 @@ class Heartbeat:
         with _LOCK:
             self._clear()
             print(text, file=file if file is not None else sys.stdout, flush=True)
+            self._quiet = time.perf_counter()
 
     def close(self) -> None:
         """Clear the line and stop."""
@@ -190,7 +214,7 @@ class Heartbeat:
         """The status text now, or ``None`` while nothing needs naming."""
         now = time.perf_counter() if now is None else now
         with _LOCK:
-            if self._stage is None or now - self._since < self.after:
+            if self._stage is None or (not self._shown and now - self._quiet < self.after):
                 return None
             text = f"… {self._stage} ({now - self._since:.0f} s)"
             if self._compiling:
@@ -219,9 +243,9 @@ class Heartbeat:
                     self.stream.write("\r\033[K" + text[:width])
                     self.stream.flush()
                     self._shown = True
-                elif now - self._logged >= LOG_EVERY_S or self._logged == self._since:
+                elif self._logged != self._stage or now - self._logged_at >= LOG_EVERY_S:
                     print(text, file=self.stream, flush=True)
-                    self._logged = now
+                    self._logged, self._logged_at = self._stage, now
             except (OSError, ValueError):  # the stream went away: stop showing
                 self._stop.set()
 
@@ -233,6 +257,19 @@ class Heartbeat:
             except (OSError, ValueError):
                 pass
             self._shown = False
+
+
+def process_age() -> float | None:
+    """Wall time since this process started [s], or ``None`` where the system does not say
+    (read from ``/proc`` on Linux)."""
+    try:
+        with open("/proc/self/stat", encoding="ascii") as fh:
+            start_ticks = int(fh.read().rsplit(")", 1)[1].split()[19])
+        with open("/proc/uptime", encoding="ascii") as fh:
+            uptime = float(fh.read().split()[0])
+        return max(0.0, uptime - start_ticks / os.sysconf("SC_CLK_TCK"))
+    except (OSError, ValueError, IndexError, AttributeError):
+        return None
 
 
 def _columns() -> int:
