@@ -467,6 +467,8 @@ def _pair_drive(st: StageSpec, pair):
 
 def _drive_stage(st: StageSpec, drive, confidence: float):
     """Lost motion of a ``[drive]`` stage from the drive's own model, and its result."""
+    from gearte.labels import value_label
+
     assert st.drive is not None
     values: dict = {
         "drive_kind": drive.kind,
@@ -474,7 +476,10 @@ def _drive_stage(st: StageSpec, drive, confidence: float):
         "ratio": st.ratio,
         "drive_ratio": drive.ratio,
     }
-    notes = [f"{drive.kind} drive; lost motion and stiffness from its own model (gearte.drives)."]
+    notes = [
+        f"{value_label(drive.kind)} drive; lost motion and stiffness from its own model "
+        "(gearte.drives)."
+    ]
     if st.lost_motion_max_arcmin is not None:  # a model without lost motion: the given values
         mx, mean, lo = _given_lost_motion(st)
         notes.append("Its model has no lost motion: the values given in the case are used.")
@@ -513,7 +518,7 @@ def _drive_stage(st: StageSpec, drive, confidence: float):
         values["min_backlash_limit [um]"] = pair.min_backlash_limit_um  # the report checks it
     result = AnalysisResult(
         name=f"{_slug(st.name)}_drive",
-        title=f"{st.name}: {drive.kind} drive (its own model)",
+        title=f"{st.name}: {value_label(drive.kind)} drive (its own model)",
         values=values,
         references=[],
         notes=notes,
