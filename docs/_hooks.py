@@ -140,7 +140,8 @@ def run_case(case_name: str, paper: str, page: str, out: Path) -> dict[str, Any]
     from gearte.studies import run_case as run
 
     t0 = time.perf_counter()
-    result = run(load_case(case_name), RunOptions(samples=GALLERY_SAMPLES))
+    # no progress bars: the cases run side by side, their bars would overwrite each other
+    result = run(load_case(case_name), RunOptions(samples=GALLERY_SAMPLES, progress=False))
     figs = figures_for(result)
     entries = []
     for i, f in enumerate(figs):
@@ -176,6 +177,11 @@ def run_gallery(out: Path) -> dict[str, Any]:
 
     out.mkdir(parents=True, exist_ok=True)
     jobs = int(os.environ.get("GEARTE_DOCS_JOBS", os.cpu_count() or 1))
+    print(
+        f"gallery: running {len(GALLERY)} cases, {max(1, jobs)} at a time (one line each as "
+        "it finishes; cached until src/ or examples/ change)",
+        flush=True,
+    )
     if jobs <= 1:
         manifest = {c: run_case(c, paper, page, out) for c, paper, page in GALLERY}
     else:
