@@ -226,9 +226,9 @@ def headline_table(m: dict[str, Any]) -> list[str]:
     return p
 
 
-#: In a docs page, a line ``<!-- generated: headlines CASE -->`` becomes CASE's headline table from the
-#: gallery run of this build (CASE must be in GALLERY): numbers in the guides are never copied
-#: by hand.
+#: In a docs page, a line ``<!-- generated: headlines CASE -->`` becomes CASE's headline table
+#: from the gallery run of this build (CASE must be in GALLERY): numbers in the guides are never
+#: copied by hand.
 GENERATED = re.compile(r"^<!-- generated: headlines (\w+) -->$", re.M)
 
 
