@@ -101,8 +101,8 @@ def test_final_line_gives_the_whole_wall_time(tmp_path):
     assert r.exit_code == 0, r.output
     line = next(ln for ln in r.output.splitlines() if ln.startswith("jiang2024_spur_pair:"))
     m = re.fullmatch(
-        r"jiang2024_spur_pair: (\d+) analyses in ([\d.]+) s; done in ([\d.]+) s in all "
-        r"\(start-up, outputs(, numba kernels [\d.]+ s)?\)",
+        r"jiang2024_spur_pair: (\d+) analyses in ([\d.]+) s; ([\d.]+) s in all, with "
+        r"start-up and outputs( \(numba kernels [\d.]+ s\))?",
         line,
     )
     assert m, line
