@@ -484,7 +484,8 @@ def sweep(
         paths = write_sweep(result, target, plots=not no_plots, workers=workers)
         click.echo(
             f"{result.name}: {len(result.points)} points × {len(result.columns)} scalar results "
-            f"in {result.elapsed_s:.2f} s ({result.backend})"
+            f"in {result.elapsed_s:.2f} s ({result.backend}); {_wall_since_start():.1f} s in all, "
+            "with start-up and outputs"
         )
         statuses = result.statuses
         for what, label in (("invalid", "did not validate (skipped)"), ("failed", "failed")):
