@@ -286,7 +286,7 @@ def gallery_pages(manifest: dict[str, Any] | None) -> dict[str, str]:
             + (
                 f"Validation: [{m['paper']}](../{m['page']})."
                 if m["page"].startswith("validation/")
-                else f"Guide: [{m['page']}](../{m['page']})."
+                else f"Guide: [{m['page'].removesuffix('.md').replace('-', ' ')}](../{m['page']})."
             ),
             "",
             "## Summary",
