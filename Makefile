@@ -18,7 +18,8 @@ DEMO_CASE ?= hu2020_rv80e_initial
 TEST_WORKERS ?= auto
 PYTEST := $(BIN)/python -m pytest -q -n $(TEST_WORKERS)
 
-.PHONY: demo test test-slow test-latest lint typecheck bench lock clean fuzz fuzz-extremes docs
+.PHONY: demo test test-slow test-latest lint typecheck bench lock clean fuzz fuzz-extremes docs \
+	release-check
 
 $(VENV)/bin/python:
 	@echo "==> creating $(VENV) with $(PYTHON)"
@@ -91,6 +92,25 @@ fuzz-extremes: $(DEV_STAMP)
 		--count -1 --runs -1 --run-cpu-limit $(FUZZ_RUN_CPU) --run-timeout 600 \
 		--record out/fuzz_extremes.jsonl
 
+# The release check (docs/release.md): build the sdist and the wheel, check their metadata, install
+# the wheel alone (no source tree) in a fresh venv from the constraints and run the demo case with
+# it, outside the clone. ~1 min with pip's download cache filled; not part of `make test`.
+RELEASE_VENV := .venv-release
+release-check: $(DEV_STAMP)
+	rm -rf dist $(RELEASE_VENV) out/release-check
+	$(BIN)/python -m build
+	$(BIN)/twine check --strict dist/*
+	$(PYTHON) -m venv $(RELEASE_VENV)
+	$(RELEASE_VENV)/bin/python -m pip install --disable-pip-version-check --no-compile \
+		-c $(CONSTRAINTS) dist/gearte-*.whl
+	mkdir -p out/release-check
+	cd out/release-check && ../../$(RELEASE_VENV)/bin/python -c \
+		"import gearte, importlib.resources as r; \
+		assert r.files('gearte').joinpath('py.typed').is_file(), 'py.typed missing'; \
+		assert 'site-packages' in gearte.__file__, gearte.__file__; print('gearte', gearte.__version__, 'from', gearte.__file__)"
+	cd out/release-check && ../../$(RELEASE_VENV)/bin/gearte run $(DEMO_CASE) --out demo
+	@echo "release check passed: dist/ holds the sdist and the wheel"
+
 test-slow: $(DEV_STAMP)
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(PYTEST) -m slow
 
@@ -121,4 +141,4 @@ bench: $(DEV_STAMP)
 	for b in benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) .venv-latest out .numba_cache_test .numba_cache_latest .pytest_cache site .docs_cache
+	rm -rf $(VENV) .venv-latest $(RELEASE_VENV) dist out .numba_cache_test .numba_cache_latest .pytest_cache site .docs_cache

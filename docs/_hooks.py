@@ -35,6 +35,8 @@ GALLERY: list[tuple[str, str, str]] = [
     ("wang2013_2kh_eq9", "wang2013", "validation/wang2013.md"),
     ("han2023_rv110e", "han2023", "validation/han2023.md"),
     ("li2023_rv_errors", "li2023", "validation/li2023.md"),
+    ("robot_joint_spur_rv", "jiang2024", "drives.md"),
+    ("synthetic_rv110e_lot", "han2023", "selective-assembly.md"),
 ]
 #: Monte-Carlo samples of the gallery runs (the figures' layout, not their statistics, is shown).
 GALLERY_SAMPLES = 200
@@ -138,7 +140,8 @@ def run_case(case_name: str, paper: str, page: str, out: Path) -> dict[str, Any]
     from gearte.studies import run_case as run
 
     t0 = time.perf_counter()
-    result = run(load_case(case_name), RunOptions(samples=GALLERY_SAMPLES))
+    # no progress bars: the cases run side by side, their bars would overwrite each other
+    result = run(load_case(case_name), RunOptions(samples=GALLERY_SAMPLES, progress=False))
     figs = figures_for(result)
     entries = []
     for i, f in enumerate(figs):
@@ -147,8 +150,13 @@ def run_case(case_name: str, paper: str, page: str, out: Path) -> dict[str, Any]
         entries.append(
             {"file": file, "title": f.title, "caption": f.caption, "analysis": f.analysis}
         )
+    from gearte.report.html import render_report
+
+    report = f"{case_name}_report.html"
+    (out / report).write_text(render_report(result), encoding="utf-8")
     entry = {
         "title": result.case.case.title or case_name,
+        "report": report,
         "paper": paper,
         "page": page,
         "headlines": [[r.title, r.quantity, r.value, r.spec, r.status] for r in headlines(result)],
@@ -169,6 +177,11 @@ def run_gallery(out: Path) -> dict[str, Any]:
 
     out.mkdir(parents=True, exist_ok=True)
     jobs = int(os.environ.get("GEARTE_DOCS_JOBS", os.cpu_count() or 1))
+    print(
+        f"gallery: running {len(GALLERY)} cases, {max(1, jobs)} at a time (one line each as "
+        "it finishes; cached until src/ or examples/ change)",
+        flush=True,
+    )
     if jobs <= 1:
         manifest = {c: run_case(c, paper, page, out) for c, paper, page in GALLERY}
     else:
@@ -198,6 +211,46 @@ def gallery(enabled: bool = True) -> tuple[dict[str, Any] | None, Path]:
     manifest = run_gallery(tmp)
     tmp.rename(folder)
     return manifest, folder
+
+
+def headline_table(m: dict[str, Any]) -> list[str]:
+    """Markdown lines of a gallery entry's headline table (the report's summary rows)."""
+    spec = any(r[3] or r[4] for r in m["headlines"])
+    cols = ["analysis", "quantity", "value"] + (["spec", "status"] if spec else [])
+    p = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    prev = None
+    for row in m["headlines"]:
+        cells = [("" if row[0] == prev else row[0]), *row[1 : len(cols)]]
+        prev = row[0]
+        p.append("| " + " | ".join(_md_cell(c) for c in cells) + " |")
+    return p
+
+
+#: In a docs page, a line ``<!-- generated: headlines CASE -->`` becomes CASE's headline table
+#: from the gallery run of this build (CASE must be in GALLERY): numbers in the guides are never
+#: copied by hand.
+GENERATED = re.compile(r"^<!-- generated: headlines (\w+) -->$", re.M)
+
+
+def generated_markdown(markdown: str, src_uri: str, manifest: dict[str, Any] | None) -> str:
+    """``markdown`` with each ``<!-- generated: headlines CASE -->`` replaced by the table."""
+
+    def table(match: re.Match[str]) -> str:
+        name = match.group(1)
+        if name not in {c for c, _, _ in GALLERY}:
+            raise KeyError(f"{src_uri}: {name!r} is not a gallery case (docs/_hooks.py GALLERY)")
+        if manifest is None:
+            return "*(Numbers left out of this build: `GEARTE_DOCS_GALLERY=0`.)*"
+        up = "../" * src_uri.count("/")
+        lines = headline_table(manifest[name])
+        lines += [
+            "",
+            f"*`gearte run {name}`, run when this site was built; its figures and full report: "
+            f"[gallery]({up}gallery/{name}.md).*",
+        ]
+        return "\n".join(lines)
+
+    return GENERATED.sub(table, markdown)
 
 
 def gallery_pages(manifest: dict[str, Any] | None) -> dict[str, str]:
@@ -230,19 +283,17 @@ def gallery_pages(manifest: dict[str, Any] | None) -> dict[str, str]:
             f"# {m['title']}",
             "",
             f"Case `{case_name}` (`gearte run {case_name}`); paper: {ref}. "
-            f"Validation: [{m['paper']}](../{m['page']}).",
+            + (
+                f"Validation: [{m['paper']}](../{m['page']})."
+                if m["page"].startswith("validation/")
+                else f"Guide: [{m['page'].removesuffix('.md').replace('-', ' ')}](../{m['page']})."
+            ),
             "",
             "## Summary",
             "",
         ]
-        spec = any(r[3] or r[4] for r in m["headlines"])
-        cols = ["analysis", "quantity", "value"] + (["spec", "status"] if spec else [])
-        p += ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-        prev = None
-        for row in m["headlines"]:
-            cells = [("" if row[0] == prev else row[0]), *row[1 : len(cols)]]
-            prev = row[0]
-            p.append("| " + " | ".join(_md_cell(c) for c in cells) + " |")
+        p += headline_table(m)
+        p += ["", f"The full report of this run: [{m['report']}]({m['report']})."]
         if m["warnings"]:
             p += ["", '!!! warning "Warnings"', ""]
             p += [f"    - {w}" for w in m["warnings"]]
@@ -294,7 +345,13 @@ def on_files(files: Any, config: Any) -> Any:
         for m in manifest.values():
             for f in m["figures"]:
                 add(f"gallery/{f['file']}", (folder / f["file"]).read_bytes())
+            add(f"gallery/{m['report']}", (folder / m["report"]).read_bytes())
     return files
+
+
+def on_page_markdown(markdown: str, page: Any, **kwargs: Any) -> str:
+    """Fill the generated numbers of a guide page (:func:`generated_markdown`)."""
+    return generated_markdown(markdown, page.file.src_uri, _STATE.get("manifest"))
 
 
 _ROLE = re.compile(r":(?:class|func|mod|data|meth|attr|exc|obj|const):(?=<code)")

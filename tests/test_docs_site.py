@@ -70,6 +70,7 @@ def test_gallery_pages_link_each_case_and_figure(hooks) -> None:
                 {"file": "demo_case_00.png", "title": "Profile", "caption": "c", "analysis": "g"}
             ],
             "seconds": 1.0,
+            "report": "demo_case_report.html",
         }
     }
     pages = hooks.gallery_pages(manifest)
@@ -81,6 +82,7 @@ def test_gallery_pages_link_each_case_and_figure(hooks) -> None:
     assert "| analysis | quantity | value |\n" in page  # no spec columns when no row has one
     assert "| Geometry | K1 | 0.79 |" in page and "|  | Clearance | 0.02 mm |" in page
     assert "a | warning" in page
+    assert "[demo_case_report.html](demo_case_report.html)" in page  # the full report
 
 
 def test_gallery_left_out_says_so(hooks) -> None:
@@ -90,3 +92,24 @@ def test_gallery_left_out_says_so(hooks) -> None:
 def test_short_citation(hooks) -> None:
     assert hooks._short_ref("Jiang J., Zhong X. (2024). Gear backlash") == "Jiang et al. 2024"
     assert hooks._short_ref("Hu, Li, Zhu, Cui (2020). An Elastic") == "Hu et al. 2020"
+
+
+def test_guide_numbers_come_from_the_build(hooks) -> None:
+    """A guide's ``<!-- generated: headlines CASE -->`` line becomes CASE's headline table of the
+    build's gallery run (no hand-copied numbers); a case outside the gallery fails the build."""
+    entry = {
+        "headlines": [["Chain", "Joint lost motion max", "0.1282′", "", ""]],
+        "report": "robot_joint_spur_rv_report.html",
+    }
+    page = "Text.\n\n<!-- generated: headlines robot_joint_spur_rv -->\n\nMore `<!-- x -->`.\n"
+    out = hooks.generated_markdown(page, "drives.md", {"robot_joint_spur_rv": entry})
+    assert "| Chain | Joint lost motion max | 0.1282′ |" in out
+    assert "](gallery/robot_joint_spur_rv.md)" in out
+    sub = hooks.generated_markdown(page, "validation/x.md", {"robot_joint_spur_rv": entry})
+    assert "](../gallery/robot_joint_spur_rv.md)" in sub
+    assert "GEARTE_DOCS_GALLERY=0" in hooks.generated_markdown(page, "drives.md", None)
+    with pytest.raises(KeyError):
+        hooks.generated_markdown("<!-- generated: headlines nope -->\n", "drives.md", {})
+    # the guides that carry model numbers use it
+    for guide in ("drives.md", "selective-assembly.md"):
+        assert hooks.GENERATED.search((ROOT / "docs" / guide).read_text(encoding="utf-8"))

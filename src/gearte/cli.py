@@ -21,6 +21,8 @@ from typing import Any
 
 import click
 
+_T_START = __import__("time").perf_counter()  # fallback clock of the final line's "in all"
+
 EXIT_FAILED = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERNAL = 3
@@ -233,6 +235,55 @@ def main() -> None:
     """
 
 
+def _wall_since_start() -> float:
+    """Wall time since this command started [s]: the process's age (interpreter start-up
+    included) where the system gives it, else the time since this module was imported. A
+    process that a shell ``exec``-ed after other work keeps the shell's start time: an age more
+    than :data:`_STARTUP_MAX_S` beyond this module's import is not this command's."""
+    import time
+
+    from gearte.execution.heartbeat import process_age
+
+    since_import = time.perf_counter() - _T_START
+    age = process_age()
+    if age is None or age > since_import + _STARTUP_MAX_S:
+        return since_import
+    return age
+
+
+#: The longest plausible interpreter start-up before this module is imported [s].
+_STARTUP_MAX_S = 5.0
+
+
+def _final_line(result: Any, total_s: float) -> str:
+    """The last line of a run: the analyses' own time and the command's whole wall time [s]
+    (start-up, loading kernels or compiling them on first use, the report), so that the
+    time a user waited is the number they read."""
+    compile_s = sum(v for k, v in result.timings.items() if k.startswith("numba load/compile"))
+    extra = f" (numba kernels {compile_s:.1f} s)" if compile_s >= 0.5 else ""
+    return (
+        f"{result.name}: {len(result.analyses)} analyses in {result.elapsed_s:.2f} s; "
+        f"{total_s:.1f} s in all, with start-up and outputs{extra}"
+    )
+
+
+@contextlib.contextmanager
+def _analysis_stages(beat: Any) -> Any:
+    """The heartbeat's stage while ``run_case`` runs: "running the analyses", then after each
+    finished analysis how many are done and which one finished last."""
+    from gearte.results import analysis_listener
+
+    done: list[str] = []
+
+    def finished(a: Any) -> None:
+        done.append(a.title or a.name)
+        beat.stage(f"running the analyses ({len(done)} done; last: {done[-1]})")
+
+    beat.stage("running the analyses")
+    with analysis_listener(finished):
+        yield
+
+
 @main.command()
 @click.argument("case")
 @click.option(
@@ -269,6 +320,19 @@ def run(
         import time
 
         t0 = time.perf_counter()
+        from gearte.execution.heartbeat import Heartbeat
+
+        # quiet since the process started: interpreter start-up and imports count
+        beat = Heartbeat(enabled=not no_progress, quiet_since=t0 - _wall_since_start())
+        try:
+            _run_with(beat, t0)
+        finally:
+            beat.close()
+
+    def _run_with(beat: Any, t0: float) -> None:
+        import time
+
+        beat.stage("loading gearte")
         from gearte.errors import ClusterLostError
         from gearte.io.case_file import load_case
         from gearte.report.outputs import check_output_dir, safe_label, write_outputs
@@ -283,6 +347,7 @@ def run(
 
             renderer = ReportWorker.start(case)
         try:
+            beat.stage("loading the case")
             c = load_case(case)
             t2 = time.perf_counter()
             default = os.path.join("out", safe_label(c.case.name or c.case.kind))
@@ -302,18 +367,23 @@ def run(
                     workers=workers,
                 )
                 try:
-                    result = run_case(c, opts)
+                    with _analysis_stages(beat):
+                        result = run_case(c, opts)
                 except (KeyboardInterrupt, ClusterLostError) as exc:
+                    beat.stage(None)
                     _write_partial(exc, target)
                     raise
             result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
+            beat.stage("writing results.json" + ("" if no_report else " and the report (figures)"))
             paths = write_outputs(result, target, report=not no_report, worker=renderer)
         finally:
+            beat.stage(None)
             if renderer is not None:
                 renderer.close()
+        beat.close()
         for w in result.warnings:
             click.echo(f"warning: {w}", err=True)
-        click.echo(f"{result.name}: {len(result.analyses)} analyses in {result.elapsed_s:.2f} s")
+        click.echo(_final_line(result, _wall_since_start()))
         for p in paths.values():
             click.echo(f"  wrote {p}")
         if timings:
@@ -414,7 +484,8 @@ def sweep(
         paths = write_sweep(result, target, plots=not no_plots, workers=workers)
         click.echo(
             f"{result.name}: {len(result.points)} points × {len(result.columns)} scalar results "
-            f"in {result.elapsed_s:.2f} s ({result.backend})"
+            f"in {result.elapsed_s:.2f} s ({result.backend}); {_wall_since_start():.1f} s in all, "
+            "with start-up and outputs"
         )
         statuses = result.statuses
         for what, label in (("invalid", "did not validate (skipped)"), ("failed", "failed")):
@@ -559,25 +630,37 @@ def warm_cache_cmd(kinds: tuple[str, ...], processes: int | None, debug: bool) -
     def _warm() -> None:
         import time
 
-        from gearte.warm import warm_cache, warm_cache_parallel
+        from gearte.execution.heartbeat import Heartbeat
+        from gearte.warm import warm_cache, warm_cache_parallel, warm_case_names
 
         n = processes if processes is not None else min(4, os.cpu_count() or 1)
         t0 = time.perf_counter()
+        total = len(warm_case_names(list(kinds) or None))
         click.echo(f"==> compiling gearte's numba kernels, one line per case ({n} at a time)")
-        if n == 1:
-            cpu = [0.0]
+        with Heartbeat(quiet_since=time.perf_counter()) as beat:
+            done = [0]
 
-            def report(kind: str, case: str, seconds: float) -> None:
-                if seconds < 0:
-                    cpu[0] = time.process_time()
-                    click.echo(f"  {kind:14s} {case:32s} ...", nl=False)
-                else:
-                    click.echo(f" {seconds:6.1f} s ({time.process_time() - cpu[0]:.1f} s CPU)")
+            def line(kind: str, case: str, wall: float, cpu_s: float) -> None:
+                done[0] += 1
+                beat.echo(f"  {kind:14s} {case:32s} {wall:6.1f} s ({cpu_s:.1f} s CPU)")
+                beat.stage(f"compiling numba kernels ({done[0]} of {total} cases done)")
 
-            list(warm_cache(list(kinds) or None, report=report))
-        else:
-            for kind, case, wall, cpu_s in warm_cache_parallel(list(kinds) or None, processes=n):
-                click.echo(f"  {kind:14s} {case:32s} {wall:6.1f} s ({cpu_s:.1f} s CPU)")
+            beat.stage(f"compiling numba kernels (0 of {total} cases done)")
+            if n == 1:
+                cpu = [0.0]
+
+                def report(kind: str, case: str, seconds: float) -> None:
+                    if seconds < 0:
+                        cpu[0] = time.process_time()
+                        beat.stage(f"compiling numba kernels: {case} ({done[0]} of {total} done)")
+                    else:
+                        line(kind, case, seconds, time.process_time() - cpu[0])
+
+                list(warm_cache(list(kinds) or None, report=report))
+            else:
+                for ev in warm_cache_parallel(list(kinds) or None, processes=n):
+                    line(*ev)
+            beat.stage("stopping the compile workers")
         click.echo(f"==> numba cache warm ({time.perf_counter() - t0:.1f} s)")
 
     _guarded(_warm, debug)

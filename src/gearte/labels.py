@@ -9,9 +9,20 @@ first into the second: an explicit registry (:data:`LABELS`) first, then word by
 
 from __future__ import annotations
 
+import re
+
 from gearte.units import split_unit, unit_text
 
-__all__ = ["LABELS", "WORDS", "PHRASES", "label", "label_with_unit"]
+__all__ = [
+    "LABELS",
+    "WORDS",
+    "PHRASES",
+    "VALUE_LABELS",
+    "label",
+    "label_with_unit",
+    "value_label",
+    "is_identifier",
+]
 
 #: Whole names whose word-by-word reading is wrong or clumsy (name without its unit).
 LABELS: dict[str, str] = {
@@ -36,6 +47,8 @@ LABELS: dict[str, str] = {
     "sobol_first_order": "Sobol first-order index",
     "sobol_total": "Sobol total index",
     "speeds": "Speeds",
+    "rhs_evaluations": "ODE right-hand-side evaluations",
+    "solver_residual_evaluations": "Solver residual evaluations",
 }
 
 #: Word-by-word readings of abbreviations inside names.
@@ -85,3 +98,69 @@ def label_with_unit(name: str) -> str:
     _, unit = split_unit(str(name))
     text = label(name)
     return f"{text} [{unit_text(unit)}]" if unit else text
+
+
+#: Values that are identifiers (an option, a factor, a law, a kind), as people read them. Others
+#: are read word by word (:func:`label`); paper symbols (``beta_s``) become ``β_s``.
+VALUE_LABELS: dict[str, str] = {
+    "line_contact": "line contact (Johnson 1985)",
+    "hu2020": "Hu et al. 2020 (eq. 38–39)",
+    "equal_share": "equal share",
+    "truncated_normal": "truncated normal",
+    "rv_reducer": "RV reducer",
+    "spur_pair": "spur pair",
+    "bevel_pair": "bevel pair",
+    "gear_pair": "gear pair",
+    "gear_chain": "gear chain",
+    "cycloid_stage": "cycloid stage",
+}
+
+_IDENTIFIER = re.compile(r"[a-z][a-z0-9]*(?:_[a-z0-9]+)+")
+_SYMBOL = re.compile(
+    r"(alpha|beta|gamma|delta|epsilon|theta|phi|psi|omega|sigma|tau|mu|nu|rho)_([a-z0-9]+)"
+)
+_GREEK = {
+    "alpha": "α",
+    "beta": "β",
+    "gamma": "γ",
+    "delta": "δ",
+    "epsilon": "ε",
+    "theta": "θ",
+    "phi": "φ",
+    "psi": "ψ",
+    "omega": "ω",
+    "sigma": "σ",
+    "tau": "τ",
+    "mu": "μ",
+    "nu": "ν",
+    "rho": "ρ",
+}
+
+
+def is_identifier(text: str) -> bool:
+    """Whether ``text`` reads as a program identifier (``shifted_modification``,
+    ``line_contact``): lower-case words joined by underscores, nothing else."""
+    return bool(_IDENTIFIER.fullmatch(text))
+
+
+def value_label(value: str) -> str:
+    """A text *value* (an option, a factor's name, a law) as people read it.
+
+    ``"shifted_modification"`` → ``"Shifted modification"``; ``"line_contact"`` → ``"line
+    contact (Johnson 1985)"`` (:data:`VALUE_LABELS`); ``"beta_s"`` → ``"β_s"``; a result name
+    ``"geometric_te [arcmin]"`` → ``"Geometric TE [arcmin]"``. Text that is not an identifier (a
+    sentence, a file name, a number) is returned as it is.
+    """
+    if not isinstance(value, str):
+        return value
+    base, unit = split_unit(value)
+    if unit and is_identifier(base):  # a result name: "geometric_te [arcmin]"
+        return label_with_unit(value)
+    if value in VALUE_LABELS:
+        return VALUE_LABELS[value]
+    if not is_identifier(value):
+        return value
+    sym = _SYMBOL.fullmatch(value)
+    if sym:
+        return f"{_GREEK[sym.group(1)]}_{sym.group(2)}"
+    return label(value)

@@ -36,6 +36,7 @@ __all__ = [
     "BENCH_CASES",
     "warm_cache",
     "warm_cache_parallel",
+    "warm_case_names",
 ]
 
 WARM_CASES: dict[str, tuple[str, ...]] = {
@@ -136,6 +137,11 @@ def _chains(kinds: Sequence[str] | None) -> list[list[tuple[str, str]]]:
         if sel:
             out.append(sel)
     return out
+
+
+def warm_case_names(kinds: Sequence[str] | None = None) -> list[str]:
+    """The warm-up cases that :func:`warm_cache` runs for ``kinds``, in order (for progress)."""
+    return [case for chain in _chains(kinds) for _, case in chain]
 
 
 def _run_one(case: str) -> tuple[float, float]:

@@ -11,7 +11,7 @@ test bench does (:func:`gearte.models.rv_catalogue.catalogue_values`):
   ``zero_load_fraction`` × rated torque; loaded at a given torque).
 
 An RV reducer described with its measured errors has no tolerance stack: its lost-motion spread
-is ``None`` (issue 14 samples the errors through this model instead).
+is ``None`` (the production yield samples the errors through this model instead).
 
 References
 ----------

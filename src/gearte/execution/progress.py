@@ -85,6 +85,9 @@ class ChunkProgress:
             console=Console(stderr=True),
             transient=True,
         )
+        from gearte.execution.heartbeat import hide_status
+
+        hide_status()  # the bar is the progress now
         self._bar.start()
         self._task = self._bar.add_task(description, total=total)
 
@@ -99,8 +102,11 @@ class ChunkProgress:
 
     def close(self) -> None:
         if self._bar is not None:
+            from gearte.execution.heartbeat import show_status
+
             self._bar.stop()
             self._bar = None
+            show_status()
 
     def __enter__(self) -> ChunkProgress:
         return self

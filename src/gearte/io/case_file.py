@@ -10,9 +10,12 @@ from __future__ import annotations
 import os
 import tomllib
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from gearte.errors import CaseFileError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from gearte.io.schema import CaseBase
 
 __all__ = [
     "load_case",
@@ -390,7 +393,7 @@ def _checks_beside_errors(
     return out
 
 
-def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
+def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> CaseBase:
     """Load and validate a case from a TOML file, a bundled case name, or a dictionary.
 
     Examples
@@ -424,6 +427,6 @@ def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
     )
 
 
-def validate_case(case: str | os.PathLike[str] | dict[str, Any]) -> Any:
+def validate_case(case: str | os.PathLike[str] | dict[str, Any]) -> CaseBase:
     """Validate a case without running it; returns the ``Case`` or raises ``CaseFileError``."""
     return load_case(case)

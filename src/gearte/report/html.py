@@ -210,6 +210,11 @@ def _case_json(result: Any) -> str:
     )
 
 
+#: Tables with more columns than this leave the column beside the figures and span the
+#: section's width below them (their first column stays in view when they scroll sideways).
+WIDE_COLUMNS = 5
+
+
 @functools.cache
 def report_template() -> Any:
     """The report's jinja2 template (``report.html.j2``), compiled once per process (~0.02 s
@@ -241,7 +246,7 @@ def render_report(result: Any, figures: list[RenderedFigure] | None = None) -> s
     from gearte._version import __version__
     from gearte.references import REFERENCES
     from gearte.report.summary import headlines, tradeoff_warnings
-    from gearte.report.tables import analysis_tables
+    from gearte.report.tables import analysis_tables, run_metadata_table
 
     if figures is None:
         figures = render_figures(result)
@@ -268,11 +273,12 @@ def render_report(result: Any, figures: list[RenderedFigure] | None = None) -> s
         kind=result.kind,
         version=__version__,
         date=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
-        elapsed=f"{result.elapsed_s:.2f}",
         description=result.case.case.description,
         warnings=list(result.warnings) + tradeoff_warnings(result),
         headline_groups=_grouped(headlines(result)),
         analyses=analyses,
         references=[(k, REFERENCES.get(k, k)) for k in result.references],
         case_json=_case_json(result),
+        run_metadata=run_metadata_table(result),
+        wide_columns=WIDE_COLUMNS,
     )

@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from gearte.labels import label
-from gearte.report.tables import item_label, relative_change
+from gearte.labels import label, value_label
+from gearte.report.tables import dominant_text, is_run_metadata, item_label, relative_change
 from gearte.units import format_quantity, split_unit
 
 __all__ = [
@@ -103,6 +103,7 @@ SPEC_CHECKS: list[tuple[str, str, str]] = [
     ("backlash_after_shim_min", "target_min_backlash", ">="),
     ("joint_lost_motion_max", "joint_lost_motion_limit", "<="),
     ("worst_te_peak_to_peak", "te_spec", "<="),
+    ("max_contact_pressure", "allowable_contact_pressure", "<="),
 ]
 
 #: Counts of items that meet a limit of the same analysis: the spec column shows that limit,
@@ -142,7 +143,48 @@ def _finite(v: Any) -> bool:
 
 
 def _text(v: Any, unit: str) -> str:
-    return v if isinstance(v, str) else format_quantity(v, unit)
+    return value_label(v) if isinstance(v, str) else format_quantity(v, unit)
+
+
+def _limits_text(spec: dict[str, Any]) -> str:
+    """A yield's spec (``{"geometric_te [arcmin]": {"lower": 0, "upper": 1.5}}``) for people:
+    ``"Geometric TE ≤ 1.5′"``, ``"0.2′ ≤ Lost motion ≤ 1′"``; several joined by ``"; "``."""
+    out = []
+    for name, lim in spec.items():
+        if not isinstance(lim, dict):
+            continue
+        unit = split_unit(name)[1]
+        lo, hi = lim.get("lower"), lim.get("upper")
+        what = label(name)
+        if _finite(lo) and lo != 0 and _finite(hi):
+            out.append(f"{_text(lo, unit)} ≤ {what} ≤ {_text(hi, unit)}")
+        elif _finite(hi):
+            out.append(f"{what} ≤ {_text(hi, unit)}")
+        elif _finite(lo):
+            out.append(f"{what} ≥ {_text(lo, unit)}")
+    return "; ".join(out)
+
+
+def _yield_rows(vals: dict[str, tuple[str, Any]]) -> list[tuple[str, str, str, str]]:
+    """(quantity, value, spec, status) of a yield analysis: the yield with its confidence
+    interval against the case's spec; pass/fail against the allocation's target yield when the
+    case gives one."""
+    y = vals.get("yield", ("", None))[1]
+    spec = vals.get("spec", ("", None))[1]
+    if not _finite(y) or not isinstance(spec, dict):
+        return []
+    value = format_quantity(100 * y, "%")
+    lo, hi = vals.get("yield_ci_low", ("", None))[1], vals.get("yield_ci_high", ("", None))[1]
+    if _finite(lo) and _finite(hi):
+        value += f" ({format_quantity(100 * lo, '%')} – {format_quantity(100 * hi, '%')})"
+    spec_text = _limits_text(spec)
+    status = ""
+    alloc = vals.get("allocation", ("", None))[1]
+    target = alloc.get("target_yield") if isinstance(alloc, dict) else None
+    if target is not None and _finite(target):
+        spec_text += f"; target yield ≥ {format_quantity(100 * target, '%')}"
+        status = "pass" if y >= target else "fail"
+    return [("Yield (confidence interval)", value, spec_text, status)]
 
 
 def _spec_of(base: str, vals: dict[str, tuple[str, Any]]) -> str:
@@ -199,6 +241,8 @@ def analysis_headlines(a: Any) -> list[HeadlineRow]:
                 spec = _text(vals[limit][1], vals[limit][0])
             add(label(limit), "met" if v else "not met", spec, "pass" if v else "fail")
             checked.add(limit)
+    for row in _yield_rows(vals):
+        add(*row)
     for base in HEADLINE_KEYS:
         if len(picked) >= MAX_HEADLINES:
             break
@@ -206,7 +250,10 @@ def analysis_headlines(a: Any) -> list[HeadlineRow]:
             continue
         if base in vals:
             unit, v = vals[base]
-            if _is_num(v) or isinstance(v, str):
+            dominant = dominant_text({base: v, **{k: x for k, (_, x) in vals.items()}}, base)
+            if dominant is not None:
+                add(label(base), dominant)
+            elif _is_num(v) or isinstance(v, str):
                 add(label(base), _text(v, unit), _spec_of(base, vals))
             continue
         if f"{base}_before" in vals and f"{base}_after" in vals:
@@ -226,7 +273,7 @@ def analysis_headlines(a: Any) -> list[HeadlineRow]:
                 break
     if not picked:
         for base, (unit, v) in vals.items():
-            if _finite(v) and base not in ("seed", "samples"):
+            if _finite(v) and not is_run_metadata(base):
                 add(label(base), _text(v, unit), _spec_of(base, vals))
                 if len(picked) >= 3:
                     break

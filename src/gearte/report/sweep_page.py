@@ -44,6 +44,10 @@ def _num(v: Any) -> str:
         return str(v).lower()
     if isinstance(v, float):
         return "" if math.isnan(v) else f"{v:.6g}"
+    if isinstance(v, str):
+        from gearte.labels import value_label
+
+        return value_label(v)  # an option or factor name as people read it
     return str(v)
 
 

@@ -26,12 +26,16 @@ from typing import Any
 
 import numpy as np
 
-from gearte.labels import label
+from gearte.labels import label, value_label
 from gearte.units import format_number, format_quantity, split_unit, unit_text
 
 __all__ = [
     "Table",
+    "RUN_METADATA",
     "analysis_tables",
+    "dominant_text",
+    "is_run_metadata",
+    "run_metadata_table",
     "csv_files",
     "summarise_series",
     "is_series",
@@ -43,6 +47,28 @@ __all__ = [
 INLINE_MAX = 8
 #: Tables with more rows than this are collapsed (``<details>``) in the report.
 COLLAPSE_ROWS = 25
+
+#: Result names (without unit) that describe the run, not the drive: solver timings and
+#: counters, seeds and sample counts. The report lists them in its "Run metadata" section, apart
+#: from the results (results.json and summary.csv keep them with the analysis).
+RUN_METADATA: frozenset[str] = frozenset(
+    {
+        "seed",
+        "samples",
+        "verified_seed",
+        "solver_wall_time",
+        "solver_residual_evaluations",
+        "rhs_evaluations",
+        "model_evaluations",
+        "simulated_seconds_per_wall_second",
+        "scoring_time",
+        "assignment_time",
+        "pairings_scored",
+    }
+)
+
+#: What an empty list or mapping reads as in a table cell.
+EMPTY = "none"
 
 
 @dataclass
@@ -76,9 +102,13 @@ class Table:
     def cell(self, row: list[Any], j: int) -> str:
         v = row[j]
         if isinstance(v, str):
-            return v
+            return value_label(v)
+        if isinstance(v, list | tuple | dict) and not v:
+            return EMPTY
         if isinstance(v, list | tuple):
-            return ", ".join(format_number(x) if not isinstance(x, str) else x for x in v)
+            return ", ".join(
+                format_number(x) if not isinstance(x, str) else value_label(x) for x in v
+            )
         return format_number(v)
 
     @property
@@ -197,8 +227,64 @@ def _parse_number(s: str) -> Any:
 
 def _scalar_text(v: Any, unit: str) -> str:
     if isinstance(v, str):
-        return v
+        return value_label(v)
     return format_quantity(v, unit)
+
+
+def dominant_text(values: dict[str, Any], key: str) -> str | None:
+    """The text of a ``dominant_*`` value ``key`` of an analysis's ``values``, or ``None`` when
+    it is not one: ``"none (every contribution is zero)"`` when every mapping of numbers that
+    holds it as a key (or, for an empty value, every ``contribution*`` mapping) is all zero —
+    nothing dominates then; ``"none"`` for another empty value; otherwise the value as people
+    read it."""
+    if not split_unit(key)[0].startswith("dominant_"):
+        return None
+    v = values[key]
+    if not isinstance(v, str):
+        return None
+    rankings = [
+        m
+        for k, m in values.items()
+        if isinstance(m, dict)
+        and m
+        and all(_is_number(x) for x in m.values())
+        and (v in m if v else split_unit(k)[0].startswith("contribution"))
+    ]
+    if rankings and all(not any(m.values()) for m in rankings):
+        return "none (every contribution is zero)"
+    return value_label(v) if v else "none"
+
+
+def is_run_metadata(name: str) -> bool:
+    """Whether the result ``name`` (with or without unit) describes the run
+    (:data:`RUN_METADATA`)."""
+    return split_unit(name)[0] in RUN_METADATA
+
+
+def run_metadata_table(result: Any) -> Table | None:
+    """The report's "Run metadata" table: every :data:`RUN_METADATA` value of every analysis
+    (analysis, quantity, value) and the run's total analysis time.
+
+    Parameters
+    ----------
+    result : StudyResult
+        The study result whose report it is.
+
+    Returns
+    -------
+    Table or None
+        ``None`` if the result holds no run metadata.
+    """
+    rows: list[list[Any]] = []
+    for a in result.analyses:
+        for k, v in a.values.items():
+            if is_run_metadata(k) and _is_scalar(v):
+                rows.append([a.title, label(k), _scalar_text(v, split_unit(k)[1])])
+    if getattr(result, "elapsed_s", 0.0):
+        rows.append(["(whole run)", "Time of the analyses", format_quantity(result.elapsed_s, "s")])
+    if not rows:
+        return None
+    return Table("run_metadata", "Run metadata", ["analysis", "quantity", "value"], rows, csv=False)
 
 
 def analysis_tables(analysis: Any) -> list[Table]:
@@ -223,7 +309,7 @@ def analysis_tables(analysis: Any) -> list[Table]:
     series: list[list[Any]] = []
     mappings: dict[tuple[str, ...], list[str]] = {}
     for k, v in values.items():
-        if k in paired:
+        if k in paired or is_run_metadata(k):
             continue
         base, unit = split_unit(k)
         if base.endswith("_dms") and base[:-4] in bases:
@@ -232,7 +318,7 @@ def analysis_tables(analysis: Any) -> list[Table]:
             tables.append(_csv_table(f"{name}_{base}", v))
             continue
         if _is_scalar(v):
-            text = _scalar_text(v, unit)
+            text = dominant_text(values, k) or _scalar_text(v, unit)
             dms = values.get(f"{base}_dms")
             if isinstance(dms, str):
                 text += f" ({dms})"
@@ -244,9 +330,11 @@ def analysis_tables(analysis: Any) -> list[Table]:
                 tables += _nested_tables(f"{name}_{base}", k, v)
         elif isinstance(v, list | tuple) and v and all(isinstance(x, dict) for x in v):
             tables.append(_records_table(f"{name}_{base}", k, v))
-        elif isinstance(v, list | tuple) and v and all(isinstance(x, str) for x in v):
+        elif isinstance(v, list | tuple | dict) and not v:
+            results.append([label(k), EMPTY])
+        elif isinstance(v, list | tuple) and all(isinstance(x, str) for x in v):
             if len(v) <= INLINE_MAX and sum(len(x) for x in v) < 120:
-                results.append([label(k), ", ".join(v)])
+                results.append([label(k), ", ".join(value_label(x) for x in v)])
             else:
                 tables.append(
                     Table(f"{name}_{base}", label(k), [base], [[x] for x in v], kind="list")
@@ -344,10 +432,20 @@ def _records_table(key: str, name: str, records: Any) -> Table:
 
 def _plain_cell(v: Any) -> Any:
     if isinstance(v, dict):
-        return "; ".join(f"{label(a)}: {format_number(b)}" for a, b in v.items())
+        if not v:
+            return EMPTY
+        return "; ".join(f"{label(a)}: {_plain_text(b)}" for a, b in v.items())
     if isinstance(v, np.ndarray):
         return v.tolist()
     return v
+
+
+def _plain_text(v: Any) -> str:
+    if isinstance(v, str):
+        return value_label(v)
+    if isinstance(v, list | tuple):
+        return ", ".join(_plain_text(x) for x in v) if v else EMPTY
+    return format_number(v)
 
 
 def _nested_tables(key: str, name: str, mapping: dict[str, Any]) -> list[Table]:

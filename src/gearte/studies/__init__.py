@@ -16,9 +16,13 @@ import sys
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from gearte.io.kinds import available_kinds, get_kind, register_kind
+
+if TYPE_CHECKING:  # pragma: no cover
+    from gearte.io.schema import CaseBase
+    from gearte.results import StudyResult
 
 __all__ = [
     "RunOptions",
@@ -139,7 +143,9 @@ def preflight(case: Any) -> None:
         fn(case)
 
 
-def run_case(case: Any, options: RunOptions | None = None) -> Any:
+def run_case(
+    case: CaseBase | str | os.PathLike[str] | dict[str, Any], options: RunOptions | None = None
+) -> StudyResult:
     """Run a case: a validated ``Case``, a path to a TOML file, a bundled name or a dict.
 
     Parameters
@@ -247,6 +253,9 @@ def _numba_timer() -> Iterator[dict[str, float]]:
 
         timer.append(event.TimingListener())
         event.register("numba:compiler_lock", timer[0])
+        from gearte.execution.heartbeat import numba_ready
+
+        numba_ready()  # a status line names the kernels numba compiles from now on
 
     hook = None
     if "numba" in sys.modules:

@@ -32,7 +32,7 @@ class MeasuredPartsCase(CaseBase):
         from gearte.studies import rv_reducer as rv
 
         try:
-            design = load_case(self.reducer.case)
+            design: Any = load_case(self.reducer.case)  # an rv_reducer Case, checked below
         except (FileNotFoundError, IsADirectoryError, PermissionError) as exc:
             # checked at validation; the file went away (or became unreadable) since
             raise ParameterError("reducer.case", self.reducer.case, str(exc)) from None

@@ -348,7 +348,8 @@ def _geometric_te(st, case: Case, opts: GeometricTEOptions) -> AnalysisResult:
             "error_coefficient": te.coefficients,
             "sensitivity_index": sens,
             "error_gain [arcmin/um]": gain,
-            "dominant_factor": ranked[0][0] if ranked else "",
+            # none when every contribution is zero (no error given): nothing dominates
+            "dominant_factor": ranked[0][0] if ranked and ranked[0][1] != 0 else "",
             "paper_symbol": {k: PAPER_SYMBOLS[k] for k in arc},
         },
         references=["hu2020"],
@@ -447,6 +448,8 @@ def _tooth_contact(st, o: ToothContactOptions) -> tuple[AnalysisResult, list[str
         )
         values["max_contact_pressure [MPa]"] = float(sweep.max_contact_pressure.max())
     allowable = o.allowable_contact_pressure_MPa
+    if allowable is not None:
+        values["allowable_contact_pressure [MPa]"] = allowable  # the report checks it
     if allowable is not None and values["max_contact_pressure [MPa]"] > allowable:
         warnings.append(
             f"tooth_contact: max_contact_pressure {values['max_contact_pressure [MPa]']:.0f} MPa "

@@ -470,6 +470,8 @@ def _pair_drive(st: StageSpec, pair):
 
 def _drive_stage(st: StageSpec, drive, confidence: float):
     """Lost motion of a ``[drive]`` stage from the drive's own model, and its result."""
+    from gearte.labels import value_label
+
     assert st.drive is not None
     values: dict = {
         "drive_kind": drive.kind,
@@ -477,7 +479,10 @@ def _drive_stage(st: StageSpec, drive, confidence: float):
         "ratio": st.ratio,
         "drive_ratio": drive.ratio,
     }
-    notes = [f"{drive.kind} drive; lost motion and stiffness from its own model (gearte.drives)."]
+    notes = [
+        f"{value_label(drive.kind)} drive; lost motion and stiffness from its own model "
+        "(gearte.drives)."
+    ]
     if st.lost_motion_max_arcmin is not None:  # a model without lost motion: the given values
         mx, mean, lo = _given_lost_motion(st)
         notes.append("Its model has no lost motion: the values given in the case are used.")
@@ -509,9 +514,14 @@ def _drive_stage(st: StageSpec, drive, confidence: float):
     )
     k = drive.torsional_stiffness()
     values["torsional_stiffness [N*m/arcmin]"] = None if k is None else _nm_per_arcmin(k)
+    pair = getattr(st.drive.validated_case, "pair", None)
+    if pair is not None and pair.min_backlash_limit_um > 0:  # a gear pair with a limit
+        s = summarise_backlash(pair.backlash_stack(), confidence=confidence)
+        values["backlash_min [um]"] = float(mm_to_um(s.min))
+        values["min_backlash_limit [um]"] = pair.min_backlash_limit_um  # the report checks it
     result = AnalysisResult(
         name=f"{_slug(st.name)}_drive",
-        title=f"{st.name}: {drive.kind} drive (its own model)",
+        title=f"{st.name}: {value_label(drive.kind)} drive (its own model)",
         values=values,
         references=[],
         notes=notes,
@@ -889,6 +899,12 @@ def run(case: Case, options) -> StudyResult:
                         "lost_motion_mean_dms": format_dms(mean),
                         "lost_motion_min_dms": format_dms(lo),
                         "lost_motion_max_dms": format_dms(mx),
+                        # the case's limit (0: none), so that the report checks against it
+                        **(
+                            {"min_backlash_limit [um]": st.min_backlash_limit_um}
+                            if st.min_backlash_limit_um > 0
+                            else {}
+                        ),
                     },
                     references=["jiang2024"],
                     notes=[

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
@@ -280,7 +280,7 @@ def _reducer(ref: ReducerRef):
     from gearte.io.case_file import load_case
     from gearte.studies.rv_reducer import build_reducer
 
-    rcase = load_case(ref.case)
+    rcase: Any = load_case(ref.case)  # an rv_reducer Case (checked at validation)
     return build_reducer(rcase.reducer), rcase
 
 

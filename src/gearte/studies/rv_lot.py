@@ -1,5 +1,5 @@
 """Study kind ``rv_lot``: selective assembly of a lot of measured RV parts, and pin grading
-(issue 16).
+(docs/selective-assembly.md).
 
 Given the measured disc sets and crank sets of a lot (files: ``docs/metrology.md``), choose which
 disc set goes with which crank set and in which orientation so that the most reducers meet the

@@ -1,4 +1,4 @@
-"""Study kind ``rv_serial``: one assembled RV serial from its measured parts (issue 16).
+"""Study kind ``rv_serial``: one assembled RV serial from its measured parts (docs/metrology.md).
 
 The design (an ``rv_reducer`` case: geometry, stiffnesses, contact law) plus the measurement
 files of the parts that form this serial; the measured values replace the design's in the one

@@ -15,7 +15,7 @@ contributors form one Gaussian group: their sum is drawn as *one* normal per sam
 sum of independent normals is normal with the summed mean and variance); the others are drawn
 one by one. Its plain reference, :func:`linear_stack_reference`, is a per-sample Python loop
 drawing the same numbers in the same order: the two give bit-identical samples (tested).
-(Issue 12 changed the samples of a seed three times — when the normals were grouped, when the
+(Before 0.1.0 the samples of a seed changed three times — when the normals were grouped, when the
 kernel got its own generator and when its main stream became 16 interleaved ones; the
 distribution did not change.) Per-contributor values
 (contributions, variance shares) come from :mod:`gearte.tolerance.stackup`, not from these

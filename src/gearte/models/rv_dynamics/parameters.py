@@ -52,7 +52,7 @@ class RVDynamicsParameters:
     with it) and β, e.g. to feed the paper's printed 2.62e8 N/m and 3.8°.
     Operating point: ``input_speed_rpm``, ``output_torque_Nm`` (split equally over the discs for
     the contact analysis).
-    No field that is data has a default (issue 11): Li 2023's values live in the example cases
+    No field that is data has a default: Li 2023's values live in the example cases
     ``examples/li2023_rv*.toml``; build from a case with
     :func:`gearte.studies._rv_dynamics.build_dynamic_model` or from an
     :class:`~gearte.geometry.rv.RVReducer` with :func:`parameters_from_reducer`.

@@ -7,7 +7,7 @@ loop), and the tests compare both. The kernel's arguments are two arrays: the sc
 both packed by :meth:`~gearte.models.rv_dynamics.assembly.RVDynamicModel.kernel_args`.
 
 What the first (cold-cache) compile of the kernels costs, and why the kernel is written as it is
-(issue 12, ``docs/numba.md``): numba types and lowers every statement and LLVM optimises the
+(``docs/numba.md``): numba types and lowers every statement and LLVM optimises the
 module once for :func:`rv_rhs` and again inside every integrator that calls it, so the kernel
 reads each array element once into a local, sums each body's forces in locals and stores them
 once (one store instead of a read and a write per element force), gives every variable one
