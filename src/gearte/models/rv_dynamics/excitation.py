@@ -190,6 +190,7 @@ def disc_rotation_error(
     m = int(samples_per_mesh)
     pc0 = pin_contacts(nominal, theta[:m])
     a0, a1 = law.coefficients(pc0.phase)
+    a0 = law.series_a0(a0, np.arange(n_discs)[None, :, None])  # pin seat + bending in series
     rot0, ela0 = loaded_disc_rotation(pc0, a0, a1, torque_per_disc)
     reps = k // m
     out = np.empty((n_discs, k))
@@ -198,6 +199,7 @@ def disc_rotation_error(
         th = theta[s : s + chunk]
         pc = pin_contacts(reducer, th)
         a0, a1 = law.coefficients(pc.phase)
+        a0 = law.series_a0(a0, np.arange(n_discs)[None, :, None])
         r0 = np.tile(rot0, (reps, 1))[s : s + chunk]
         e0 = np.tile(ela0, (reps, 1))[s : s + chunk]
         rot, _ = loaded_disc_rotation(pc, a0, a1, torque_per_disc, guess=e0)

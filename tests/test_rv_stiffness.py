@@ -1,0 +1,198 @@
+"""The RV stiffness chain: each element against its closed form, the chain's shares and its
+tangent compliance against a finite difference of the load-sharing model."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gearte.errors import ParameterError
+from gearte.models import rv_stiffness as st
+
+
+# ---- each element against its closed form, written out independently ---------------------
+def test_palmgren_line_deflection_closed_form():
+    q, length = np.array([10.0, 1000.0, 12345.0]), np.array([5.0, 10.0, 22.0])
+    want = [3.84e-5 * qi**0.9 / li**0.8 for qi, li in zip(q, length, strict=True)]
+    np.testing.assert_allclose(st.palmgren_line_deflection(q, length), want, rtol=1e-12)
+
+
+def test_palmgren_tangent_is_derivative_of_the_law():
+    q, length, h = 2500.0, 12.0, 1e-3
+    fd = (
+        2
+        * h
+        / (st.palmgren_line_deflection(q + h, length) - st.palmgren_line_deflection(q - h, length))
+    )
+    assert float(st.palmgren_line_stiffness(q, length)) == pytest.approx(float(fd), rel=1e-7)
+    secant = q / (3.84e-5 * q**0.9 / length**0.8)
+    assert float(st.palmgren_line_stiffness(q, length, "secant")) == pytest.approx(secant, 1e-12)
+
+
+def test_roller_bearing_stiffness_palmgren_stribeck_closed_form():
+    z, length, fr, alpha, rows = 16, 14.0, 5000.0, math.radians(30.0), 2
+    q_max = 4.08 * (fr / rows) / (z * math.cos(alpha))
+    delta_r = 2 * 3.84e-5 * q_max**0.9 / length**0.8 / math.cos(alpha)
+    k = float(st.roller_bearing_radial_stiffness(z, length, fr, alpha, rows))
+    assert k == pytest.approx(fr / delta_r, rel=1e-12)
+    k_t = float(st.roller_bearing_radial_stiffness(z, length, fr, alpha, rows, "tangent"))
+    assert k_t == pytest.approx(fr / delta_r / 0.9, rel=1e-12)
+
+
+def test_roller_bearing_value_of_the_former_geometry_function():
+    """The value the bundled cases had from gearte.geometry.rv.palmgren_radial_stiffness."""
+    assert round(float(st.roller_bearing_radial_stiffness(16, 14.0, 5000.0)) / 1e5, 2) == 8.62
+
+
+def test_pin_seat_is_palmgren_tangent():
+    f, length = 3000.0, 26.0
+    want = 1.0 / (0.9 * 3.84e-5 * f**-0.1 / length**0.8)
+    assert float(st.pin_seat_stiffness(f, length)) == pytest.approx(want, rel=1e-12)
+
+
+def test_beam_point_compliance_roark_case_1e_and_shear():
+    L, a, d, E, nu = 40.0, 15.0, 7.0, 2.06e5, 0.3
+    b = L - a
+    inertia = math.pi * d**4 / 64
+    bending = a**2 * b**2 / (3 * E * inertia * L)
+    shear = (10 / 9) * a * b / (E / (2 * (1 + nu)) * math.pi * d**2 / 4 * L)
+    got = st.beam_point_compliance(L, a, d, E, nu, shear=False)
+    assert float(got) == pytest.approx(bending, rel=1e-12)
+    assert float(st.beam_point_compliance(L, a, d, E, nu)) == pytest.approx(bending + shear, 1e-12)
+
+
+def test_beam_midspan_is_textbook_wl3_over_48ei():
+    L, d, E = 50.0, 10.0, 2.0e5
+    inertia = math.pi * d**4 / 64
+    got = float(st.beam_point_compliance(L, L / 2, d, E, 0.3, shear=False))
+    assert got == pytest.approx(L**3 / (48 * E * inertia), rel=1e-12)
+
+
+def test_disc_positions_centred():
+    np.testing.assert_allclose(st.disc_load_positions(40.0, 2, 13.0), [13.5, 26.5])
+    np.testing.assert_allclose(st.disc_load_positions(40.0, 3, 10.0), [10.0, 20.0, 30.0])
+    with pytest.raises(ParameterError, match="span"):
+        st.disc_load_positions(20.0, 2, 13.0)
+
+
+def test_shaft_torsion_shigley():
+    d, L, E, nu = 22.0, 35.0, 2.06e5, 0.3
+    G = E / (2 * (1 + nu))
+    want = G * math.pi * d**4 / 32 / L
+    assert float(st.shaft_torsional_stiffness(d, L, E, nu)) == pytest.approx(want, rel=1e-12)
+
+
+def test_iso6336_mesh_stiffness():
+    assert float(st.iso6336_mesh_stiffness(12.0)) == pytest.approx(20.0 * 12.0 * 1000.0)
+    assert float(st.iso6336_mesh_stiffness(12.0, 15.0)) == pytest.approx(15.0 * 12.0 * 1000.0)
+
+
+def test_ideal_peak_pin_force_hu2020_eq30():
+    T, share, K1, zc, rp = 1.078e6, 0.5, 1.5 * 40 / 82.0, 39, 82.0
+    assert float(st.ideal_peak_pin_force(T, share, K1, zc, rp)) == pytest.approx(
+        4 * share * T / (K1 * zc * rp), rel=1e-12
+    )
+
+
+def test_series_and_shares():
+    assert float(st.series_compliance(1.0, None, 2.5)) == 3.5
+    shares = st.compliance_shares({"a": 1.0, "b": 3.0})
+    assert shares == {"a": 0.25, "b": 0.75}
+    with pytest.raises(ParameterError):
+        st.compliance_shares({"a": -1.0})
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: st.palmgren_line_deflection(-1.0, 10.0),
+        lambda: st.palmgren_line_deflection(1.0, 0.0),
+        lambda: st.stribeck_max_roller_load(100.0, 2),
+        lambda: st.roller_bearing_radial_stiffness(10, 5.0, 100.0, math.radians(95.0)),
+        lambda: st.beam_point_compliance(10.0, 12.0, 5.0, 2e5, 0.3),
+        lambda: st.shaft_torsional_stiffness(-1.0, 10.0, 2e5, 0.3),
+        lambda: st.palmgren_line_stiffness(100.0, 5.0, "chord"),
+    ],
+)
+def test_bad_inputs_are_refused(call):
+    with pytest.raises(ParameterError):
+        call()
+
+
+# ---- the chain on the bundled cases -------------------------------------------------------
+@pytest.fixture(scope="module")
+def han():
+    from gearte.io.case_file import load_case
+    from gearte.studies.rv_reducer import build_reducer
+
+    return build_reducer(load_case("han2023_rv110e").reducer)
+
+
+def test_chain_shares_sum_to_one_and_name_left_out(han):
+    from gearte.models.rv_stiffness_chain import stiffness_chain
+
+    chain = stiffness_chain(han)
+    assert sum(chain.shares.values()) == pytest.approx(1.0, abs=1e-9)
+    assert set(chain.left_out) == {"output_flange", "pin_bending"}
+    assert not set(chain.left_out) & set(chain.shares)
+    for e in ("pin_seat", "crank_bending", "crank_torsion", "cam_bearing", "carrier_bearing"):
+        assert chain.shares[e] > 0.0
+
+
+def test_chain_tangent_compliance_is_the_models_derivative(han):
+    """C = uᵀ K_t⁻¹ u equals dθ/dT of the load-sharing model (line_contact law: each contact's
+    secant satisfies its law exactly), by a central difference at ±0.1 % of rated torque."""
+    from gearte.models.rv_load_sharing import assemble, load_sharing
+    from gearte.models.rv_stiffness_chain import stiffness_chain
+
+    chain = stiffness_chain(han)
+    T = han.rated_torque
+    h = 1e-3 * T
+    system = assemble(han, np.array([0.0]))
+    up = load_sharing(han, T + h, system=system).output_error[0]
+    down = load_sharing(han, T - h, system=system).output_error[0]
+    assert chain.total_compliance == pytest.approx(-(up - down) / (2 * h), rel=1e-6)
+
+
+def test_series_elements_change_the_load_sharing(han):
+    """Pin seat and crank bending are in the solve: removing them changes the pin forces."""
+    import dataclasses
+
+    from gearte.models.rv_load_sharing import load_sharing
+
+    rigid = han.replace(
+        pins=dataclasses.replace(han.pins, seat_compliance=None),
+        cranks=dataclasses.replace(han.cranks, bending_compliance=None, torsional_stiffness=None),
+    )
+    theta = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    a = load_sharing(han, han.rated_torque, theta).pin_force
+    b = load_sharing(rigid, han.rated_torque, theta).pin_force
+    assert np.max(np.abs(a - b)) > 10.0  # N
+
+
+def test_output_flange_adds_its_compliance(han):
+    import dataclasses
+
+    from gearte.models.rv_stiffness_chain import stiffness_chain
+
+    k_out = 2.0e9  # N·mm/rad
+    flanged = han.replace(
+        supports=dataclasses.replace(han.supports, output_torsional_stiffness=k_out)
+    )
+    a, b = stiffness_chain(han), stiffness_chain(flanged)
+    assert b.total_compliance == pytest.approx(a.total_compliance + 1.0 / k_out, rel=1e-12)
+    assert "output_flange" not in b.left_out
+    assert b.shares["output_flange"] == pytest.approx(1.0 / k_out / b.total_compliance)
+
+
+def test_catalogue_results_carry_shares_and_sources():
+    from gearte.io.case_file import load_case
+    from gearte.studies.rv_reducer import chain_sources
+
+    src = chain_sources(load_case("hu2020_rv80e_initial_reducer").reducer)
+    assert src["pin_seat"].startswith("derived")
+    assert src["main_bearing"].startswith("derived")
+    assert src["output_flange"] == "left out"
+    assert src["sun_support"] == "given"
