@@ -1221,6 +1221,8 @@ def _chain_inputs(sec: ReducerSection) -> dict[str, Any]:
                 "linearised at the largest pin force at rated torque)",
             )
         k1 = c.eccentricity_mm * p.count / (p.circle_radius_mm + d.shift_modification_mm)
+        if not 0.0 < k1 < 1.0:  # RVReducer refuses it next, naming cranks.eccentricity
+            return out
         force = ideal_peak_pin_force(
             Nm_to_Nmm(sec.rated_torque_Nm), 1.0 / d.count, k1, p.count - 1, p.circle_radius_mm
         )
