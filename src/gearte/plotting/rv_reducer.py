@@ -1,5 +1,6 @@
 """Figures of the ``rv_reducer`` study: pin-load map, peak pin load with/without errors, TE split,
-hysteresis curve with lost motion and rigidity, compliance breakdown of the stiffness chain. matplotlib is imported lazily (new_figure)."""
+hysteresis curve with lost motion and rigidity, compliance breakdown of the stiffness chain.
+matplotlib is imported lazily (new_figure)."""
 
 from __future__ import annotations
 
