@@ -73,9 +73,10 @@ def test_hu2020_modified_prototype_has_lower_total_te(te):
     gearte, bearing-compliant reducer with the bundled case's stiffness chain (pin seats, crank
     bending and torsion; -22.06 % without them): -19.69 % (documented deviation: the
     compliance of bearings and shafts, common to both prototypes, dilutes the gain); supports
-    and first stage stiffened 1e4×, no seats or shaft compliance (the paper's Adams setting): 0.8921' → 0.2077', -76.71 % (documented
-    deviation: gearte's rigid setting also stiffens the crank bearings the Adams model keeps
-    flexible through the discs). The paper's two numbers lie between gearte's two settings.
+    and first stage stiffened 1e4×, no seats or shaft compliance (the paper's Adams setting):
+    0.8921' → 0.2077', -76.71 % (documented deviation: gearte's rigid setting also stiffens
+    the crank bearings the Adams model keeps flexible through the discs). The paper's two
+    numbers lie between gearte's two settings.
     Tolerance 0.05 points: the 120-position load-sharing solution is converged far below that.
     """
     rows = {}
