@@ -1046,6 +1046,11 @@ class Case(CaseBase):
             for key in keys
             if not have[key]
         ]
+        if self.reducer.pins.seat_length_mm is not None and not have["reducer.rated_torque_Nm"]:
+            problems.append(
+                "reducer.pins.seat_length_mm needs reducer.rated_torque_Nm (the pin seat is "
+                "linearised at the largest pin force at rated torque), which the case does not give"
+            )
         if problems:
             raise ValueError("; ".join(problems))
         return self
@@ -1213,13 +1218,8 @@ def _chain_inputs(sec: ReducerSection) -> dict[str, Any]:
     elif c.torsional_stiffness_Nm_per_rad is not None:
         out["crank_torsion"] = c.torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD
     if p.seat_length_mm is not None:
-        if sec.rated_torque_Nm is None:
-            raise ParameterError(
-                "reducer.rated_torque_Nm",
-                None,
-                "needed to derive the pin seat stiffness from pins.seat_length_mm (it is "
-                "linearised at the largest pin force at rated torque)",
-            )
+        if sec.rated_torque_Nm is None:  # refused by Case._inputs, naming both keys
+            return out
         k1 = c.eccentricity_mm * p.count / (p.circle_radius_mm + d.shift_modification_mm)
         if not 0.0 < k1 < 1.0:  # RVReducer refuses it next, naming cranks.eccentricity
             return out
@@ -1533,7 +1533,7 @@ def _catalogue(red, sec: CatalogueSection, law, fs_terms=None, sources=None) -> 
     chain = stiffness_chain(red, theta=deg_to_rad(sec.position_deg), law=law)
     values["tangent_rigidity_at_rated [N*m/arcmin]"] = Nmm_per_rad_to_Nm_per_arcmin(chain.rigidity)
     values["compliance_shares"] = chain.shares
-    values["stiffness_chain_left_out"] = list(chain.left_out)
+    values["stiffness_chain_left_out"] = ", ".join(chain.left_out) or "none"
     values["cam_bearing_load_at_rated [N]"] = chain.cam_bearing_load
     values["carrier_bearing_load_at_rated [N]"] = chain.carrier_bearing_load
     if sources is not None:
