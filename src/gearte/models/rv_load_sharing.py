@@ -519,6 +519,16 @@ def cam_row_stiffness(reducer: RVReducer) -> np.ndarray:
     The cam (needle) bearing in series with the crank's bending at that cam
     (:attr:`~gearte.geometry.rv.Cranks.bending_compliance`; none when left out):
     ``1 / (1 / k_cam + c_bend,j)``.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` row stiffness [N/mm].
     """
     k = np.full(reducer.discs.count, float(reducer.cranks.cam_bearing_stiffness))
     c = reducer.cranks.bending_compliance
@@ -532,6 +542,16 @@ def mesh_row_stiffness(reducer: RVReducer) -> float:
     (:attr:`~gearte.geometry.rv.Cranks.torsional_stiffness` ``k_t``; none when left out): a twist
     ``F r_b2 / k_t`` of the planet against its cams moves the mesh point by ``F r_b2² / k_t``
     along the line of action, so ``1 / (1 / k_m + r_b2² / k_t)``.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    float
+        Row stiffness [N/mm].
     """
     k = float(reducer.first_stage.mesh_stiffness)
     kt = reducer.cranks.torsional_stiffness
@@ -547,6 +567,16 @@ def pin_series_compliance(reducer: RVReducer) -> np.ndarray:
     The pin's seat in its housing groove plus the pin's bending at that disc
     (:attr:`~gearte.geometry.rv.PinRing.seat_compliance`,
     :attr:`~gearte.geometry.rv.PinRing.bending_compliance`; 0 for those left out).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` compliance [mm/N].
     """
     n = reducer.discs.count
     c = np.zeros(n)

@@ -316,7 +316,20 @@ def ideal_peak_pin_force(
 
 
 def shear_modulus(youngs_modulus: ArrayLike, poisson_ratio: ArrayLike) -> np.ndarray:
-    """``G = E / (2 (1 + ν))`` [MPa] of an isotropic material."""
+    """``G = E / (2 (1 + ν))`` [MPa] of an isotropic material.
+
+    Parameters
+    ----------
+    youngs_modulus : array_like
+        ``E`` [MPa].
+    poisson_ratio : array_like
+        ``ν`` [-], in ``[0, 0.5)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``G`` [MPa].
+    """
     e = _positive("youngs_modulus", youngs_modulus)
     nu = np.asarray(poisson_ratio, dtype=float)
     if np.any(nu < 0.0) or np.any(nu >= 0.5):
@@ -498,7 +511,8 @@ def compliance_shares(compliances: dict[str, float]) -> dict[str, float]:
     Parameters
     ----------
     compliances : dict
-        Element name → its contribution to a total compliance (any one unit), ``>= 0``.
+        Element name → its contribution to a total compliance [any one unit of compliance,
+        e.g. rad/(N·mm)], ``>= 0``.
 
     Returns
     -------
