@@ -196,3 +196,116 @@ def test_catalogue_results_carry_shares_and_sources():
     assert src["main_bearing"].startswith("derived")
     assert src["output_flange"] == "left out"
     assert src["sun_support"] == "given"
+
+
+# ---- the case keys -------------------------------------------------------------------------
+def _han_dict():
+    import tomllib
+
+    from gearte.cases import case_path
+
+    return tomllib.loads(case_path("han2023_rv110e").read_text(encoding="utf-8"))
+
+
+def test_seat_without_rated_torque_is_refused_naming_both_keys():
+    from gearte.errors import CaseFileError
+    from gearte.io.case_file import load_case_dict
+
+    data = _han_dict()
+    del data["reducer"]["rated_torque_Nm"]
+    for a in ("catalogue", "compensation"):
+        data["analyses"].pop(a, None)
+    with pytest.raises(CaseFileError, match="pins.seat_length_mm needs reducer.rated_torque_Nm"):
+        load_case_dict(data)
+
+
+@pytest.mark.parametrize(
+    ("section", "derived", "given", "value"),
+    [
+        ("pins", "seat_length_mm", "seat_stiffness_N_per_mm", 8e5),
+        ("cranks", "bearing_span_mm", "bending_stiffness_N_per_mm", 1e6),
+        ("cranks", "torsion_length_mm", "torsional_stiffness_Nm_per_rad", 5e4),
+    ],
+)
+def test_an_element_given_and_derived_is_refused(section, derived, given, value):
+    from gearte.errors import CaseFileError
+    from gearte.io.case_file import load_case_dict
+
+    data = _han_dict()
+    data["reducer"][section][given] = value
+    with pytest.raises(CaseFileError, match=f"give {derived} \\(derived\\) or {given}"):
+        load_case_dict(data)
+
+
+def test_given_stiffnesses_reach_the_reducer_and_sources_say_given():
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies.rv_reducer import build_reducer, chain_sources
+
+    data = _han_dict()
+    pins, cranks, sup = (
+        data["reducer"]["pins"],
+        data["reducer"]["cranks"],
+        data["reducer"]["supports"],
+    )
+    del pins["seat_length_mm"], cranks["bearing_span_mm"], cranks["torsion_length_mm"]
+    pins["seat_stiffness_N_per_mm"] = 8e5
+    pins["bending_stiffness_N_per_mm"] = 2e6
+    cranks["bending_stiffness_N_per_mm"] = 1e6
+    cranks["torsional_stiffness_Nm_per_rad"] = 5e4
+    sup["output_flange_torsional_stiffness_Nm_per_rad"] = 2e6
+    case = load_case_dict(data)
+    red = build_reducer(case.reducer)
+    assert red.pins.seat_compliance == pytest.approx(1 / 8e5)
+    assert red.pins.bending_compliance == pytest.approx((1 / 2e6,) * 2)
+    assert red.cranks.bending_compliance == pytest.approx((1 / 1e6,) * 2)
+    assert red.cranks.torsional_stiffness == pytest.approx(5e7)  # N·mm/rad
+    assert red.supports.output_torsional_stiffness == pytest.approx(2e9)
+    src = chain_sources(case.reducer)
+    for e in ("pin_seat", "pin_bending", "crank_bending", "crank_torsion", "output_flange"):
+        assert src[e] == "given"
+
+
+def test_derived_elements_match_their_closed_forms():
+    """The case's dimensions become the closed forms of gearte.models.rv_stiffness."""
+    from gearte.io.case_file import load_case
+    from gearte.studies.rv_reducer import build_reducer
+
+    case = load_case("han2023_rv110e")
+    red = build_reducer(case.reducer)
+    c = case.reducer.cranks
+    E, nu = 2.06e5, 0.3
+    a = st.disc_load_positions(c.bearing_span_mm, 2, 13.0)
+    np.testing.assert_allclose(
+        red.cranks.bending_compliance,
+        st.beam_point_compliance(c.bearing_span_mm, a, c.shaft_diameter_mm, E, nu),
+        rtol=1e-12,
+    )
+    assert red.cranks.torsional_stiffness == pytest.approx(
+        float(st.shaft_torsional_stiffness(22.0, 35.0, E, nu)), rel=1e-12
+    )
+    f = st.ideal_peak_pin_force(1.078e6, 0.5, 1.5 * 40 / 82.0, 39, 82.0)
+    assert 1 / red.pins.seat_compliance == pytest.approx(
+        float(st.pin_seat_stiffness(f, 30.0)), rel=1e-12
+    )
+    assert red.supports.carrier_radial_stiffness == pytest.approx(
+        float(st.roller_bearing_radial_stiffness(40, 6.0, 5000.0, math.radians(45.0), 2)),
+        rel=1e-12,
+    )
+
+
+def test_case_without_chain_names_what_it_leaves_out():
+    from gearte.io.case_file import load_case
+    from gearte.models.rv_stiffness_chain import stiffness_chain
+    from gearte.studies.rv_reducer import build_reducer, chain_sources
+
+    case = load_case("li2023_rv_errors")
+    chain = stiffness_chain(build_reducer(case.reducer))
+    assert set(chain.left_out) == {
+        "output_flange",
+        "crank_bending",
+        "pin_seat",
+        "pin_bending",
+        "crank_torsion",
+    }
+    assert sum(chain.shares.values()) == pytest.approx(1.0, abs=1e-9)
+    assert chain_sources(case.reducer)["cam_bearing"] == "given"

@@ -21,17 +21,23 @@ Case file layout (units in the keys)::
                                or backlash_um (j_t per mesh)
     [reducer.cranks]           count, circle_radius_mm, eccentricity_mm, shaft_diameter_mm,
                                shaft_length_mm, cam_bearing = {stiffness_N_per_mm | rollers,
-                               roller_length_mm, reference_load_N; radial_clearance_um},
-                               carrier_bearing = {...}
+                               roller_length_mm, reference_load_N, contact_angle_deg, rows;
+                               radial_clearance_um}, carrier_bearing = {...}; stiffness chain
+                               (docs/rv-stiffness-chain.md): bearing_span_mm |
+                               bending_stiffness_N_per_mm, torsion_length_mm |
+                               torsional_stiffness_Nm_per_rad
     [reducer.discs]            count, face_width_mm, equidistant_modification_mm,
                                shift_modification_mm, youngs_modulus_MPa, poisson_ratio,
                                crank_bore_diameter_mm, centre_bore_diameter_mm,
                                equidistant_modification_errors_um,
                                shift_modification_errors_um (one per disc)
     [reducer.pins]             count, pin_radius_mm, circle_radius_mm, radius_errors_um,
-                               radial_position_errors_um, tangential_position_errors_um (per pin)
-    [reducer.supports]         carrier_radial_stiffness_N_per_mm, main_bearing_clearance_um,
-                               carrier_outer_diameter_mm, carrier_length_mm
+                               radial_position_errors_um, tangential_position_errors_um (per pin);
+                               seat_length_mm | seat_stiffness_N_per_mm, support_span_mm |
+                               bending_stiffness_N_per_mm
+    [reducer.supports]         carrier_radial_stiffness_N_per_mm | main_bearing = {...},
+                               main_bearing_clearance_um, carrier_outer_diameter_mm,
+                               carrier_length_mm, output_flange_torsional_stiffness_Nm_per_rad
     [[reducer.errors]]         part, crank, disc, value_um, angle_deg (one per error:
                                sun_eccentricity, sun_assembly, planet_eccentricity, cam,
                                disc_crank_bore,
