@@ -141,14 +141,22 @@ def test_validate_refuses_a_malformed_measurement_file_naming_file_line_column(t
 
 def _without_stiffness_chain(red):
     """The serial's reducer as it was before its design case had a stiffness chain (no pin
-    seat, crank bending or torsion; main bearings 2e6 N/mm): the state the reproducers below
-    were found in (with the chain's compliance the clearances close earlier and the former
-    Newton cap no longer fails)."""
+    seat, crank bending or torsion; crank bearings at 5 and 6 kN, main bearings 2e6 N/mm): the
+    state the reproducers below were found in (with the chain the clearances close earlier and
+    the former Newton cap no longer fails)."""
     import dataclasses
+
+    from gearte.models.rv_stiffness import roller_bearing_radial_stiffness as k_roller
 
     return red.replace(
         pins=dataclasses.replace(red.pins, seat_compliance=None, bending_compliance=None),
-        cranks=dataclasses.replace(red.cranks, bending_compliance=None, torsional_stiffness=None),
+        cranks=dataclasses.replace(
+            red.cranks,
+            bending_compliance=None,
+            torsional_stiffness=None,
+            cam_bearing_stiffness=float(k_roller(14, 12.0, 5000.0)),
+            carrier_bearing_stiffness=float(k_roller(16, 10.0, 6000.0)),
+        ),
         supports=dataclasses.replace(red.supports, carrier_radial_stiffness=2.0e6),
     )
 

@@ -144,23 +144,34 @@ class Bearing(StrictModel):
         default=0.0, ge=0, lt=90, description="contact angle of the rollers (0: radial) [deg]"
     )
     rows: int = Field(default=1, ge=1, le=8, description="identical rows sharing the load [-]")
+    at_rated_torque: bool = Field(
+        default=False,
+        description="linearise at the bearing's largest load at rated torque (found by a fixed "
+        "point of the load sharing) instead of at reference_load_N",
+    )
 
     @model_validator(mode="after")
     def _one_way(self):
         palm = (self.rollers, self.roller_length_mm, self.reference_load_N)
         if self.stiffness_N_per_mm is not None:
-            if any(v is not None for v in palm):
+            if any(v is not None for v in palm) or self.at_rated_torque:
                 raise ValueError("give either stiffness_N_per_mm or the Palmgren data, not both")
-        elif any(v is None for v in palm):
+        elif self.rollers is None or self.roller_length_mm is None:
             raise ValueError(
-                "give stiffness_N_per_mm, or all of rollers, roller_length_mm, reference_load_N"
+                "give stiffness_N_per_mm, or rollers, roller_length_mm and reference_load_N (or "
+                "at_rated_torque = true)"
             )
+        elif (self.reference_load_N is None) == (not self.at_rated_torque):
+            raise ValueError("give reference_load_N or at_rated_torque = true (one)")
         return self
 
-    def stiffness(self) -> float:
+    def stiffness(self, load: float | None = None) -> float:
+        """Radial stiffness [N/mm]: the given one, or Palmgren/Stribeck at ``load`` [N]
+        (default ``reference_load_N``)."""
         if self.stiffness_N_per_mm is not None:
             return self.stiffness_N_per_mm
-        n, length, load = self.rollers, self.roller_length_mm, self.reference_load_N
+        n, length = self.rollers, self.roller_length_mm
+        load = self.reference_load_N if load is None else load
         if n is None or length is None or load is None:  # refused by _one_way
             raise ParameterError("stiffness_N_per_mm", None, "no stiffness and no Palmgren data")
         return float(
@@ -173,10 +184,14 @@ class Bearing(StrictModel):
         """How the stiffness was obtained (for the results)."""
         if self.stiffness_N_per_mm is not None:
             return "given"
+        at = (
+            "its largest load at rated torque"
+            if self.at_rated_torque
+            else f"{self.reference_load_N} N"
+        )
         return (
             f"derived: Palmgren/Stribeck from {self.rollers} rollers x {self.rows} row(s), "
-            f"l = {self.roller_length_mm} mm, alpha = {self.contact_angle_deg} deg, secant at "
-            f"{self.reference_load_N} N"
+            f"l = {self.roller_length_mm} mm, alpha = {self.contact_angle_deg} deg, secant at {at}"
         )
 
 
@@ -606,6 +621,11 @@ class SupportsSection(StrictModel):
     def _main(self):
         if (self.carrier_radial_stiffness_N_per_mm is None) == (self.main_bearing is None):
             raise ValueError("give carrier_radial_stiffness_N_per_mm or main_bearing (one)")
+        if self.main_bearing is not None and self.main_bearing.at_rated_torque:
+            raise ValueError(
+                "main_bearing.at_rated_torque: the output torque puts (almost) no radial load on "
+                "the main bearings; give their preload as reference_load_N"
+            )
         return self
 
     def main_stiffness(self) -> float:
@@ -793,7 +813,7 @@ class ReducerSection(StrictModel):
                 problems.append(str(exc).replace("errors[0]", f"errors[{k}]"))
         if not problems:
             try:
-                build_reducer(self)
+                build_reducer(self, operating=False)
             except ParameterError as exc:
                 problems.append(str(exc))
         if problems:
@@ -1057,6 +1077,15 @@ class Case(CaseBase):
                 "reducer.pins.seat_length_mm needs reducer.rated_torque_Nm (the pin seat is "
                 "linearised at the largest pin force at rated torque), which the case does not give"
             )
+        for name in ("cam_bearing", "carrier_bearing"):
+            if (
+                getattr(self.reducer.cranks, name).at_rated_torque
+                and not have["reducer.rated_torque_Nm"]
+            ):
+                problems.append(
+                    f"reducer.cranks.{name}.at_rated_torque needs reducer.rated_torque_Nm, which "
+                    "the case does not give"
+                )
         if problems:
             raise ValueError("; ".join(problems))
         return self
@@ -1075,7 +1104,9 @@ _GEAR_SET_KEYS = {
 }
 
 
-def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer:
+def build_reducer(
+    sec: ReducerSection, *, with_errors: bool = True, operating: bool = True
+) -> RVReducer:
     """The :class:`RVReducer` a case's ``[reducer]`` section describes.
 
     Parameters
@@ -1084,6 +1115,10 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         The validated ``[reducer]`` table.
     with_errors : bool
         Include the ``[[reducer.errors]]`` (``False``: the nominal reducer).
+    operating : bool
+        Linearise the bearings marked ``at_rated_torque`` at their largest load at rated torque
+        (:func:`_at_operating_load`); ``False``: at a first estimate (the case check, which
+        needs the geometry only).
 
     Returns
     -------
@@ -1113,12 +1148,13 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
     first = FirstStage(gears, mesh, fs.sun_support_stiffness_N_per_mm, fs.face_width_mm)
     c = sec.cranks
     chain = _chain_inputs(sec)
+    f0 = _first_bearing_load(sec)
     cranks = Cranks(
         c.count,
         c.circle_radius_mm,
         c.eccentricity_mm,
-        c.cam_bearing.stiffness(),
-        c.carrier_bearing.stiffness(),
+        c.cam_bearing.stiffness(f0 if c.cam_bearing.at_rated_torque else None),
+        c.carrier_bearing.stiffness(f0 if c.carrier_bearing.at_rated_torque else None),
         um_to_mm(c.cam_bearing.radial_clearance_um),
         um_to_mm(c.carrier_bearing.radial_clearance_um),
         c.shaft_diameter_mm,
@@ -1182,7 +1218,75 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
     from gearte.models.rv_load_sharing import cycloid_stage
 
     cycloid_stage(red)  # the stage's own validation (undercut, interference, pin fit)
+    if operating and (c.cam_bearing.at_rated_torque or c.carrier_bearing.at_rated_torque):
+        red = _at_operating_load(red, sec)
     return red
+
+
+def _first_bearing_load(sec: ReducerSection) -> float:
+    """First estimate of a crank bearing's load at rated torque [N]: ``T / (M R_dc)``, the
+    tangential force one crank passes to the carrier (1 kN without a rated torque: the case
+    check refuses ``at_rated_torque`` then)."""
+    if sec.rated_torque_Nm is None:
+        return 1.0e3
+    return float(Nm_to_Nmm(sec.rated_torque_Nm)) / (sec.cranks.count * sec.cranks.circle_radius_mm)
+
+
+def _at_operating_load(red: RVReducer, sec: ReducerSection, tol: float = 1e-4) -> RVReducer:
+    """``red`` with the ``at_rated_torque`` crank bearings linearised at their largest radial
+    load at rated torque over 36 output positions of the error-free design (a property of the
+    design: the measured errors of one reducer do not change its bearings' stiffness): a fixed
+    point (the load sharing depends on the stiffnesses it sets; Palmgren's stiffness grows as
+    ``F^0.1``, so it contracts in a few steps), to a relative load change below ``tol``.
+
+    Raises
+    ------
+    ParameterError
+        No rated torque (``reducer.rated_torque_Nm``).
+    """
+    import dataclasses
+
+    from gearte.models.rv_load_sharing import load_sharing, output_positions
+
+    if red.rated_torque is None:
+        raise ParameterError(
+            "reducer.rated_torque_Nm", None, "needed by a bearing linearised at_rated_torque"
+        )
+    c = sec.cranks
+    theta = output_positions(36)
+    f0 = _first_bearing_load(sec)
+    loads = {"cam": f0, "carrier": f0}
+    for _ in range(30):
+        cranks = dataclasses.replace(
+            red.cranks,
+            cam_bearing_stiffness=c.cam_bearing.stiffness(
+                loads["cam"] if c.cam_bearing.at_rated_torque else None
+            ),
+            carrier_bearing_stiffness=c.carrier_bearing.stiffness(
+                loads["carrier"] if c.carrier_bearing.at_rated_torque else None
+            ),
+        )
+        red = red.replace(cranks=cranks)
+        nominal = red.replace(  # no errors of any kind: the design
+            pins=dataclasses.replace(
+                red.pins,
+                radius_errors=np.zeros(0),
+                radial_position_errors=np.zeros(0),
+                tangential_position_errors=np.zeros(0),
+            ),
+            errors=ManufacturingErrors.none(c.count, sec.discs.count),
+        )
+        ls = load_sharing(nominal, red.rated_torque, theta)
+        new = {
+            "cam": float(ls.cam_bearing_load.max()),
+            "carrier": float(ls.carrier_bearing_load.max()),
+        }
+        if all(abs(new[k] - loads[k]) <= tol * loads[k] for k in loads):
+            return red
+        loads = new
+    raise ConvergenceError(
+        f"bearing loads at rated torque did not settle: {loads} N (at_rated_torque bearings)"
+    )
 
 
 def _chain_inputs(sec: ReducerSection) -> dict[str, Any]:
