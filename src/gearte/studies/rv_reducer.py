@@ -1252,6 +1252,7 @@ def _at_operating_load(red: RVReducer, sec: ReducerSection, tol: float = 1e-4) -
         raise ParameterError(
             "reducer.rated_torque_Nm", None, "needed by a bearing linearised at_rated_torque"
         )
+    torque = float(red.rated_torque)
     c = sec.cranks
     theta = output_positions(36)
     f0 = _first_bearing_load(sec)
@@ -1276,7 +1277,7 @@ def _at_operating_load(red: RVReducer, sec: ReducerSection, tol: float = 1e-4) -
             ),
             errors=ManufacturingErrors.none(c.count, sec.discs.count),
         )
-        ls = load_sharing(nominal, red.rated_torque, theta)
+        ls = load_sharing(nominal, torque, theta)
         new = {
             "cam": float(ls.cam_bearing_load.max()),
             "carrier": float(ls.carrier_bearing_load.max()),
