@@ -309,3 +309,36 @@ def test_case_without_chain_names_what_it_leaves_out():
     }
     assert sum(chain.shares.values()) == pytest.approx(1.0, abs=1e-9)
     assert chain_sources(case.reducer)["cam_bearing"] == "given"
+
+
+def test_crank_bearings_at_rated_torque_are_a_fixed_point_of_the_load_sharing():
+    """at_rated_torque: each crank bearing's stiffness is Palmgren's secant at its own largest
+    load at rated torque over 36 positions of the error-free design (tolerance 1e-4 of the load:
+    the fixed point's stopping rule; the stiffness moves as F^0.1, i.e. 1e-5)."""
+    from gearte.io.case_file import load_case
+    from gearte.models.rv_load_sharing import load_sharing, output_positions
+    from gearte.studies.rv_reducer import build_reducer
+
+    case = load_case("han2023_rv110e")
+    red = build_reducer(case.reducer)
+    red0 = build_reducer(case.reducer, with_errors=False)
+    # a property of the design: the reducer with errors has the same bearing stiffness
+    assert red.cranks.cam_bearing_stiffness == red0.cranks.cam_bearing_stiffness
+    ls = load_sharing(red0, red0.rated_torque, output_positions(36))
+    for load, k, (z, length) in (
+        (ls.cam_bearing_load.max(), red.cranks.cam_bearing_stiffness, (14, 12.0)),
+        (ls.carrier_bearing_load.max(), red.cranks.carrier_bearing_stiffness, (16, 10.0)),
+    ):
+        assert k == pytest.approx(float(st.roller_bearing_radial_stiffness(z, length, load)), 1e-5)
+
+
+def test_main_bearing_at_rated_torque_is_refused():
+    from gearte.errors import CaseFileError
+    from gearte.io.case_file import load_case_dict
+
+    data = _han_dict()
+    main = data["reducer"]["supports"]["main_bearing"]
+    del main["reference_load_N"]
+    main["at_rated_torque"] = True
+    with pytest.raises(CaseFileError, match="preload"):
+        load_case_dict(data)
