@@ -342,3 +342,26 @@ def test_main_bearing_at_rated_torque_is_refused():
     main["at_rated_torque"] = True
     with pytest.raises(CaseFileError, match="preload"):
         load_case_dict(data)
+
+
+@pytest.mark.parametrize("name", ["han2023_rv110e", "hu2020_rv80e_initial_reducer"])
+def test_paper_cases_report_compliance_shares_and_rigidity(name):
+    """The catalogue analysis of the paper cases carries the breakdown (sum 1 ± 1e-9) beside
+    the catalogue rigidity, and the tangent rigidity is within 2 % of that secant one."""
+    import tomllib
+
+    from gearte.cases import case_path
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies.rv_reducer import run
+
+    data = tomllib.loads(case_path(name).read_text(encoding="utf-8"))
+    data["analyses"] = {"catalogue": data["analyses"]["catalogue"]}
+    data["reducer"].pop("dynamics", None)
+    data.pop("operation", None)
+    values = run(load_case_dict(data, name=name))["catalogue"].values
+    shares = values["compliance_shares"]
+    assert sum(shares.values()) == pytest.approx(1.0, abs=1e-9)
+    assert {"pin_contact", "pin_seat", "cam_bearing", "crank_bending"} <= set(shares)
+    k = values["torsional_rigidity [N*m/arcmin]"]
+    assert values["tangent_rigidity_at_rated [N*m/arcmin]"] == pytest.approx(k, rel=0.02)
+    assert "pin_bending" in values["stiffness_chain_left_out"]
