@@ -85,7 +85,6 @@ def test_rv_case_writes_required_names_in_one_results_json(name, tmp_path):
 def test_analysis_without_its_input_names_the_missing_key():
     data = _data("han2023_rv110e")
     del data["reducer"]["rated_torque_Nm"]
-    del data["reducer"]["pins"]["seat_length_mm"]  # its own message: test_rv_stiffness.py
     del data["reducer"]["dynamics"]
     data["analyses"]["geometric_te"] = {}
     with pytest.raises(CaseFileError) as exc:
