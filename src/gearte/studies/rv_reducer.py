@@ -1470,12 +1470,22 @@ def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
             float((ls.disc_torque / ls.disc_torque.sum(axis=1, keepdims=True)).max()),
         ],
     }
+    from gearte.models.rv_stiffness_chain import left_out_elements
+
+    left_out = left_out_elements(red)
+    values["stiffness_chain_left_out"] = ", ".join(left_out) or "none"
     data = {"load": ls}
     notes = [
         "Pin loads from the quasi-static equilibrium of all parts (springs + unilateral pin "
         f"contacts with the '{ls.contact_law}' load-dependent stiffness), one output revolution; "
         "max_contact_pressure: Hertz line-contact pressure of each pin with its own flank "
-        "curvature.",
+        "curvature. Pin seat and pin bending are in series with each pin contact, crank bending "
+        "with the cam bearings, crank torsion with the mesh (docs/rv-stiffness-chain.md)"
+        + (
+            f"; left out (rigid: the case describes neither): {', '.join(left_out)}."
+            if left_out
+            else "."
+        ),
     ]
     if has_errors and sec.compare_without_errors:
         ls0 = load_sharing(red0, T, th, law=law)
