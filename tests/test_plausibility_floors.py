@@ -33,7 +33,7 @@ KEYS = [
     ("li2023_rv", "reducer.dynamics.crank_torsional_stiffness_Nm_per_rad", "torsional_stiffness"),
     ("han2023_rv110e_no_errors", "reducer.cranks.cam_bearing.roller_length_mm", "part_length"),
     (
-        "han2023_rv110e_no_errors",
+        "han2023_rv110e_yield",  # the no_errors case linearises at rated torque
         "reducer.cranks.cam_bearing.reference_load_N",
         "bearing_reference_load",
     ),

@@ -16,7 +16,14 @@ from gearte.errors import ParameterError
 from gearte.geometry.measured import MeasuredDisc
 from gearte.geometry.rv import PinContacts, RVReducer, pin_contacts
 from gearte.io.case_file import load_case
-from gearte.models.rv_load_sharing import RVSystem, assemble, dof_layout, output_positions
+from gearte.models.rv_load_sharing import (
+    RVSystem,
+    assemble,
+    cam_row_stiffness,
+    dof_layout,
+    mesh_row_stiffness,
+    output_positions,
+)
 
 
 # ------------------------------------------------------------------------------------------
@@ -228,7 +235,9 @@ def _assemble_reference(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
                 add(
                     r,
                     (eps_cam - eps_bore) @ d,
-                    reducer.cranks.cam_bearing_stiffness,
+                    # the cam bearing in series with the crank's bending (stiffness chain;
+                    # the one change to the verbatim reference)
+                    float(cam_row_stiffness(reducer)[j]),
                     _measured_ref(reducer.cranks.cam_bearing_clearance, err.cam_clearance, (i, j)),
                 )
     labels["cam_bearing"] = slice(start, len(rows))
@@ -251,7 +260,8 @@ def _assemble_reference(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
         _point_row_ref(r, lay.crank(i), tp - cp, n, -1.0)
         eps_pl = _rot_ref(np.broadcast_to(err.planet[i], (P, 2)), ecc1)
         eps_sun = _rot_ref(np.broadcast_to(err.sun, (P, 2)), reducer.ratio * th)
-        add(r, np.sum((eps_sun - eps_pl) * n, axis=-1), reducer.first_stage.mesh_stiffness)
+        # the mesh in series with the crank's torsion (stiffness chain)
+        add(r, np.sum((eps_sun - eps_pl) * n, axis=-1), mesh_row_stiffness(reducer))
     labels["mesh"] = slice(start, len(rows))
 
     spring_B = np.stack(rows, axis=1)
@@ -433,7 +443,10 @@ def _every_error(red: RVReducer, seed: int, n_discs: int | None = None) -> RVRed
         tangential_position_errors=e(zp) * 0.3,
     )
     cranks = dataclasses.replace(
-        red.cranks, cam_bearing_clearance=0.004, carrier_bearing_clearance=0.003
+        red.cranks,
+        cam_bearing_clearance=0.004,
+        carrier_bearing_clearance=0.003,
+        bending_compliance=None if red.cranks.bending_compliance is None else (7e-7,) * n,
     )
     discs = dataclasses.replace(red.discs, count=n)
     return red.replace(pins=pins, cranks=cranks, discs=discs, errors=err)

@@ -25,9 +25,9 @@ from numpy.typing import ArrayLike
 
 from gearte.drives import LostMotionSpread
 from gearte.errors import ParameterError
-from gearte.geometry.rv import iso6336_mesh_stiffness
 from gearte.models.backlash import BevelPair, SpurPair, summarise_backlash
 from gearte.models.lost_motion import return_error
+from gearte.models.rv_stiffness import iso6336_mesh_stiffness
 
 __all__ = ["GearPairDrive"]
 
@@ -96,7 +96,7 @@ class GearPairDrive:
         if b is None:
             return None
         r_b = 0.5 * self.pair.output_diameter * math.cos(self.pair.pressure_angle)
-        return iso6336_mesh_stiffness(b, self.c_gamma) * r_b * r_b
+        return float(iso6336_mesh_stiffness(b, self.c_gamma)) * r_b * r_b
 
     def transmission_error(self, output_angle: ArrayLike) -> np.ndarray | None:
         """Not modelled for a pair (Jiang 2024 gives backlash only): ``None``."""

@@ -33,12 +33,19 @@ Stiffness laws
 --------------
 * Pin–disc contacts: the load-dependent law of Hu et al. 2020, section 4 (eq 33–36): a per-disc
   secant stiffness ``F_max / delta_max(F_max)`` (see :func:`gearte.models.rv_load_sharing`).
-* Roller bearings (crank needle bearings, carrier crank bearings): either given, or derived from
-  the Palmgren line-contact deflection ``delta = 3.84e-5 Q^0.9 / l^0.8`` per race (Harris &
-  Kotzalas, *Rolling Bearing Analysis*, eq. for line contact; Palmgren 1959) with the Stribeck
-  load of the most loaded roller ``Q = 4.08 F_r / Z`` — see :func:`palmgren_radial_stiffness`.
+* Roller bearings (crank needle bearings, carrier crank bearings, main bearings): either given,
+  or derived from the Palmgren line-contact deflection ``delta = 3.84e-5 Q^0.9 / l^0.8`` per race
+  with the Stribeck load of the most loaded roller ``Q = 4.08 F_r / Z`` —
+  :func:`gearte.models.rv_stiffness.roller_bearing_radial_stiffness`.
 * Involute mesh: given, or ``c_gamma * b`` with ``c_gamma`` the ISO 6336-1 mean mesh stiffness
-  per unit face width (default 20 N/(mm·µm)).
+  per unit face width (:func:`gearte.models.rv_stiffness.iso6336_mesh_stiffness`).
+* The rest of the stiffness chain (``docs/rv-stiffness-chain.md``), each optional here and
+  named "left out" by the stiffness-chain analysis when None: the pin seat and pin bending
+  (:attr:`PinRing.seat_compliance`, :attr:`PinRing.bending_compliance`, in series with each
+  pin contact), crank bending at each cam (:attr:`Cranks.bending_compliance`, in series with
+  that cam's bearing), crank torsion between planet and cams (:attr:`Cranks.torsional_stiffness`,
+  in series with the sun–planet mesh) and the output flange
+  (:attr:`Supports.output_torsional_stiffness`, in series with the output rotation).
 
 Reuse
 -----
@@ -60,7 +67,6 @@ import numpy as np
 from gearte.errors import ParameterError
 from gearte.geometry.planetary import EccentricityError, SunPlanetErrors, SunPlanets
 from gearte.limits import check_floor
-from gearte.units import um_to_mm
 
 __all__ = [
     "FirstStage",
@@ -76,85 +82,7 @@ __all__ = [
     "RVReducer",
     "PinContacts",
     "pin_contacts",
-    "palmgren_radial_stiffness",
-    "iso6336_mesh_stiffness",
 ]
-
-
-def palmgren_radial_stiffness(
-    rollers: int, roller_length: float, radial_load: float, contact_angle: float = 0.0
-) -> float:
-    """Secant radial stiffness [N/mm] of a roller (needle) bearing from Palmgren's formula.
-
-    Parameters
-    ----------
-    rollers : int
-        Number of rollers ``Z`` [-].
-    roller_length : float
-        Effective roller length ``l`` [mm].
-    radial_load : float
-        Radial load ``F_r`` at which the secant stiffness is taken [N].
-    contact_angle : float
-        Contact angle ``alpha`` [rad] (0 for radial needle bearings).
-
-    Returns
-    -------
-    float
-        ``F_r / delta_r`` [N/mm].
-
-    Notes
-    -----
-    Palmgren's empirical line-contact approach per roller–race contact
-    ``delta = 3.84e-5 Q^0.9 / l^0.8`` [mm, N, mm]; inner + outer race give twice that. The most
-    loaded roller of a zero-clearance bearing carries ``Q_max = 4.08 F_r / (Z cos alpha)``
-    (Stribeck), and the bearing's radial deflection is ``delta_r = 2 delta(Q_max) / cos alpha``.
-
-    References
-    ----------
-    Palmgren A. (1959) *Ball and Roller Bearing Engineering*, 3rd ed.; Harris T.A., Kotzalas M.N.
-    (2007) *Rolling Bearing Analysis*, 5th ed., ch. 6.
-
-    Examples
-    --------
-    >>> round(palmgren_radial_stiffness(16, 14.0, 5000.0) / 1e5, 2)
-    8.62
-    """
-    if rollers < 3:
-        raise ParameterError("rollers", rollers, "must be >= 3")
-    if roller_length <= 0:
-        raise ParameterError("roller_length", roller_length, "must be > 0 mm")
-    if radial_load <= 0:
-        raise ParameterError("radial_load", radial_load, "must be > 0 N")
-    ca = np.cos(contact_angle)
-    q_max = 4.08 * radial_load / (rollers * ca)
-    delta = 2.0 * 3.84e-5 * q_max**0.9 / roller_length**0.8
-    return float(radial_load / (delta / ca))
-
-
-def iso6336_mesh_stiffness(face_width: float, c_gamma: float = 20.0) -> float:
-    """Mean involute mesh stiffness [N/mm] = ``c_gamma`` [N/(mm·µm)] × face width [mm] × 1000.
-
-    ISO 6336-1:2019, 9.3 gives ``c_gamma ≈ 20 N/(mm·µm)`` for solid steel spur gears.
-
-    Parameters
-    ----------
-    face_width : float
-        Face width of the mesh [mm].
-    c_gamma : float
-        Mesh stiffness per face width [N/(mm·µm)].
-
-    Returns
-    -------
-    float
-        Mean mesh stiffness [N/mm].
-
-    References
-    ----------
-    ISO 6336-1:2019, clause 9.3.
-    """
-    if face_width <= 0:
-        raise ParameterError("face_width", face_width, "must be > 0 mm")
-    return float(c_gamma * face_width / um_to_mm(1.0))  # N/µm → N/mm
 
 
 @dataclass(frozen=True)
@@ -240,6 +168,12 @@ class Cranks:
         ``k (|w| - c)`` along its radial deflection ``w`` and nothing while ``|w| <= c``.
     shaft_diameter, shaft_length : float or None
         Crankshaft envelope [mm] (needed only to derive its mass and inertia).
+    bending_compliance : tuple of float or None
+        Bending compliance of the crank at the cam of each disc [mm/N], one per disc, in series
+        with that cam's bearing; None: left out (rigid, named so by the stiffness chain).
+    torsional_stiffness : float or None
+        Torsional stiffness of one crank between its planet and its cams [N·mm/rad], in series
+        with the sun–planet mesh; None: left out.
     """
 
     count: int
@@ -251,6 +185,8 @@ class Cranks:
     carrier_bearing_clearance: float = 0.0
     shaft_diameter: float | None = None
     shaft_length: float | None = None
+    bending_compliance: tuple[float, ...] | None = None
+    torsional_stiffness: float | None = None
 
     def __post_init__(self) -> None:
         _check_int("cranks.count", self.count, 2, 6)
@@ -265,6 +201,10 @@ class Cranks:
             v = getattr(self, name)
             if not np.isfinite(v) or not 0.0 <= v <= 0.2:
                 raise ParameterError(f"cranks.{name}", v, "must be in [0, 0.2] mm")
+        if self.bending_compliance is not None:
+            _check_compliances("cranks.bending_compliance", self.bending_compliance)
+        if self.torsional_stiffness is not None:
+            _check_pos("cranks.torsional_stiffness", self.torsional_stiffness)
 
 
 @dataclass(frozen=True)
@@ -335,6 +275,12 @@ class PinRing:
         Per-pin radius error [mm] (positive = larger pin), shape ``(z_p,)``.
     radial_position_errors, tangential_position_errors : numpy.ndarray
         Per-pin centre position errors [mm] (radially outward, counter-clockwise), ``(z_p,)``.
+    seat_compliance : float or None
+        Compliance of a pin's seat in its housing groove [mm/N], in series with each pin–disc
+        contact; None: left out (rigid, named so by the stiffness chain).
+    bending_compliance : tuple of float or None
+        Bending compliance of a pin at the mid-plane of each disc [mm/N], one per disc, in
+        series with that disc's pin contacts; None: left out.
     """
 
     count: int
@@ -343,11 +289,17 @@ class PinRing:
     radius_errors: np.ndarray = field(default_factory=lambda: np.zeros(0))
     radial_position_errors: np.ndarray = field(default_factory=lambda: np.zeros(0))
     tangential_position_errors: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    seat_compliance: float | None = None
+    bending_compliance: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         _check_int("pins.count", self.count, 8, 200)
         _check_pos("pins.pin_radius", self.pin_radius)
         _check_pos("pins.circle_radius", self.circle_radius)
+        if self.seat_compliance is not None:
+            _check_compliances("pins.seat_compliance", (self.seat_compliance,))
+        if self.bending_compliance is not None:
+            _check_compliances("pins.bending_compliance", self.bending_compliance)
         for name in ("radius_errors", "radial_position_errors", "tangential_position_errors"):
             arr = np.asarray(getattr(self, name), dtype=float)
             if arr.size == 0:
@@ -373,15 +325,21 @@ class Supports:
         Radial clearance of the main bearings [mm] (Li 2023 ``ε_h``; used by the dynamics).
     carrier_outer_diameter, carrier_length : float or None
         Envelope of the carrier (output flange + end plate) [mm], needed only to derive its mass.
+    output_torsional_stiffness : float or None
+        Torsional stiffness of the carrier / output flange between the crank bores and the
+        output face [N·mm/rad], in series with the output rotation; None: left out.
     """
 
     carrier_radial_stiffness: float
     main_bearing_clearance: float = 0.0
     carrier_outer_diameter: float | None = None
     carrier_length: float | None = None
+    output_torsional_stiffness: float | None = None
 
     def __post_init__(self) -> None:
         _check_pos("supports.carrier_radial_stiffness", self.carrier_radial_stiffness)
+        if self.output_torsional_stiffness is not None:
+            _check_pos("supports.output_torsional_stiffness", self.output_torsional_stiffness)
         v = self.main_bearing_clearance
         if not np.isfinite(v) or not 0.0 <= v <= 0.2:
             raise ParameterError("supports.main_bearing_clearance", v, "must be in [0, 0.2] mm")
@@ -712,6 +670,12 @@ class RVReducer:
                 f"crank circle must lie inside the pin circle r_p = {self.pins.circle_radius} mm",
             )
         m, n = self.cranks.count, self.discs.count
+        for name, per_disc in (
+            ("cranks.bending_compliance", self.cranks.bending_compliance),
+            ("pins.bending_compliance", self.pins.bending_compliance),
+        ):
+            if per_disc is not None and len(per_disc) != n:
+                raise ParameterError(name, per_disc, f"needs one value per disc ({n})")
         err = self.errors if self.errors is not None else ManufacturingErrors.none(m, n)
         shapes = {
             "errors.planet": (err.planet.shape, (m, 2)),
@@ -771,16 +735,7 @@ class RVReducer:
 
     def with_errors(self, errors: ManufacturingErrors) -> RVReducer:
         """Copy with other errors."""
-        return RVReducer(
-            self.first_stage,
-            self.cranks,
-            self.discs,
-            self.pins,
-            self.supports,
-            self.rated_torque,
-            self.planets,
-            errors,
-        )
+        return dataclasses.replace(self, errors=errors)
 
     def replace(self, **changes) -> RVReducer:
         """Copy with some of the sections replaced (``discs=..., pins=...``)."""
@@ -1079,6 +1034,12 @@ def mass_properties(
 def _check_pos(name: str, v: float) -> None:
     if not np.isfinite(v) or v <= 0:
         raise ParameterError(name, v, "must be finite and > 0")
+
+
+def _check_compliances(name: str, v: tuple[float, ...]) -> None:
+    arr = np.asarray(v, dtype=float)
+    if arr.ndim != 1 or not np.all(np.isfinite(arr)) or np.any(arr < 0.0):
+        raise ParameterError(name, v, "must be finite compliances >= 0 [mm/N]")
 
 
 def _check_int(name: str, v: int, lo: int, hi: int | None = None) -> None:

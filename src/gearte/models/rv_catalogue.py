@@ -164,7 +164,11 @@ def _follow(reducer, theta, torques, law):
     system = assemble(reducer, np.full(torques.size, float(theta)))
     sol = solve_positions(system, torques, solver_law(reducer, system, law))
     # the torque resists the drive: the output turns against it; report angle along the torque
-    return -sol.q[:, system.layout.output_rotation]
+    angle = -sol.q[:, system.layout.output_rotation]
+    k_out = reducer.supports.output_torsional_stiffness
+    if k_out is not None:  # the output flange's wind-up, in series with the carrier rotation
+        angle = angle + np.asarray(torques, dtype=float) / k_out
+    return angle
 
 
 def torsion_test(

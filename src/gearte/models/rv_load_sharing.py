@@ -83,6 +83,9 @@ __all__ = [
     "contact_law",
     "PinContactLaw",
     "solver_law",
+    "pin_series_compliance",
+    "cam_row_stiffness",
+    "mesh_row_stiffness",
     "assemble",
     "LoadSharing",
     "load_sharing",
@@ -241,6 +244,11 @@ class PinContactLaw:
     stiffness : float
         Start value (or the constant of ``"linear"``) [N/mm]: finite and at least the
         plausibility floor of a linear stiffness (1 N/mm, ``gearte.limits.FLOORS``).
+    series_compliance : tuple of float
+        Linear compliance in series with every contact of each disc [mm/N] (pin seat + pin
+        bending, :func:`pin_series_compliance`); empty: none. It adds to ``a0`` of the log law
+        ``δ = F (a0 − a1 ln F)`` exactly (a linear spring carrying the same force), and to the
+        compliance of ``"linear"``.
     """
 
     name: str
@@ -249,6 +257,14 @@ class PinContactLaw:
     poisson_ratio: float
     face_width: float
     stiffness: float = 2.0e5
+    series_compliance: tuple[float, ...] = ()
+
+    def series_a0(self, a0: np.ndarray, disc: ArrayLike) -> np.ndarray:
+        """``a0`` [mm/N] of contacts of disc index ``disc`` (broadcast) plus their series
+        compliance."""
+        if not self.series_compliance:
+            return a0
+        return a0 + np.asarray(self.series_compliance, dtype=float)[np.asarray(disc)]
 
     def __post_init__(self) -> None:
         if not math.isfinite(self.stiffness):
@@ -320,8 +336,19 @@ class PinContactLaw:
     def for_system(self, system: RVSystem) -> ContactLaw:
         """The solver's :class:`~gearte.solvers.rv_equilibrium.ContactLaw` for ``system``."""
         if self.name == "linear":
-            return ContactLaw(kind="linear", stiffness=self.stiffness, name="linear")
+            k = self.stiffness
+            if any(c > 0.0 for c in self.series_compliance):
+                if len(set(self.series_compliance)) > 1:
+                    raise ParameterError(
+                        "series_compliance",
+                        self.series_compliance,
+                        "the 'linear' law takes one stiffness: discs with different pin "
+                        "compliances need a load-dependent law",
+                    )
+                k = 1.0 / (1.0 / k + self.series_compliance[0])
+            return ContactLaw(kind="linear", stiffness=k, name="linear")
         a0, a1, a2, a3 = self.law_coefficients(contact_phase(system))
+        a0 = self.series_a0(a0, system.contact_group)
         kind = "secant_per_disc" if self.name == "hu2020" else "secant_per_contact"
         return ContactLaw(kind=kind, stiffness=self.stiffness, a0=a0, a1=a1, a2=a2, a3=a3,
                           name=self.name)  # fmt: skip
@@ -360,6 +387,7 @@ def contact_law(
     elif law != "linear":
         check_law(law, "contact_law")
     d = reducer.discs
+    series = pin_series_compliance(reducer)
     return PinContactLaw(
         name=law,
         stage=cycloid_stage(reducer),
@@ -367,6 +395,7 @@ def contact_law(
         poisson_ratio=d.poisson_ratio,
         face_width=d.face_width,
         stiffness=stiffness,
+        series_compliance=tuple(float(c) for c in series) if np.any(series > 0.0) else (),
     )
 
 
@@ -538,6 +567,80 @@ def _row_pattern(n_cranks: int, n_discs: int) -> tuple[np.ndarray, np.ndarray]:
     return B0, index
 
 
+def cam_row_stiffness(reducer: RVReducer) -> np.ndarray:
+    """Stiffness of the cam-bearing rows of each disc [N/mm], ``(N,)``.
+
+    The cam (needle) bearing in series with the crank's bending at that cam
+    (:attr:`~gearte.geometry.rv.Cranks.bending_compliance`; none when left out):
+    ``1 / (1 / k_cam + c_bend,j)``.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` row stiffness [N/mm].
+    """
+    k = np.full(reducer.discs.count, float(reducer.cranks.cam_bearing_stiffness))
+    c = reducer.cranks.bending_compliance
+    return k if c is None else 1.0 / (1.0 / k + np.asarray(c, dtype=float))
+
+
+def mesh_row_stiffness(reducer: RVReducer) -> float:
+    """Stiffness of a sun–planet mesh row along its line of action [N/mm].
+
+    The mesh in series with the crank's torsion between planet and cams
+    (:attr:`~gearte.geometry.rv.Cranks.torsional_stiffness` ``k_t``; none when left out): a twist
+    ``F r_b2 / k_t`` of the planet against its cams moves the mesh point by ``F r_b2² / k_t``
+    along the line of action, so ``1 / (1 / k_m + r_b2² / k_t)``.
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    float
+        Row stiffness [N/mm].
+    """
+    k = float(reducer.first_stage.mesh_stiffness)
+    kt = reducer.cranks.torsional_stiffness
+    if kt is None:
+        return k
+    rb2 = reducer.first_stage.base_radii[1]
+    return 1.0 / (1.0 / k + rb2 * rb2 / kt)
+
+
+def pin_series_compliance(reducer: RVReducer) -> np.ndarray:
+    """Linear compliance in series with each disc's pin contacts [mm/N], ``(N,)``.
+
+    The pin's seat in its housing groove plus the pin's bending at that disc
+    (:attr:`~gearte.geometry.rv.PinRing.seat_compliance`,
+    :attr:`~gearte.geometry.rv.PinRing.bending_compliance`; 0 for those left out).
+
+    Parameters
+    ----------
+    reducer : RVReducer
+        The reducer description (:class:`gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` compliance [mm/N].
+    """
+    n = reducer.discs.count
+    c = np.zeros(n)
+    if reducer.pins.seat_compliance is not None:
+        c = c + float(reducer.pins.seat_compliance)
+    if reducer.pins.bending_compliance is not None:
+        c = c + np.asarray(reducer.pins.bending_compliance, dtype=float)
+    return c
+
+
 def _measured(design: float, measured: np.ndarray | None, index) -> float:
     """A bearing's clearance [mm]: the measured one of that bearing if given, else the design's."""
     return design if measured is None else float(measured[index])
@@ -597,12 +700,13 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
     for i in range(M):
         ks += [reducer.cranks.carrier_bearing_stiffness] * 2
         cs += [_measured(reducer.cranks.carrier_bearing_clearance, err.carrier_clearance, i)] * 2
+    k_cam = cam_row_stiffness(reducer)  # (N,): cam bearing in series with crank bending
     for i in range(M):
         for j in range(N):
-            ks += [reducer.cranks.cam_bearing_stiffness] * 2
+            ks += [float(k_cam[j])] * 2
             cam_c = _measured(reducer.cranks.cam_bearing_clearance, err.cam_clearance, (i, j))
             cs += [cam_c] * 2
-    ks += [reducer.first_stage.mesh_stiffness] * M
+    ks += [mesh_row_stiffness(reducer)] * M
     cs += [0.0] * M
 
     crank_ang = th[:, None] + 2.0 * np.pi * np.arange(M)[None, :] / M  # (P, M)

@@ -1,5 +1,6 @@
 """Figures of the ``rv_reducer`` study: pin-load map, peak pin load with/without errors, TE split,
-hysteresis curve with lost motion and rigidity. matplotlib is imported lazily (new_figure)."""
+hysteresis curve with lost motion and rigidity, compliance breakdown of the stiffness chain.
+matplotlib is imported lazily (new_figure)."""
 
 from __future__ import annotations
 
@@ -147,6 +148,29 @@ def _hysteresis(cat, rated: float) -> Figure:
     )
 
 
+def _compliance_shares(chain) -> Figure:
+    fig, ax = new_figure(figsize=(6.0, 3.6))
+    names = list(chain.shares)
+    shares = np.array([chain.shares[n] for n in names]) * 100.0
+    y = np.arange(len(names))[::-1]
+    ax.barh(y, shares, color=PALETTE[0])
+    ax.set_yticks(y, names)
+    for yi, v in zip(y, shares, strict=True):
+        ax.text(v, yi, f" {v:.1f} %", va="center", fontsize=7)
+    ax.set_xlabel("share of the output torsional compliance [%]")
+    ax.set_xlim(0.0, max(float(shares.max()) * 1.2, 1.0))
+    rig = format_quantity(Nmm_per_rad_to_Nm_per_arcmin(chain.rigidity), "N*m/arcmin")
+    ax.set_title(f"tangent rigidity at rated torque {rig}", fontsize=9)
+    left = ", ".join(chain.left_out) if chain.left_out else "none"
+    return Figure(
+        "Compliance breakdown",
+        "Share of each element of the stiffness chain in the output torsional compliance at "
+        "rated torque (its share of the strain energy of a torque increment; the shares sum to "
+        f"1). Left out (rigid, not described by the case): {left}.",
+        fig,
+    )
+
+
 def _compensation(comp) -> Figure:
     fig, axes = new_figure(1, 3, figsize=(9.0, 3.2))
     labels = ["before", "after"]
@@ -180,7 +204,11 @@ def figures(result) -> list[Figure]:
     if "catalogue" in result:
         cat = result["catalogue"].data["catalogue"]
         rated = Nm_to_Nmm(result["catalogue"]["rated_torque [N*m]"])
-        out += for_analysis("catalogue", [_hysteresis(cat, rated)])
+        figs = [_hysteresis(cat, rated)]
+        chain = result["catalogue"].data.get("stiffness_chain")
+        if chain is not None:
+            figs.append(_compliance_shares(chain))
+        out += for_analysis("catalogue", figs)
     if "compensation" in result:
         comp = result["compensation"].data["compensation"]
         out += for_analysis("compensation", [_compensation(comp)])

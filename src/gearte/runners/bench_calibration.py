@@ -669,7 +669,9 @@ def serial_reducer(reducer, stiffness_scale: float, clearances: tuple[float, flo
         The design.
     stiffness_scale : float
         Factor on the cam and carrier bearing stiffnesses, the carrier support stiffness, the
-        involute mesh stiffness and the Young's modulus of discs and pins [-] (1: the design).
+        involute mesh stiffness, the Young's modulus of discs and pins and every element of the
+        stiffness chain (crank bending and torsion, pin seat and bending, output flange) [-]
+        (1: the design).
     clearances : (float, float)
         Radial clearance of the cam and carrier crank bearings [mm].
 
@@ -681,15 +683,33 @@ def serial_reducer(reducer, stiffness_scale: float, clearances: tuple[float, flo
         raise ParameterError("stiffness_scale", stiffness_scale, "must be > 0")
     s = float(stiffness_scale)
     c, d, sup, fs = reducer.cranks, reducer.discs, reducer.supports, reducer.first_stage
+    p = reducer.pins
+
+    def soft(compliance):  # a compliance (or per-disc tuple) of the stiffness chain, scaled
+        if compliance is None:
+            return None
+        if isinstance(compliance, tuple):
+            return tuple(x / s for x in compliance)
+        return compliance / s
+
+    def stiff(k):
+        return None if k is None else s * k
+
     return reducer.replace(
         cranks=type(c)(**{**c.__dict__,
                           "cam_bearing_stiffness": s * c.cam_bearing_stiffness,
                           "carrier_bearing_stiffness": s * c.carrier_bearing_stiffness,
                           "cam_bearing_clearance": float(clearances[0]),
-                          "carrier_bearing_clearance": float(clearances[1])}),
+                          "carrier_bearing_clearance": float(clearances[1]),
+                          "bending_compliance": soft(c.bending_compliance),
+                          "torsional_stiffness": stiff(c.torsional_stiffness)}),
+        pins=type(p)(**{**p.__dict__,
+                        "seat_compliance": soft(p.seat_compliance),
+                        "bending_compliance": soft(p.bending_compliance)}),
         discs=type(d)(**{**d.__dict__, "youngs_modulus": s * d.youngs_modulus}),
         supports=type(sup)(**{**sup.__dict__,
-                              "carrier_radial_stiffness": s * sup.carrier_radial_stiffness}),
+                              "carrier_radial_stiffness": s * sup.carrier_radial_stiffness,
+                              "output_torsional_stiffness": stiff(sup.output_torsional_stiffness)}),
         first_stage=type(fs)(**{**fs.__dict__, "mesh_stiffness": s * fs.mesh_stiffness}),
     )  # fmt: skip
 

@@ -1007,21 +1007,44 @@ def calibrated_case_text(rcase, cal, case, closed=None, record=None) -> str:
     """The serial as an ``rv_reducer`` case: the drive's case with the clearances and the
     stiffness scale that reproduce the bench (``closed``, :func:`_close_loop`) as values of
     ``[reducer]``, and every estimate of the calibration as values of ``[bench_calibration]``."""
-    from gearte.geometry.rv import palmgren_radial_stiffness
+    from gearte.studies.rv_reducer import build_reducer
 
     data = rcase.model_dump(mode="json", exclude_none=True)
     red = data["reducer"]
     if closed is not None:
         sc = closed.stiffness_scale
+        # the design's stiffnesses as built (bearings linearised where the case says so), scaled
+        # and written as values: every element gearte.runners.bench_calibration.serial_reducer
+        # scales; those derived from dimensions through the Young's modulus (crank and pin
+        # bending, crank torsion) follow the scaled modulus
+        design = build_reducer(rcase.reducer)
+        palmgren = ("rollers", "roller_length_mm", "reference_load_N", "contact_angle_deg",
+                    "rows", "at_rated_torque")  # fmt: skip
+        built = {"cam_bearing": design.cranks.cam_bearing_stiffness,
+                 "carrier_bearing": design.cranks.carrier_bearing_stiffness}  # fmt: skip
         for key, c in zip(("cam_bearing", "carrier_bearing"), closed.clearances, strict=True):
             b = red["cranks"][key]
-            k = b.get("stiffness_N_per_mm")
-            if k is None:
-                k = palmgren_radial_stiffness(b.pop("rollers"), b.pop("roller_length_mm"),
-                                              b.pop("reference_load_N"))  # fmt: skip
-            b["stiffness_N_per_mm"] = float(sc * k)
+            for k in palmgren:
+                b.pop(k, None)
+            b["stiffness_N_per_mm"] = float(sc * built[key])
             b["radial_clearance_um"] = float(mm_to_um(c))
-        red["supports"]["carrier_radial_stiffness_N_per_mm"] *= sc
+        sup = red["supports"]
+        sup.pop("main_bearing", None)
+        sup["carrier_radial_stiffness_N_per_mm"] = float(
+            sc * design.supports.carrier_radial_stiffness
+        )
+        for sect, key in (
+            (sup, "output_flange_torsional_stiffness_Nm_per_rad"),
+            (red["cranks"], "bending_stiffness_N_per_mm"),
+            (red["cranks"], "torsional_stiffness_Nm_per_rad"),
+            (red["pins"], "bending_stiffness_N_per_mm"),
+            (red["pins"], "seat_stiffness_N_per_mm"),
+        ):
+            if key in sect:
+                sect[key] = float(sc * sect[key])
+        if "seat_length_mm" in red["pins"] and design.pins.seat_compliance is not None:
+            del red["pins"]["seat_length_mm"]  # derived at the design's rated torque
+            red["pins"]["seat_stiffness_N_per_mm"] = float(sc / design.pins.seat_compliance)
         red["discs"]["youngs_modulus_MPa"] *= sc
         fs = red["first_stage"]
         design_mesh = closed_design_mesh(rcase)

@@ -21,17 +21,23 @@ Case file layout (units in the keys)::
                                or backlash_um (j_t per mesh)
     [reducer.cranks]           count, circle_radius_mm, eccentricity_mm, shaft_diameter_mm,
                                shaft_length_mm, cam_bearing = {stiffness_N_per_mm | rollers,
-                               roller_length_mm, reference_load_N; radial_clearance_um},
-                               carrier_bearing = {...}
+                               roller_length_mm, reference_load_N, contact_angle_deg, rows;
+                               radial_clearance_um}, carrier_bearing = {...}; stiffness chain
+                               (docs/rv-stiffness-chain.md): bearing_span_mm |
+                               bending_stiffness_N_per_mm, torsion_length_mm |
+                               torsional_stiffness_Nm_per_rad
     [reducer.discs]            count, face_width_mm, equidistant_modification_mm,
                                shift_modification_mm, youngs_modulus_MPa, poisson_ratio,
                                crank_bore_diameter_mm, centre_bore_diameter_mm,
                                equidistant_modification_errors_um,
                                shift_modification_errors_um (one per disc)
     [reducer.pins]             count, pin_radius_mm, circle_radius_mm, radius_errors_um,
-                               radial_position_errors_um, tangential_position_errors_um (per pin)
-    [reducer.supports]         carrier_radial_stiffness_N_per_mm, main_bearing_clearance_um,
-                               carrier_outer_diameter_mm, carrier_length_mm
+                               radial_position_errors_um, tangential_position_errors_um (per pin);
+                               seat_length_mm | seat_stiffness_N_per_mm, support_span_mm |
+                               bending_stiffness_N_per_mm
+    [reducer.supports]         carrier_radial_stiffness_N_per_mm | main_bearing = {...},
+                               main_bearing_clearance_um, carrier_outer_diameter_mm,
+                               carrier_length_mm, output_flange_torsional_stiffness_Nm_per_rad
     [[reducer.errors]]         part, crank, disc, value_um, angle_deg (one per error:
                                sun_eccentricity, sun_assembly, planet_eccentricity, cam,
                                disc_crank_bore,
@@ -77,10 +83,9 @@ from gearte.geometry.rv import (
     PinRing,
     RVReducer,
     Supports,
-    iso6336_mesh_stiffness,
-    palmgren_radial_stiffness,
 )
 from gearte.io.schema import CaseBase, StrictModel, floored
+from gearte.models.rv_stiffness import iso6336_mesh_stiffness, roller_bearing_radial_stiffness
 from gearte.results import AnalysisResult, StudyResult
 from gearte.studies import _rv_dynamics as dyn
 from gearte.studies._yield import YieldSection
@@ -88,6 +93,7 @@ from gearte.studies.cycloid_stage import CompensationOptions as CycloidCompensat
 from gearte.studies.cycloid_stage import Errors as CycloidErrors
 from gearte.studies.cycloid_stage import GeometricTEOptions
 from gearte.units import (
+    NM_PER_RAD_TO_NMM_PER_RAD,
     Nm_to_Nmm,
     Nmm_per_rad_to_Nm_per_arcmin,
     Nmm_to_Nm,
@@ -134,26 +140,59 @@ class Bearing(StrictModel):
         "bearing_reference_load", None, le=1e7, description="load of the secant stiffness [N]"
     )
     radial_clearance_um: float = Field(default=0.0, ge=0, le=200, description="[um]")
+    contact_angle_deg: float = Field(
+        default=0.0, ge=0, lt=90, description="contact angle of the rollers (0: radial) [deg]"
+    )
+    rows: int = Field(default=1, ge=1, le=8, description="identical rows sharing the load [-]")
+    at_rated_torque: bool = Field(
+        default=False,
+        description="linearise at the bearing's largest load at rated torque (found by a fixed "
+        "point of the load sharing) instead of at reference_load_N",
+    )
 
     @model_validator(mode="after")
     def _one_way(self):
         palm = (self.rollers, self.roller_length_mm, self.reference_load_N)
         if self.stiffness_N_per_mm is not None:
-            if any(v is not None for v in palm):
+            if any(v is not None for v in palm) or self.at_rated_torque:
                 raise ValueError("give either stiffness_N_per_mm or the Palmgren data, not both")
-        elif any(v is None for v in palm):
+        elif self.rollers is None or self.roller_length_mm is None:
             raise ValueError(
-                "give stiffness_N_per_mm, or all of rollers, roller_length_mm, reference_load_N"
+                "give stiffness_N_per_mm, or rollers, roller_length_mm and reference_load_N (or "
+                "at_rated_torque = true)"
             )
+        elif (self.reference_load_N is None) == (not self.at_rated_torque):
+            raise ValueError("give reference_load_N or at_rated_torque = true (one)")
         return self
 
-    def stiffness(self) -> float:
+    def stiffness(self, load: float | None = None) -> float:
+        """Radial stiffness [N/mm]: the given one, or Palmgren/Stribeck at ``load`` [N]
+        (default ``reference_load_N``)."""
         if self.stiffness_N_per_mm is not None:
             return self.stiffness_N_per_mm
-        n, length, load = self.rollers, self.roller_length_mm, self.reference_load_N
+        n, length = self.rollers, self.roller_length_mm
+        load = self.reference_load_N if load is None else load
         if n is None or length is None or load is None:  # refused by _one_way
             raise ParameterError("stiffness_N_per_mm", None, "no stiffness and no Palmgren data")
-        return palmgren_radial_stiffness(n, length, load)
+        return float(
+            roller_bearing_radial_stiffness(
+                n, length, load, deg_to_rad(self.contact_angle_deg), self.rows
+            )
+        )
+
+    def source(self) -> str:
+        """How the stiffness was obtained (for the results)."""
+        if self.stiffness_N_per_mm is not None:
+            return "given"
+        at = (
+            "its largest load at rated torque"
+            if self.at_rated_torque
+            else f"{self.reference_load_N} N"
+        )
+        return (
+            f"derived: Palmgren/Stribeck from {self.rollers} rollers x {self.rows} row(s), "
+            f"l = {self.roller_length_mm} mm, alpha = {self.contact_angle_deg} deg, secant at {at}"
+        )
 
 
 class FirstStageSection(StrictModel):
@@ -420,8 +459,41 @@ class CranksSection(StrictModel):
     eccentricity_mm: float = Field(gt=0, le=50, description="Crank (cam) eccentricity a [mm].")
     cam_bearing: Bearing
     carrier_bearing: Bearing
-    shaft_diameter_mm: float | None = Field(default=None, gt=0, le=500, description="mass only")
+    shaft_diameter_mm: float | None = Field(
+        default=None, gt=0, le=500, description="crank shaft diameter (mass, bending, torsion)"
+    )
     shaft_length_mm: float | None = Field(default=None, gt=0, le=2000, description="mass only")
+    bearing_span_mm: float | None = Field(
+        default=None,
+        gt=0,
+        le=2000,
+        description="distance between a crank's two carrier bearings: crank bending derived "
+        "(simply supported, cams centred) [mm]",
+    )
+    bending_stiffness_N_per_mm: float | None = floored(
+        "linear_stiffness", None, le=1e10, description="given crank bending stiffness at a cam"
+    )
+    torsion_length_mm: float | None = Field(
+        default=None,
+        gt=0,
+        le=2000,
+        description="length of crank twisted between planet and cams: torsion derived [mm]",
+    )
+    torsional_stiffness_Nm_per_rad: float | None = floored(  # noqa: N815
+        "torsional_stiffness", None, le=1e10, description="given crank torsional stiffness"
+    )
+
+    @model_validator(mode="after")
+    def _chain(self):
+        for derived, given in (
+            ("bearing_span_mm", "bending_stiffness_N_per_mm"),
+            ("torsion_length_mm", "torsional_stiffness_Nm_per_rad"),
+        ):
+            if getattr(self, derived) is not None and getattr(self, given) is not None:
+                raise ValueError(f"give {derived} (derived) or {given}, not both")
+            if getattr(self, derived) is not None and self.shaft_diameter_mm is None:
+                raise ValueError(f"{derived} needs shaft_diameter_mm to derive the stiffness")
+        return self
 
 
 class DiscsSection(StrictModel):
@@ -482,6 +554,26 @@ class PinsSection(StrictModel):
     tangential_position_errors_um: list[float] | None = Field(
         None, description="Tangential position error of each pin centre, one per pin [µm]."
     )
+    seat_length_mm: float | None = Field(
+        default=None,
+        gt=0,
+        le=2000,
+        description="length over which a pin bears on its housing groove: seat stiffness "
+        "derived (Palmgren, tangent at the largest ideal pin force at rated torque) [mm]",
+    )
+    seat_stiffness_N_per_mm: float | None = floored(
+        "linear_stiffness", None, le=1e10, description="given pin seat stiffness"
+    )
+    support_span_mm: float | None = Field(
+        default=None,
+        gt=0,
+        le=2000,
+        description="span of a pin held at its ends: bending derived (simply supported, "
+        "discs centred) [mm]",
+    )
+    bending_stiffness_N_per_mm: float | None = floored(
+        "linear_stiffness", None, le=1e10, description="given pin bending stiffness at a disc"
+    )
 
     @model_validator(mode="after")
     def _lengths(self):
@@ -490,14 +582,31 @@ class PinsSection(StrictModel):
             v = getattr(self, name)
             if v is not None and len(v) != self.count:
                 raise ValueError(f"{name} needs one value per pin ({self.count}), got {len(v)}")
+        for derived, given in (
+            ("seat_length_mm", "seat_stiffness_N_per_mm"),
+            ("support_span_mm", "bending_stiffness_N_per_mm"),
+        ):
+            if getattr(self, derived) is not None and getattr(self, given) is not None:
+                raise ValueError(f"give {derived} (derived) or {given}, not both")
         return self
 
 
 class SupportsSection(StrictModel):
-    carrier_radial_stiffness_N_per_mm: float = floored(
+    carrier_radial_stiffness_N_per_mm: float | None = floored(
         "linear_stiffness",
+        None,
         le=1e10,
-        description="Radial stiffness of the carrier (output) support [N/mm].",
+        description="Radial stiffness of the carrier (output) support [N/mm] (or main_bearing).",
+    )
+    main_bearing: Bearing | None = Field(
+        default=None,
+        description="The carrier's main bearings (both rows): roller data or a stiffness.",
+    )
+    output_flange_torsional_stiffness_Nm_per_rad: float | None = floored(  # noqa: N815
+        "torsional_stiffness",
+        None,
+        le=1e12,
+        description="given torsional stiffness of the carrier / output flange [N·m/rad]",
     )
     main_bearing_clearance_um: float = Field(
         default=0.0,
@@ -507,6 +616,24 @@ class SupportsSection(StrictModel):
     )
     carrier_outer_diameter_mm: float | None = Field(default=None, gt=0, le=5000, description="mass")
     carrier_length_mm: float | None = Field(default=None, gt=0, le=5000, description="mass")
+
+    @model_validator(mode="after")
+    def _main(self):
+        if (self.carrier_radial_stiffness_N_per_mm is None) == (self.main_bearing is None):
+            raise ValueError("give carrier_radial_stiffness_N_per_mm or main_bearing (one)")
+        if self.main_bearing is not None and self.main_bearing.at_rated_torque:
+            raise ValueError(
+                "main_bearing.at_rated_torque: the output torque puts (almost) no radial load on "
+                "the main bearings; give their preload as reference_load_N"
+            )
+        return self
+
+    def main_stiffness(self) -> float:
+        """Radial stiffness of the carrier's main bearings [N/mm]."""
+        if self.main_bearing is not None:
+            return self.main_bearing.stiffness()
+        assert self.carrier_radial_stiffness_N_per_mm is not None  # noqa: S101 - _main
+        return self.carrier_radial_stiffness_N_per_mm
 
 
 _Part = Literal[
@@ -698,7 +825,7 @@ class ReducerSection(StrictModel):
                 problems.append(str(exc).replace("errors[0]", f"errors[{k}]"))
         if not problems:
             try:
-                build_reducer(self)
+                build_reducer(self, operating=False)
             except ParameterError as exc:
                 problems.append(str(exc))
         if problems:
@@ -1001,6 +1128,20 @@ class Case(CaseBase):
             for key in keys
             if not have[key]
         ]
+        if self.reducer.pins.seat_length_mm is not None and not have["reducer.rated_torque_Nm"]:
+            problems.append(
+                "reducer.pins.seat_length_mm needs reducer.rated_torque_Nm (the pin seat is "
+                "linearised at the largest pin force at rated torque), which the case does not give"
+            )
+        for name in ("cam_bearing", "carrier_bearing"):
+            if (
+                getattr(self.reducer.cranks, name).at_rated_torque
+                and not have["reducer.rated_torque_Nm"]
+            ):
+                problems.append(
+                    f"reducer.cranks.{name}.at_rated_torque needs reducer.rated_torque_Nm, which "
+                    "the case does not give"
+                )
         if problems:
             raise ValueError("; ".join(problems))
         return self
@@ -1019,7 +1160,9 @@ _GEAR_SET_KEYS = {
 }
 
 
-def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer:
+def build_reducer(
+    sec: ReducerSection, *, with_errors: bool = True, operating: bool = True
+) -> RVReducer:
     """The :class:`RVReducer` a case's ``[reducer]`` section describes.
 
     Parameters
@@ -1028,6 +1171,10 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         The validated ``[reducer]`` table.
     with_errors : bool
         Include the ``[[reducer.errors]]`` (``False``: the nominal reducer).
+    operating : bool
+        Linearise the bearings marked ``at_rated_torque`` at their largest load at rated torque
+        (:func:`_at_operating_load`); ``False``: at a first estimate (the case check, which
+        needs the geometry only).
 
     Returns
     -------
@@ -1038,7 +1185,7 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
     if fs.mesh_stiffness_N_per_mm is not None:
         mesh = fs.mesh_stiffness_N_per_mm
     elif fs.face_width_mm is not None:
-        mesh = iso6336_mesh_stiffness(fs.face_width_mm)
+        mesh = float(iso6336_mesh_stiffness(fs.face_width_mm))
     else:  # refused by FirstStageSection's validator
         raise ParameterError(
             "reducer.first_stage.face_width_mm", None, "give it or mesh_stiffness_N_per_mm"
@@ -1056,16 +1203,20 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         raise ParameterError(f"first_stage.{key}", exc.value, exc.reason) from None
     first = FirstStage(gears, mesh, fs.sun_support_stiffness_N_per_mm, fs.face_width_mm)
     c = sec.cranks
+    chain = _chain_inputs(sec)
+    f0 = _first_bearing_load(sec)
     cranks = Cranks(
         c.count,
         c.circle_radius_mm,
         c.eccentricity_mm,
-        c.cam_bearing.stiffness(),
-        c.carrier_bearing.stiffness(),
+        c.cam_bearing.stiffness(f0 if c.cam_bearing.at_rated_torque else None),
+        c.carrier_bearing.stiffness(f0 if c.carrier_bearing.at_rated_torque else None),
         um_to_mm(c.cam_bearing.radial_clearance_um),
         um_to_mm(c.carrier_bearing.radial_clearance_um),
         c.shaft_diameter_mm,
         c.shaft_length_mm,
+        chain["crank_bending"],
+        chain["crank_torsion"],
     )
     d = sec.discs
     if sec.contact_law is None:
@@ -1093,13 +1244,16 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
         arr(p.radius_errors_um),
         arr(p.radial_position_errors_um),
         arr(p.tangential_position_errors_um),
+        chain["pin_seat"],
+        chain["pin_bending"],
     )
     s = sec.supports
     supports = Supports(
-        s.carrier_radial_stiffness_N_per_mm,
+        s.main_stiffness(),
         um_to_mm(s.main_bearing_clearance_um),
         s.carrier_outer_diameter_mm,
         s.carrier_length_mm,
+        chain["output_flange"],
     )
     entries = [
         ErrorEntry(e.part, e.crank, e.disc, um_to_mm(e.value_um), deg_to_rad(e.angle_deg))
@@ -1122,6 +1276,8 @@ def build_reducer(sec: ReducerSection, *, with_errors: bool = True) -> RVReducer
     from gearte.models.rv_load_sharing import cycloid_stage
 
     cycloid_stage(red)  # the stage's own validation (undercut, interference, pin fit)
+    if operating and (c.cam_bearing.at_rated_torque or c.carrier_bearing.at_rated_torque):
+        red = _at_operating_load(red, sec)
     return red
 
 
@@ -1187,6 +1343,179 @@ def plausibility(case: Case) -> list[tuple[str, float, str]]:
         if got:
             out.append(got)
     return out
+
+
+def _first_bearing_load(sec: ReducerSection) -> float:
+    """First estimate of a crank bearing's load at rated torque [N]: ``T / (M R_dc)``, the
+    tangential force one crank passes to the carrier (1 kN without a rated torque: the case
+    check refuses ``at_rated_torque`` then)."""
+    if sec.rated_torque_Nm is None:
+        return 1.0e3
+    return float(Nm_to_Nmm(sec.rated_torque_Nm)) / (sec.cranks.count * sec.cranks.circle_radius_mm)
+
+
+def _at_operating_load(red: RVReducer, sec: ReducerSection, tol: float = 1e-4) -> RVReducer:
+    """``red`` with the ``at_rated_torque`` crank bearings linearised at their largest radial
+    load at rated torque over 36 output positions of the error-free design (a property of the
+    design: the measured errors of one reducer do not change its bearings' stiffness): a fixed
+    point (the load sharing depends on the stiffnesses it sets; Palmgren's stiffness grows as
+    ``F^0.1``, so it contracts in a few steps), to a relative load change below ``tol``.
+
+    Raises
+    ------
+    ParameterError
+        No rated torque (``reducer.rated_torque_Nm``).
+    """
+    import dataclasses
+
+    from gearte.models.rv_load_sharing import load_sharing, output_positions
+
+    if red.rated_torque is None:
+        raise ParameterError(
+            "reducer.rated_torque_Nm", None, "needed by a bearing linearised at_rated_torque"
+        )
+    torque = float(red.rated_torque)
+    c = sec.cranks
+    theta = output_positions(36)
+    f0 = _first_bearing_load(sec)
+    loads = {"cam": f0, "carrier": f0}
+    for _ in range(30):
+        cranks = dataclasses.replace(
+            red.cranks,
+            cam_bearing_stiffness=c.cam_bearing.stiffness(
+                loads["cam"] if c.cam_bearing.at_rated_torque else None
+            ),
+            carrier_bearing_stiffness=c.carrier_bearing.stiffness(
+                loads["carrier"] if c.carrier_bearing.at_rated_torque else None
+            ),
+        )
+        red = red.replace(cranks=cranks)
+        nominal = red.replace(  # no errors of any kind: the design
+            pins=dataclasses.replace(
+                red.pins,
+                radius_errors=np.zeros(0),
+                radial_position_errors=np.zeros(0),
+                tangential_position_errors=np.zeros(0),
+            ),
+            errors=ManufacturingErrors.none(c.count, sec.discs.count),
+        )
+        ls = load_sharing(nominal, torque, theta)
+        new = {
+            "cam": float(ls.cam_bearing_load.max()),
+            "carrier": float(ls.carrier_bearing_load.max()),
+        }
+        if all(abs(new[k] - loads[k]) <= tol * loads[k] for k in loads):
+            return red
+        loads = new
+    raise ConvergenceError(
+        f"bearing loads at rated torque did not settle: {loads} N (at_rated_torque bearings)"
+    )
+
+
+def _chain_inputs(sec: ReducerSection) -> dict[str, Any]:
+    """The stiffness-chain elements of the description, given or derived (None: left out).
+
+    Returns the crank bending compliance per disc [mm/N], the crank torsional stiffness
+    [N·mm/rad], the pin seat compliance [mm/N], the pin bending compliance per disc [mm/N] and
+    the output flange's torsional stiffness [N·mm/rad] (:mod:`gearte.models.rv_stiffness`).
+    """
+    from gearte.models.rv_stiffness import (
+        beam_point_compliance,
+        disc_load_positions,
+        ideal_peak_pin_force,
+        pin_seat_stiffness,
+        shaft_torsional_stiffness,
+    )
+
+    c, d, p, s = sec.cranks, sec.discs, sec.pins, sec.supports
+    E, nu = d.youngs_modulus_MPa, d.poisson_ratio
+    shaft = float("nan") if c.shaft_diameter_mm is None else c.shaft_diameter_mm  # checked
+    out: dict[str, Any] = dict.fromkeys(
+        ("crank_bending", "crank_torsion", "pin_seat", "pin_bending", "output_flange")
+    )
+
+    def span_positions(key: str, span: float) -> np.ndarray:
+        try:
+            return disc_load_positions(span, d.count, d.face_width_mm)
+        except ParameterError as exc:
+            raise ParameterError(key, span, exc.reason) from None
+
+    if c.bearing_span_mm is not None:
+        a = span_positions("reducer.cranks.bearing_span_mm", c.bearing_span_mm)
+        cb = beam_point_compliance(c.bearing_span_mm, a, shaft, E, nu)
+        out["crank_bending"] = tuple(float(x) for x in cb)
+    elif c.bending_stiffness_N_per_mm is not None:
+        out["crank_bending"] = (1.0 / c.bending_stiffness_N_per_mm,) * d.count
+    if c.torsion_length_mm is not None:
+        out["crank_torsion"] = float(shaft_torsional_stiffness(shaft, c.torsion_length_mm, E, nu))
+    elif c.torsional_stiffness_Nm_per_rad is not None:
+        out["crank_torsion"] = c.torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD
+    if p.seat_length_mm is not None:
+        if sec.rated_torque_Nm is None:  # refused by Case._inputs, naming both keys
+            return out
+        k1 = c.eccentricity_mm * p.count / (p.circle_radius_mm + d.shift_modification_mm)
+        if not 0.0 < k1 < 1.0:  # RVReducer refuses it next, naming cranks.eccentricity
+            return out
+        force = ideal_peak_pin_force(
+            Nm_to_Nmm(sec.rated_torque_Nm), 1.0 / d.count, k1, p.count - 1, p.circle_radius_mm
+        )
+        out["pin_seat"] = 1.0 / float(pin_seat_stiffness(force, p.seat_length_mm))
+    elif p.seat_stiffness_N_per_mm is not None:
+        out["pin_seat"] = 1.0 / p.seat_stiffness_N_per_mm
+    if p.support_span_mm is not None:
+        a = span_positions("reducer.pins.support_span_mm", p.support_span_mm)
+        pb = beam_point_compliance(p.support_span_mm, a, 2.0 * p.pin_radius_mm, E, nu)
+        out["pin_bending"] = tuple(float(x) for x in pb)
+    elif p.bending_stiffness_N_per_mm is not None:
+        out["pin_bending"] = (1.0 / p.bending_stiffness_N_per_mm,) * d.count
+    if s.output_flange_torsional_stiffness_Nm_per_rad is not None:
+        out["output_flange"] = (
+            s.output_flange_torsional_stiffness_Nm_per_rad * NM_PER_RAD_TO_NMM_PER_RAD
+        )
+    return out
+
+
+def chain_sources(sec: ReducerSection) -> dict[str, str]:
+    """Element of the stiffness chain → ``"given"``, ``"derived: <how>"`` or ``"left out"``."""
+    c, p, s, fs = sec.cranks, sec.pins, sec.supports, sec.first_stage
+
+    def pick(derived: Any, how: str, given: Any) -> str:
+        if derived is not None:
+            return f"derived: {how}"
+        return "given" if given is not None else "left out"
+
+    return {
+        "output_flange": "given"
+        if s.output_flange_torsional_stiffness_Nm_per_rad is not None
+        else "left out",
+        "main_bearing": "given" if s.main_bearing is None else s.main_bearing.source(),
+        "carrier_bearing": c.carrier_bearing.source(),
+        "crank_bending": pick(
+            c.bearing_span_mm,
+            "simply supported crank (Roark, bending + shear), cams centred in bearing_span_mm",
+            c.bending_stiffness_N_per_mm,
+        ),
+        "cam_bearing": c.cam_bearing.source(),
+        "pin_contact": f"contact law '{sec.contact_law}'",
+        "pin_seat": pick(
+            p.seat_length_mm,
+            "Palmgren line contact in the groove, tangent at the largest ideal pin force at "
+            "rated torque (Hu 2020 eq 30)",
+            p.seat_stiffness_N_per_mm,
+        ),
+        "pin_bending": pick(
+            p.support_span_mm,
+            "simply supported pin (Roark, bending + shear), discs centred in support_span_mm",
+            p.bending_stiffness_N_per_mm,
+        ),
+        "crank_torsion": pick(
+            c.torsion_length_mm, "G J / L over torsion_length_mm", c.torsional_stiffness_Nm_per_rad
+        ),
+        "first_stage_mesh": "given"
+        if fs.mesh_stiffness_N_per_mm is not None
+        else "derived: ISO 6336 c_gamma b",
+        "sun_support": "given",
+    }
 
 
 def build_stage_case(case: Case):
@@ -1277,12 +1606,22 @@ def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
             f"({pk.describe()}; less than half of its force turns the disc): the load there "
             "depends on the root geometry and on the pin-contact law more than on the torque path"
         )
+    from gearte.models.rv_stiffness_chain import left_out_elements
+
+    left_out = left_out_elements(red)
+    values["stiffness_chain_left_out"] = ", ".join(left_out) or "none"
     data = {"load": ls}
     notes = [
         "Pin loads from the quasi-static equilibrium of all parts (springs + unilateral pin "
         f"contacts with the '{ls.contact_law}' load-dependent stiffness), one output revolution; "
         "max_contact_pressure: Hertz line-contact pressure of each pin with its own flank "
-        "curvature.",
+        "curvature. Pin seat and pin bending are in series with each pin contact, crank bending "
+        "with the cam bearings, crank torsion with the mesh (docs/rv-stiffness-chain.md)"
+        + (
+            f"; left out (rigid: the case describes neither): {', '.join(left_out)}."
+            if left_out
+            else "."
+        ),
     ]
     if has_errors and sec.compare_without_errors:
         ls0 = load_sharing(red0, T, th, law=law)
@@ -1389,9 +1728,10 @@ def _te_csv(te) -> str:
     return "\n".join(rows) + "\n"
 
 
-def _catalogue(red, sec: CatalogueSection, law, fs_terms=None) -> AnalysisResult:
+def _catalogue(red, sec: CatalogueSection, law, fs_terms=None, sources=None) -> AnalysisResult:
     from gearte.models.rv_catalogue import catalogue_values
     from gearte.models.rv_first_stage import catalogue_with_free_angle, output_free_angle
+    from gearte.models.rv_stiffness_chain import stiffness_chain
 
     cat = catalogue_values(
         red,
@@ -1447,12 +1787,35 @@ def _catalogue(red, sec: CatalogueSection, law, fs_terms=None) -> AnalysisResult
         **fs_values,
         "contact_law": red.discs.contact_law,
     }
+    chain = stiffness_chain(red, theta=deg_to_rad(sec.position_deg), law=law)
+    values["tangent_rigidity_at_rated [N*m/arcmin]"] = Nmm_per_rad_to_Nm_per_arcmin(chain.rigidity)
+    values["compliance_shares"] = chain.shares
+    values["stiffness_chain_left_out"] = ", ".join(chain.left_out) or "none"
+    values["cam_bearing_load_at_rated [N]"] = chain.cam_bearing_load
+    values["carrier_bearing_load_at_rated [N]"] = chain.carrier_bearing_load
+    if sources is not None:
+        values["stiffness_sources"] = sources
+    chain_notes = [
+        "compliance_shares: each element's share of the tangent output torsional compliance at "
+        "rated torque (its share of the strain energy of a torque increment; sum 1), "
+        "tangent_rigidity_at_rated its inverse (docs/rv-stiffness-chain.md). Pin seat and pin "
+        "bending act in series with each pin contact, crank bending with each cam bearing, "
+        "crank torsion with the sun–planet mesh, the output flange with the output rotation: "
+        "all in the load-sharing solve and in the torsion test."
+    ]
+    if chain.left_out:
+        chain_notes.append(
+            "Left out of the stiffness chain (rigid: the case gives neither the element's data "
+            "nor its stiffness): " + ", ".join(chain.left_out) + "."
+        )
     return AnalysisResult(
         name="catalogue",
         title="Catalogue quantities from a virtual torsion test (input locked)",
         values=values,
         references=[],
+        data={"catalogue": cat, "stiffness_chain": chain},
         notes=[
+            *chain_notes,
             "Definitions as in the Nabtesco RV catalogue: rigidity = (T_r/2)/(θ(T_r) − θ(T_r/2)) "
             "averaged over both directions; lost motion = θ(+3% T_r) − θ(−3% T_r) at the "
             "curve midpoints; backlash = θ(0+) − θ(0−).",
@@ -1460,7 +1823,6 @@ def _catalogue(red, sec: CatalogueSection, law, fs_terms=None) -> AnalysisResult
             "backlash, so hysteresis loss = backlash.",
             *fs_notes,
         ],
-        data={"catalogue": cat},
     )
 
 
@@ -1621,7 +1983,15 @@ def run(case: Case, options=None, *, reducer: RVReducer | None = None) -> StudyR
     if a.transmission_error is not None:
         out.append(_transmission_error(red, a.transmission_error, law))
     if a.catalogue is not None:
-        out.append(_catalogue(red, a.catalogue, law, first_stage_terms(case.reducer.first_stage)))
+        out.append(
+            _catalogue(
+                red,
+                a.catalogue,
+                law,
+                first_stage_terms(case.reducer.first_stage),
+                chain_sources(case.reducer),
+            )
+        )
     if a.compensation is not None:
         out.append(_compensation(red, a.compensation))
     if a.yield_ is not None:

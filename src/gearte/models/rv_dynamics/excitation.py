@@ -193,6 +193,7 @@ def disc_rotation_error(
 
     def coefficients(phase):  # (a0, a1, power): the power part only for a power law
         a0, a1, a2, a3 = law.law_coefficients(phase)
+        a0 = law.series_a0(a0, np.arange(n_discs)[None, :, None])  # pin seat + bending in series
         return a0, a1, ((a2, a3) if np.any(a2 != 0.0) else None)
 
     nominal = reducer.replace(
