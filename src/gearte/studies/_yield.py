@@ -531,22 +531,38 @@ def grid_error(
     grid: GridCheck, model: Callable, ts: Any, *, n: int, seed: int, chunk_size: int
 ) -> dict[str, Any]:
     """The grid's error on the run's first ``grid.samples`` samples (the same draws as the
-    run: the first chunk's stream): each grid quantity's mean and largest change from the
+    run: its first chunks' streams): each grid quantity's mean and largest change from the
     default grid to the refined one, in its unit and relative to its mean.
 
     Returns ``{"quantities": {q: {...}}, "te_arcsec": float | None, "note": str,
     "warnings": [str]}``. The refined grid holds the default one's positions, so a
     peak-to-peak can only grow: the change is a lower bound of the default grid's error (the
     refined grid misses its own part).
+
+    Parameters
+    ----------
+    grid : GridCheck
+        The refined model, the grids and the samples to check.
+    model : callable
+        The yield model on the default grid.
+    ts : ToleranceSet
+        The run's tolerances.
+    n : int
+        The run's samples [-].
+    seed : int
+        The run's seed.
+    chunk_size : int
+        The run's samples per chunk [-].
     """
     from gearte.execution import seeded_chunks
     from gearte.tolerance.yield_mc import evaluate_checked
     from gearte.units import arcmin_to_rad, rad_to_arcsec
 
     m = min(int(grid.samples), int(n))
-    first = seeded_chunks(int(n), int(chunk_size), seed)[0]
-    drawn = ts.sample(first.rng(), first.size)
-    errs = {k: v[:m] for k, v in drawn.items()}
+    parts: list[dict[str, np.ndarray]] = []
+    for c in seeded_chunks(int(n), int(chunk_size), seed)[: -(-m // int(chunk_size))]:
+        parts.append(ts.sample(c.rng(), c.size))
+    errs = {k: np.concatenate([p[k] for p in parts])[:m] for k in parts[0]}
     a = evaluate_checked(model, errs, m)
     b = evaluate_checked(grid.refined(), errs, m)
     out: dict[str, dict[str, float]] = {}

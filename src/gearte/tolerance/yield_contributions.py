@@ -211,10 +211,20 @@ def _sobol_chunk(chunk: Any, shared: _SobolShared) -> dict[str, Any]:
 def sobol_estimates(
     f: np.ndarray, rows: np.ndarray | slice = slice(None)
 ) -> tuple[np.ndarray, np.ndarray, float]:
-    """First-order and total indices of every factor from the model runs ``f`` (``k + 2``, n):
-    rows ``f(A)``, ``f(B)``, ``f(A_B⁽ⁱ⁾)``; ``rows`` picks (or resamples) base samples.
+    """First-order and total indices of every factor from the model runs ``f``.
 
-    Returns ``(S, ST, V)``: zeros when the variance ``V`` is 0.
+    Parameters
+    ----------
+    f : numpy.ndarray
+        ``(k + 2, n)`` model outputs [unit of the quantity]: rows ``f(A)``, ``f(B)``,
+        ``f(A_B⁽ⁱ⁾)``.
+    rows : numpy.ndarray or slice
+        Base samples to use (a bootstrap resample) [-].
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, float)
+        ``(S, ST, V)`` [-, -, unit²]: zeros when the variance ``V`` is 0.
     """
     fa, fb, fab = f[0, rows], f[1, rows], f[2:, rows]
     both = np.concatenate([fa, fb])
