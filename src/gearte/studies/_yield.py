@@ -8,7 +8,8 @@ A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) 
     seed = 14
     confidence = 0.95           # of the yield's interval
     ci_method = "wilson"        # or "clopper-pearson"
-    sobol_samples = 2_000       # 0: no Sobol indices
+    sobol_samples = 2_048       # 0: none (a power of 2 keeps the Sobol' set balanced)
+    sobol_sampling = "qmc"      # scrambled Sobol' points; "mc": pseudo-random
     bootstrap = 100
     keep_worst = 3              # worst samples written as case files
 
@@ -21,8 +22,9 @@ A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) 
     phase = false               # rayleigh: also a uniform direction
     values_um = [...]           # empirical: measured deviations
 
-    [[analyses.yield.groups]]   # correlated errors (one batch)
+    [[analyses.yield.groups]]   # correlated errors (one batch): one factor of the Sobol
     name = "pins"; keys = ["pin_radius_error", "pin_circle_radius_error"]; rho = 0.8
+                                # indices ("pins"), the two tolerances' joint share
 
     [analyses.yield.spec."geometric_te [arcmin]"]
     upper = 1.0                 # and/or lower
@@ -32,8 +34,14 @@ A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) 
     costs.<error key> = {a = 1.0, b = 8.0, k = 1.0}
 
 Result (analysis ``yield``): ``yield``, ``yield_ci_low``, ``yield_ci_high``, ``cpk``,
-per-quantity statistics, ``sobol_first`` / ``sobol_total`` per tolerance (with CIs) beside
-``linear_share``, the worst samples (their drawn errors), and ``allocation``.
+per-quantity statistics (``non_finite_samples`` counted), ``sobol_first`` / ``sobol_total`` per
+independent factor (a tolerance family, or the families a correlated group joins:
+``sobol_factors``) with CIs, beside ``linear_share`` (each factor's share in the least-squares
+linear fit, ≤ its first-order index) and ``linear_r2``, the worst samples (their drawn errors),
+``allocation``, and, for a drive read on a grid of output positions,
+``te_discretisation_error [arcsec]`` and ``discretisation_error``; ``statistics_warnings``
+(a Sobol interval wider than 0.1, non-finite samples, a grid error above 2 %) are also the
+run's warnings.
 """
 
 from __future__ import annotations
