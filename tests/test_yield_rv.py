@@ -186,9 +186,7 @@ def test_han2023_yield_sobol_totals_sum_below_1_5_and_the_grid_error_is_reported
 
     data = tomllib.loads(case_path("han2023_rv110e_yield").read_text())
     assert data["analyses"]["yield"]["sobol_samples"] == 100
-    data["analyses"]["yield"].update(
-        samples=16, chunk_size=16, keep_worst=0, grid_check_samples=16
-    )
+    data["analyses"]["yield"].update(samples=16, chunk_size=16, keep_worst=0, grid_check_samples=16)
     res = gearte.run_case(load_case_dict(data, name="rv_sobol"), RunOptions(progress=False))
     v = res["yield"]
     assert v["sobol_sampling"] == "qmc" and v["sobol_samples"] == 100
