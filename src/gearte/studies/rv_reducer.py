@@ -867,7 +867,7 @@ class RVYieldSection(YieldSection):
     grid_check_samples: int = Field(
         default=32,
         ge=0,
-        le=10_000,
+        le=10**9,  # as samples: --samples caps it, never refused by it (at most the run's)
         description="Samples re-run on a refined grid of output positions to estimate the "
         "grid's error of the TE and pin loads (0: no check).",
     )
