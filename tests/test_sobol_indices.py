@@ -118,47 +118,66 @@ def test_factors_join_the_families_a_group_spans_and_keep_a_group_within_one_fam
     assert clash.factors() == {"pins + ring": ["pins", "ring"], "q": ["q"]}
 
 
-def _salib_errors(n: int, seeds: range):
-    """RMS errors of (S, ST) of Ishigami and of the correlated linear model: gearte's
-    estimator and SALib's (Sobol' sample + Saltelli/Jansen analysis), both n·(k + 2) runs."""
+def salib_indices(model: str, n: int, seed: int) -> np.ndarray:
+    """SALib's (S1…, ST…) of ``"ishigami"`` or ``"correlated linear"`` at ``n`` base samples:
+    its Sobol' sample without second order (n·(k + 2) runs, the cost of gearte's estimate) and
+    its Saltelli/Jansen analysis; the correlated pair given as a group of the copula's
+    independent uniforms (x1, x2 and the batch's common normal; x3)."""
     from SALib.analyze import sobol as salib_analyze
     from SALib.sample import sobol as salib_sample
     from scipy.special import ndtri
 
-    ours = {"ishigami": [], "linear": []}
-    theirs = {"ishigami": [], "linear": []}
-    p_ish = {"num_vars": 3, "names": ["x1", "x2", "x3"], "bounds": [[-math.pi, math.pi]] * 3}
-    # the correlated model in SALib: its independent uniforms (x1, x2 and the batch's common
-    # normal, one group; x3) through the same Gaussian copula
-    p_lin = {
-        "num_vars": 4,
-        "names": ["u1", "u2", "ug", "u3"],
-        "bounds": [[0.0, 1.0]] * 4,
-        "groups": ["batch", "batch", "batch", "x3"],
-    }
-    truth_ish = np.r_[list(ISHIGAMI_S.values()), list(ISHIGAMI_ST.values())]
-    truth_lin = np.r_[GROUP_SHARE, 1 - GROUP_SHARE, GROUP_SHARE, 1 - GROUP_SHARE]
-    for s in seeds:
-        r = sobol_tolerances(Ishigami(), ISHIGAMI_SET, ["y"], n, seed=s, bootstrap=0)["y"]
-        ours["ishigami"].append(np.r_[list(r.first.values()), list(r.total.values())] - truth_ish)
-        r = sobol_tolerances(CorrelatedLinear(), CORRELATED_SET, ["y"], n, seed=s, bootstrap=0)
-        r = r["y"]
-        ours["linear"].append(np.r_[list(r.first.values()), list(r.total.values())] - truth_lin)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            X = salib_sample.sample(p_ish, n, calc_second_order=False, seed=s)
-            a = salib_analyze.analyze(
-                p_ish, _ishigami(*X.T), calc_second_order=False, num_resamples=2, seed=s
-            )
-            theirs["ishigami"].append(np.r_[a["S1"], a["ST"]] - truth_ish)
-            U = salib_sample.sample(p_lin, n, calc_second_order=False, seed=s)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if model == "ishigami":
+            p = {"num_vars": 3, "names": ["x1", "x2", "x3"], "bounds": [[-math.pi, math.pi]] * 3}
+            X = salib_sample.sample(p, n, calc_second_order=False, seed=seed)
+            assert X.shape[0] == n * (3 + 2)
+            y = _ishigami(*X.T)
+        else:
+            p = {
+                "num_vars": 4,
+                "names": ["u1", "u2", "ug", "u3"],
+                "bounds": [[0.0, 1.0]] * 4,
+                "groups": ["batch", "batch", "batch", "x3"],
+            }
+            U = salib_sample.sample(p, n, calc_second_order=False, seed=seed)
+            assert U.shape[0] == n * (2 + 2)  # two factors: the group and x3
             z = ndtri(np.clip(U, 2.0**-54, 1 - 2.0**-54))
             x1 = math.sqrt(RHO) * z[:, 2] + math.sqrt(1 - RHO) * z[:, 0]
             x2 = math.sqrt(RHO) * z[:, 2] + math.sqrt(1 - RHO) * z[:, 1]
             y = x1 + 2 * x2 + z[:, 3]
-            a = salib_analyze.analyze(p_lin, y, calc_second_order=False, num_resamples=2, seed=s)
-            theirs["linear"].append(np.r_[a["S1"], a["ST"]] - truth_lin)
-        assert X.shape[0] == n * (3 + 2) and U.shape[0] == n * (2 + 2)  # the same cost
+        a = salib_analyze.analyze(p, y, calc_second_order=False, num_resamples=2, seed=seed)
+    return np.r_[a["S1"], a["ST"]]
+
+
+#: Closed-form (S1…, ST…) of the two models, in the order of their factors.
+TRUTH = {
+    "ishigami": np.r_[list(ISHIGAMI_S.values()), list(ISHIGAMI_ST.values())],
+    "correlated linear": np.r_[GROUP_SHARE, 1 - GROUP_SHARE, GROUP_SHARE, 1 - GROUP_SHARE],
+}
+MODELS = {
+    "ishigami": (Ishigami(), ISHIGAMI_SET),
+    "correlated linear": (CorrelatedLinear(), CORRELATED_SET),
+}
+
+
+def gearte_indices(model: str, n: int, seed: int, sampling: str = "qmc") -> np.ndarray:
+    """gearte's (S1…, ST…) of one of :data:`MODELS` at ``n`` base samples."""
+    f, ts = MODELS[model]
+    r = sobol_tolerances(f, ts, ["y"], n, seed=seed, bootstrap=0, sampling=sampling)["y"]
+    return np.r_[list(r.first.values()), list(r.total.values())]
+
+
+def _salib_errors(n: int, seeds: range):
+    """RMS errors of (S, ST) of both models: gearte's estimator and SALib's, both n·(k + 2)
+    runs."""
+    ours: dict[str, list[np.ndarray]] = {k: [] for k in MODELS}
+    theirs: dict[str, list[np.ndarray]] = {k: [] for k in MODELS}
+    for s in seeds:
+        for k in MODELS:
+            ours[k].append(gearte_indices(k, n, s) - TRUTH[k])
+            theirs[k].append(salib_indices(k, n, s) - TRUTH[k])
     rms = {k: float(np.sqrt(np.mean(np.square(v)))) for k, v in ours.items()}
     rms_salib = {k: float(np.sqrt(np.mean(np.square(v)))) for k, v in theirs.items()}
     return rms, rms_salib
