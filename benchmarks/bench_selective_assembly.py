@@ -66,11 +66,14 @@ def main() -> None:
         print(
             f"gearte rv_lot, {v['reducers']} reducers, {v['pairings_scored']} pairings × "
             f"orientations: {wall:.1f} s wall ({cpu:.1f} s CPU) end to end; scoring "
-            f"{v['scoring_time [s]']:.2f} s, assignment {v['assignment_time [s]']:.2f} s"
+            f"{v['scoring_time [s]']:.2f} s, assignment {v['assignment_time [s]']:.2f} s, "
+            f"full-model re-scoring {v['rescoring_time [s]']:.2f} s "
+            f"({v['full_model_evaluations']} solves, {v['rescoring_rounds']} rounds, certified: "
+            f"{v['rescoring_certified']})"
         )
         print(
-            f"  in spec: optimiser {v['reducers_in_spec']} (full model "
-            f"{v['reducers_in_spec_full_model']}), orientation only "
+            f"  in spec: optimiser {v['reducers_in_spec']} by the full model (first, "
+            f"linearised round claimed {v['reducers_in_spec_linearised_only']}), orientation only "
             f"{v['reducers_in_spec_orientation_only']}, random mean "
             f"{v['reducers_in_spec_random_mean']:.2f}"
         )

@@ -576,8 +576,11 @@ def normal_clearance_unclosed(
     phi = np.asarray(phi, dtype=float)
     K1 = _k1(z_p, r_p, a, dr_p, k1_definition)
     S = _S(K1, phi)
+    out = dr_rp - dr_p * (1.0 - K1 * np.cos(phi)) / S
+    if np.ndim(rotation) == 0 and rotation == 0.0:  # the arm's term is 0: skip it (same bits)
+        return out
     l_abs = np.abs(normal_arm(phi, z_p=z_p, a=a, K1=K1))
-    return dr_rp - dr_p * (1.0 - K1 * np.cos(phi)) / S + l_abs * rotation
+    return out + l_abs * rotation
 
 
 def closing_rotation(

@@ -74,7 +74,7 @@ def _pareto(a: Any) -> Figure | None:
         lw=1,
     )
     ax.plot(x, s1, "o", color=PALETTE[2], label="first-order Sobol index")
-    ax.plot(x, lin, "x", color=PALETTE[1], ms=8, mew=2, label="linear (sensitivity × σ) share")
+    ax.plot(x, lin, "x", color=PALETTE[1], ms=8, mew=2, label="linear share (least squares)")
     ax.plot(
         x,
         [r["cumulative_total_share"] for r in rows],
@@ -88,10 +88,12 @@ def _pareto(a: Any) -> Figure | None:
     ax.legend(fontsize=8)
     return Figure(
         "Which tolerance drives the spread",
-        f"Contribution Pareto of {a.values.get('sobol_quantity')}: total Sobol index per tolerance "
-        "(bars, bootstrap interval), first-order index (dots) and the linear prediction "
-        "(crosses). A cross far from its bar marks non-linear physics (clearances, contact "
-        "loss, amplitudes).",
+        f"Contribution Pareto of {a.values.get('sobol_quantity')}: total Sobol index per "
+        "independent factor (a tolerance family, or the families a correlated group joins; "
+        "bars, bootstrap interval), first-order index (dots) and the linear share (crosses, "
+        "the factor's share in the least-squares linear fit). A cross below its dot is what "
+        "is non-linear in that factor alone (clearances, contact loss, amplitudes); a bar "
+        "above its dot, its interactions with the others.",
         fig,
     )
 

@@ -259,14 +259,14 @@ def batch_inputs(model, p: RVBatchPlan, errors: Mapping[str, np.ndarray], n: int
             dr_p=red.discs.shift_modification + b_p,
             **kw,
         )
-        for s in range(n):
-            new = normal_clearance_unclosed(
-                phi,
-                dr_rp=red.discs.equidistant_modification + d_rp[s],
-                dr_p=red.discs.shift_modification + d_p[s],
-                **kw,
-            )
-            gap[s, :, j * zp : (j + 1) * zp] += new - nominal
+        # every sample at once: its modifications broadcast against the (positions, pins) phases
+        new = normal_clearance_unclosed(
+            phi[None],
+            dr_rp=red.discs.equidistant_modification + d_rp[:, None, None],
+            dr_p=red.discs.shift_modification + d_p[:, None, None],
+            **kw,
+        )
+        gap[:, :, j * zp : (j + 1) * zp] += new - nominal[None]
     return h, en, gap
 
 

@@ -292,6 +292,15 @@ class RVReducerYield:
         "max_contact_pressure [MPa]",
     )
 
+    #: The outputs read on the grid of output positions (their grid error can be estimated by
+    #: the same model at more positions).
+    grid_quantities: tuple[str, ...] = (
+        "angular_te [arcmin]",
+        "loaded_te [arcmin]",
+        "peak_pin_load [N]",
+        "max_contact_pressure [MPa]",
+    )
+
     def __init__(
         self,
         reducer,

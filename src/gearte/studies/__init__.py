@@ -189,6 +189,8 @@ def run_case(
             # every chunk's result): stop as before, keeping nothing
             raise _stopped(stop, None) from None
     t_end = time.perf_counter()
+    for a in result.analyses:  # a sampled analysis' statistics it could not vouch for
+        result.warnings += [f"{a.name}: {w}" for w in a.values.get("statistics_warnings") or ()]
     result.elapsed_s = t_end - t0
     result.timings["imports: study kind"] = t_pre - t_imp
     result.timings["preflight"] = t0 - t_pre

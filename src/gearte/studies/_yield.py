@@ -8,7 +8,8 @@ A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) 
     seed = 14
     confidence = 0.95           # of the yield's interval
     ci_method = "wilson"        # or "clopper-pearson"
-    sobol_samples = 2_000       # 0: no Sobol indices
+    sobol_samples = 2_048       # 0: none (a power of 2 keeps the Sobol' set balanced)
+    sobol_sampling = "qmc"      # scrambled Sobol' points; "mc": pseudo-random
     bootstrap = 100
     keep_worst = 3              # worst samples written as case files
 
@@ -21,8 +22,9 @@ A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) 
     phase = false               # rayleigh: also a uniform direction
     values_um = [...]           # empirical: measured deviations
 
-    [[analyses.yield.groups]]   # correlated errors (one batch)
+    [[analyses.yield.groups]]   # correlated errors (one batch): one factor of the Sobol
     name = "pins"; keys = ["pin_radius_error", "pin_circle_radius_error"]; rho = 0.8
+                                # indices ("pins"), the two tolerances' joint share
 
     [analyses.yield.spec."geometric_te [arcmin]"]
     upper = 1.0                 # and/or lower
@@ -32,8 +34,14 @@ A kind that has a yield model of its drive (:mod:`gearte.runners.yield_models`) 
     costs.<error key> = {a = 1.0, b = 8.0, k = 1.0}
 
 Result (analysis ``yield``): ``yield``, ``yield_ci_low``, ``yield_ci_high``, ``cpk``,
-per-quantity statistics, ``sobol_first`` / ``sobol_total`` per tolerance (with CIs) beside
-``linear_share``, the worst samples (their drawn errors), and ``allocation``.
+per-quantity statistics (``non_finite_samples`` counted), ``sobol_first`` / ``sobol_total`` per
+independent factor (a tolerance family, or the families a correlated group joins:
+``sobol_factors``) with CIs, beside ``linear_share`` (each factor's share in the least-squares
+linear fit, ≤ its first-order index) and ``linear_r2``, the worst samples (their drawn errors),
+``allocation``, and, for a drive read on a grid of output positions,
+``te_discretisation_error [arcsec]`` and ``discretisation_error``; ``statistics_warnings``
+(a Sobol interval wider than 0.1, non-finite samples, a grid error above 2 %) are also the
+run's warnings.
 """
 
 from __future__ import annotations
@@ -42,6 +50,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal, NamedTuple
 
+import numpy as np
 from pydantic import Field, model_validator
 
 from gearte.io.schema import StrictModel, floored
@@ -54,6 +63,8 @@ __all__ = [
     "eccentricity_grade_tolerance",
     "yield_analysis",
     "to_toml",
+    "GridCheck",
+    "grid_error",
 ]
 
 
@@ -336,6 +347,11 @@ class YieldSection(StrictModel):
         le=10**7,
         description="Base samples for Sobol indices per tolerance (0: none).",
     )
+    sobol_sampling: Literal["qmc", "mc"] = Field(
+        "qmc",
+        description="Points of the Sobol estimate: Owen-scrambled Sobol' (qmc) or pseudo-random "
+        "(mc).",
+    )
     bootstrap: int = Field(
         default=100,
         ge=0,
@@ -498,6 +514,97 @@ def to_toml(data: Mapping[str, Any], _prefix: str = "") -> str:
     return out
 
 
+class GridCheck(NamedTuple):
+    """How to estimate the error of a yield model's grid of output positions.
+
+    ``refined``: the same drive's model on the refined grid (``refined_positions``, a multiple
+    of ``positions``, so the grid holds every position of the default one); ``samples``: how
+    many of the run's first samples are evaluated on both grids (0: no check); ``quantities``:
+    the outputs read on the grid; ``te``: the one reported as ``te_discretisation_error
+    [arcsec]`` (an angle in arcmin)."""
+
+    refined: Callable
+    positions: int
+    refined_positions: int
+    samples: int
+    quantities: tuple[str, ...]
+    te: str | None = None
+
+
+#: A grid whose mean relative error exceeds this [-] is named in the statistics warnings.
+GRID_WARN_RELATIVE = 0.02
+
+
+def grid_error(
+    grid: GridCheck, model: Callable, ts: Any, *, n: int, seed: int, chunk_size: int
+) -> dict[str, Any]:
+    """The grid's error on the run's first ``grid.samples`` samples (the same draws as the
+    run: its first chunks' streams): each grid quantity's mean and largest change from the
+    default grid to the refined one, in its unit and relative to its mean.
+
+    Returns ``{"quantities": {q: {...}}, "te_arcsec": float | None, "note": str,
+    "warnings": [str]}``. The refined grid holds the default one's positions, so a
+    peak-to-peak can only grow: the change is a lower bound of the default grid's error (the
+    refined grid misses its own part).
+
+    Parameters
+    ----------
+    grid : GridCheck
+        The refined model, the grids and the samples to check.
+    model : callable
+        The yield model on the default grid.
+    ts : ToleranceSet
+        The run's tolerances.
+    n : int
+        The run's samples [-].
+    seed : int
+        The run's seed.
+    chunk_size : int
+        The run's samples per chunk [-].
+    """
+    from gearte.execution import seeded_chunks
+    from gearte.tolerance.yield_mc import evaluate_checked
+    from gearte.units import arcmin_to_rad, rad_to_arcsec
+
+    m = min(int(grid.samples), int(n))
+    parts: list[dict[str, np.ndarray]] = []
+    for c in seeded_chunks(int(n), int(chunk_size), seed)[: -(-m // int(chunk_size))]:
+        parts.append(ts.sample(c.rng(), c.size))
+    errs = {k: np.concatenate([p[k] for p in parts])[:m] for k in parts[0]}
+    a = evaluate_checked(model, errs, m)
+    b = evaluate_checked(grid.refined(), errs, m)
+    out: dict[str, dict[str, float]] = {}
+    warn: list[str] = []
+    for q in grid.quantities:
+        d = b[q] - a[q]
+        mean_ref = float(np.mean(b[q]))
+        rel = float(np.mean(d) / mean_ref) if mean_ref != 0 else 0.0
+        out[q] = {
+            "mean": float(np.mean(d)),
+            "max": float(np.max(np.abs(d))),
+            "relative_mean": rel,
+            "positions": grid.positions,
+            "refined_positions": grid.refined_positions,
+            "samples": m,
+        }
+        if abs(rel) > GRID_WARN_RELATIVE:
+            warn.append(
+                f"{q}: {grid.positions} output positions under-estimate it by {abs(rel):.1%} "
+                f"on average against {grid.refined_positions} ({m} samples); raise positions"
+            )
+    te = None
+    if grid.te is not None and grid.te in out:
+        te = float(rad_to_arcsec(arcmin_to_rad(out[grid.te]["mean"])))
+    note = (
+        f"Grid of output positions: the run's first {m} samples again at "
+        f"{grid.refined_positions} positions (a superset of the {grid.positions}); the "
+        "mean change is the default grid's discretisation error (a lower bound)"
+        + (f": {grid.te} +{te:.3g}″" if te is not None else "")
+        + "."
+    )
+    return {"quantities": out, "te_arcsec": te, "note": note, "warnings": warn}
+
+
 def yield_inputs(
     section: YieldSection,
     units: Mapping[str, str],
@@ -568,6 +675,7 @@ def yield_analysis(
     defaults: Mapping[str, ToleranceEntry] | None = None,
     families: Mapping[str, list[str]] | None = None,
     grade_um: GradeReader | None = None,
+    grid: GridCheck | None = None,
 ) -> AnalysisResult:
     """Run the yield analysis of a drive.
 
@@ -598,14 +706,14 @@ def yield_analysis(
         derivation) for errors that are a gear's eccentricity (``None`` for the others): how
         ``grade = N`` reads for this drive. A tolerance read from a grade is reported with its
         ``grade`` and ``derived_from`` under ``tolerances`` in the result.
+    grid : GridCheck, optional
+        A drive whose quantities are read on a grid of output positions: the same model on a
+        refined grid, run on the run's first samples to estimate the grid's error
+        (``te_discretisation_error [arcsec]`` and ``discretisation_error``).
     """
     from gearte.studies import sample_cap
     from gearte.tolerance.allocation import allocate
-    from gearte.tolerance.yield_contributions import (
-        linear_prediction,
-        pareto_rows,
-        sobol_tolerances,
-    )
+    from gearte.tolerance.yield_contributions import pareto_rows, sobol_tolerances
     from gearte.tolerance.yield_mc import SpecLimit, run_yield
 
     seed = section.seed if getattr(options, "seed", None) is None else int(options.seed)
@@ -644,15 +752,18 @@ def yield_analysis(
             "max": st.stats.max,
             "cpk": st.cpk,
             "fail_fraction": st.fail_fraction,
+            "non_finite_samples": st.non_finite,
         }
         for q, st in res.quantities.items()
     }
+    stat_warnings: list[str] = list(res.warnings)
     values: dict[str, Any] = {
         "yield": res.yield_,
         "yield_ci_low": res.ci[0],
         "yield_ci_high": res.ci[1],
         "cpk": res.cpk,
         "samples": res.n,
+        "non_finite_samples": res.non_finite_samples,
         "seed": seed,
         "spec": {s.quantity: {"lower": s.lower, "upper": s.upper} for s in spec},
         "quantities": quantities,
@@ -686,25 +797,37 @@ def yield_analysis(
             bootstrap=sample_cap(section, "bootstrap", options),
             options=options,
             progress=progress,
+            sampling=section.sobol_sampling,
         )[sobol_q]
-        lin = linear_prediction(model, ts, [sobol_q])[sobol_q]
         values.update(
             {
                 "sobol_quantity": sobol_q,
+                "sobol_samples": sob.n,
+                "sobol_sampling": sob.sampling,
+                "sobol_factors": sob.factors,
                 "sobol_first": sob.first,
                 "sobol_total": sob.total,
                 "sobol_first_ci": {k: list(v) for k, v in sob.first_ci.items()},
                 "sobol_total_ci": {k: list(v) for k, v in sob.total_ci.items()},
-                "linear_share": lin.share,
-                "linear_sd": lin.sd,
+                "sobol_non_finite_samples": sob.non_finite,
+                "linear_share": sob.linear_share,
+                "linear_r2": sob.linear_r2,
                 "monte_carlo_sd": res.quantities[sobol_q].stats.sd,
             }
         )
-        data["pareto"] = pareto_rows(sob, lin)
+        stat_warnings += sob.warnings
+        data["pareto"] = pareto_rows(sob)
+        joined = "; ".join(f"{k} = {' + '.join(v)}" for k, v in sob.factors.items() if len(v) > 1)
+        points = "a scrambled Sobol' set" if sob.sampling == "qmc" else "pseudo-random draws"
         notes.append(
-            "Sobol indices (Saltelli 2010 first order, Jansen total) with percentile-bootstrap "
-            "intervals, beside the linear (sensitivity × σ) share; where they differ the "
-            "physics is non-linear."
+            "Sobol indices per independent factor (a tolerance family; the families a "
+            "correlated group joins are one factor"
+            + (f": {joined}" if joined else "")
+            + f"), {sob.n} base samples on {points}"
+            + "; first order Saltelli 2010, total Jansen 1999, percentile-bootstrap "
+            "intervals. Beside them the linear share: each factor's share of the variance in "
+            "the least-squares linear fit over the Sobol runs (≤ S; S − linear share is what is "
+            "non-linear in that factor alone, ST − S its interactions; linear_r2 the fit's R²)."
         )
     worst = []
     for i, w in enumerate(res.worst):
@@ -724,6 +847,13 @@ def yield_analysis(
             )
             files[f"worst_sample_{i + 1}.toml"] = header + to_toml(case)
     values["worst_samples"] = worst
+    if grid is not None and grid.samples > 0:
+        g = grid_error(grid, model, ts, n=n, seed=seed, chunk_size=section.chunk_size)
+        values["discretisation_error"] = g["quantities"]
+        if g["te_arcsec"] is not None:
+            values["te_discretisation_error [arcsec]"] = g["te_arcsec"]
+        notes.append(g["note"])
+        stat_warnings += g["warnings"]
     if section.allocation is not None:
         # under --samples: capped, but never below what can show the target (validated above)
         alloc_n = sample_cap(section.allocation, "samples", options) or n
@@ -754,6 +884,7 @@ def yield_analysis(
             "locally_optimal": al.locally_optimal,
             "yield_if_loosened_one_step": al.loosening_yields,
         }
+    values["statistics_warnings"] = stat_warnings
     return AnalysisResult(
         name="yield",
         title="Production yield: tolerance Monte-Carlo through the physics",

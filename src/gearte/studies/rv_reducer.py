@@ -1003,6 +1003,19 @@ class RVYieldSection(YieldSection):
     ``pins.radius_errors.p7``, ``disc_radial_runout.d1``)."""
 
     positions: int = Field(default=36, ge=2, le=3600, description="TE output positions")
+    grid_check_samples: int = Field(
+        default=32,
+        ge=0,
+        le=10**9,  # as samples: --samples caps it, never refused by it (at most the run's)
+        description="Samples re-run on a refined grid of output positions to estimate the "
+        "grid's error of the TE and pin loads (0: no check).",
+    )
+    grid_check_factor: int = Field(
+        default=10,
+        ge=2,
+        le=100,
+        description="The refined grid: this many times positions (a superset of the grid).",
+    )
     te_torque_Nm: float | None = floored(
         "load_torque", None, le=1e6, description="torque of the loaded TE; default rated"
     )
@@ -2094,6 +2107,26 @@ def _yield_model(case: Case, red, sec: RVYieldSection):
     return model, None
 
 
+def _grid_check(case: Case, red, sec: RVYieldSection):
+    """The grid check of the TE's output positions: the same yield model at
+    ``grid_check_factor × positions`` (:class:`~gearte.studies._yield.GridCheck`), or ``None``."""
+    from gearte.runners.yield_models import RVReducerYield
+    from gearte.studies._yield import GridCheck
+
+    fine = sec.positions * sec.grid_check_factor
+    if sec.grid_check_samples == 0 or sec.grid_check_factor < 2:
+        return None
+    finer = sec.model_copy(update={"positions": fine})
+    return GridCheck(
+        refined=lambda: _yield_model(case, red, finer)[0],
+        positions=sec.positions,
+        refined_positions=fine,
+        samples=sec.grid_check_samples,
+        quantities=RVReducerYield.grid_quantities,
+        te="angular_te [arcmin]",
+    )
+
+
 def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
     """``[analyses.yield]``: each sample one assembled reducer (errors drawn from the
     tolerances; errors without a tolerance keep the case's values) → catalogue test, angular TE
@@ -2167,6 +2200,7 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
         defaults=defaults,
         families=families,
         grade_um=_grade_um(case),
+        grid=_grid_check(case, red, sec),
     )
     res.values["first_stage_backlash"] = sec.first_stage_backlash
     if fs_model is not None:

@@ -1,20 +1,53 @@
 """Which tolerance drives the spread when the physics is non-linear: Sobol indices per
-tolerance with bootstrap confidence intervals, beside the linear (sensitivity × σ) prediction.
+independent factor with bootstrap confidence intervals, beside the linear share of each factor.
 
-For a model of the drawn errors (:mod:`gearte.tolerance.yield_mc`), each *tolerance* is one
-input factor — a radial error's magnitude and phase move together. With two independent
-sample matrices ``A``, ``B`` (standard normals and phases) and ``A_B⁽ⁱ⁾`` = ``A`` with the
-columns of tolerance ``i`` from ``B``::
+Factors
+-------
+For a model of the drawn errors (:mod:`gearte.tolerance.yield_mc`), each *factor* is a set of
+tolerances drawn independently of every other factor: a tolerance family (a radial error's
+magnitude and phase move together; every pin of a pin list), and the families a correlated
+group joins taken together (:meth:`~gearte.tolerance.yield_mc.ToleranceSet.factors`). These are
+*grouped* Sobol indices (Jacques et al. 2006; Saltelli et al. 2008 §4.7): with the factors
+independent, the Hoeffding–Sobol decomposition holds, first-order indices sum to ≤ 1 and
+``A_B⁽ⁱ⁾`` (``A`` with factor ``i``'s columns from ``B``) is a draw of the real joint law — none
+of which is true when a correlated group is split between two factors. Per-member indices of
+correlated inputs (Kucherenko et al. 2012) would need a conditional sampler per member and are
+not additive; a group is what a tolerance engineer changes as one (one grinding batch, one
+fixture), so it is one factor here.
 
-    Sᵢ  ≈ mean(f(B)·(f(A_B⁽ⁱ⁾) − f(A))) / V           (Saltelli et al. 2010, Table 2 (b))
-    STᵢ ≈ mean((f(A) − f(A_B⁽ⁱ⁾))²) / (2V)             (Jansen 1999; Saltelli 2010 (f))
+Estimators
+----------
+With two independent sample matrices ``A``, ``B`` and ``V`` the variance of ``f`` over both::
 
-``V`` is the variance of ``f`` over ``A`` and ``B``. Confidence intervals: percentile
-bootstrap over the rows (the same resampled rows for every index). The linear prediction is
-the first-order (delta-method) variance ``Σ (∂f/∂xᵢ)² σᵢ²`` from central differences at the
-nominal drive; a radial error with a uniform phase counts ``(g_x² + g_y²)·E[r²]/2``. Where
-``Sᵢ`` and the linear share disagree, the physics is non-linear there (clearances, contact
-loss, the |·| of an amplitude).
+    Sᵢ  ≈ mean((f(B) − f̄)·(f(A_B⁽ⁱ⁾) − f(A))) / V       (Saltelli et al. 2010, Table 2 (b),
+                                                         f(B) centred on the pooled mean f̄)
+    STᵢ ≈ mean((f(A) − f(A_B⁽ⁱ⁾))²) / (2V)               (Jansen 1999; Saltelli 2010 (f))
+
+The model runs ``n·(k + 2)`` times for ``k`` factors. ``A | B`` are the two halves of one
+Owen-scrambled Sobol' point set of dimension ``2 d`` (``d`` the uniforms of one drawn drive,
+:meth:`~gearte.tolerance.yield_mc.ToleranceSet.standard_from_uniform`), from
+:class:`scipy.stats.qmc.Sobol` (default ``sampling="qmc"``; ``"mc"``: pseudo-random streams as
+before). The point set is global: base sample ``j`` is point ``j`` of the sequence whatever the
+chunk it falls in, so the indices are the same bits for any chunk size, thread, process or Dask
+worker. Confidence intervals: percentile bootstrap over the base samples (the same resampled
+rows for every index). For a scrambled point set the rows are not independent and the
+bootstrap interval is that of plain Monte-Carlo at the same ``n`` — conservative (Owen 1997:
+the scrambled-net variance is never above ~2.7× and, for smooth integrands, far below the
+Monte-Carlo one). An index whose interval is wider than ``max_ci_width`` is named in
+``SobolIndices.warnings``.
+
+Linear share
+------------
+Beside the indices: the variance share of each factor in the least-squares linear fit of ``f``
+to the drawn errors over all ``n·(k + 2)`` model runs (the columns: each error's value, a radial
+error with a phase as its two components ``r cos φ``, ``r sin φ``). The linear part of ``f`` in
+factor ``i``'s errors is a projection of ``E[f | xᵢ]``, so ``linear_shareᵢ ≤ Sᵢ`` (up to
+sampling error), equal where ``E[f | xᵢ]`` is linear; ``Sᵢ − linear_shareᵢ`` is what is
+non-linear in factor ``i`` alone, ``STᵢ − Sᵢ`` its interactions, ``linear_r2`` the share of the
+variance any linear model explains. The first-order (delta-method) prediction at the nominal
+drive (:func:`linear_prediction`) is kept for small tolerances about a smooth nominal; at a kink
+of the model at the nominal (a peak-to-peak TE, a lost motion with pins at zero clearance) its
+gradient is zero or meaningless and it predicts nothing.
 
 References
 ----------
@@ -23,13 +56,22 @@ sensitivity analysis of model output. Design and estimator for the total sensiti
 Computer Physics Communications 181, 259–270. doi:10.1016/j.cpc.2009.09.018
 Jansen M. J. W. (1999) Analysis of variance designs for model output. Computer Physics
 Communications 117, 35–43. doi:10.1016/S0010-4655(98)00154-4
+Jacques J., Lavergne C., Devictor N. (2006) Sensitivity analysis in presence of model
+uncertainty and correlated inputs. Reliability Engineering & System Safety 91, 1126–1134.
+doi:10.1016/j.ress.2005.11.047
+Kucherenko S., Tarantola S., Annoni P. (2012) Estimation of global sensitivity indices for
+models with dependent variables. Computer Physics Communications 183, 937–946.
+doi:10.1016/j.cpc.2011.12.020
+Owen A. B. (1997) Scrambled net variance for integrals of smooth functions. Annals of
+Statistics 25, 1541–1562. doi:10.1214/aos/1069362388
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -41,16 +83,28 @@ from gearte.tolerance.yield_mc import Model, ToleranceSet, evaluate_checked
 __all__ = [
     "SobolIndices",
     "sobol_tolerances",
+    "sobol_estimates",
     "linear_prediction",
     "LinearPrediction",
     "pareto_rows",
+    "SAMPLINGS",
 ]
+
+#: Samplers of :func:`sobol_tolerances`.
+SAMPLINGS = ("qmc", "mc")
 
 
 @dataclass
 class SobolIndices:
-    """Sobol indices of one quantity per tolerance (fractions of its variance) with
-    bootstrap confidence intervals ``(low, high)``."""
+    """Sobol indices of one quantity per independent factor (fractions of its variance) with
+    bootstrap confidence intervals ``(low, high)``, and the linear share of each factor.
+
+    ``factors``: factor → its tolerance families; ``linear_share``: each factor's variance share
+    in the least-squares linear fit, ``linear_r2`` the fit's R²; ``non_finite``: base samples
+    left out because one of their ``k + 2`` model runs gave a non-finite value (counted, named in
+    ``warnings``); ``warnings``: indices whose interval is wider than the run's
+    ``max_ci_width``, and non-finite samples.
+    """
 
     quantity: str
     first: dict[str, float]
@@ -59,6 +113,13 @@ class SobolIndices:
     total_ci: dict[str, tuple[float, float]]
     variance: float
     n: int
+    factors: dict[str, list[str]] = field(default_factory=dict)
+    sampling: str = "qmc"
+    linear_share: dict[str, float] = field(default_factory=dict)
+    linear_r2: float = math.nan
+    non_finite: int = 0
+    max_ci_width: float = 0.1
+    warnings: list[str] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -66,29 +127,105 @@ class _SobolShared:
     model: Any
     tolset: ToleranceSet
     quantities: tuple[str, ...]
+    factor_cols: tuple[tuple[int, ...], ...]
+    sampling: str
+    entropy: int
+    chunk_size: int
 
 
-def _sobol_chunk(chunk: Any, shared: _SobolShared) -> dict[str, np.ndarray]:
-    """f(A), f(B), f(A_B⁽ⁱ⁾) of one chunk: ``{quantity: (k + 2, m)}``."""
-    rng = chunk.rng()
+def _uniform_halves(shared: _SobolShared, start: int, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """Points ``start … start + m`` of the run's scrambled Sobol' set, split into A and B."""
+    from scipy.stats import qmc
+
+    d = shared.tolset.uniform_dimension
+    eng = qmc.Sobol(2 * d, scramble=True, seed=np.random.default_rng([shared.entropy, 7907]))
+    if start:
+        eng.fast_forward(start)
+    with warnings.catch_warnings():  # balance needs powers of 2; any n is still a valid estimate
+        warnings.simplefilter("ignore", UserWarning)
+        u = eng.random(m)
+    return u[:, :d], u[:, d:]
+
+
+def _features(ts: ToleranceSet, values: dict[str, np.ndarray]) -> np.ndarray:
+    """Columns of the linear fit, scaled by each error's spread (mean ≈ 0, σ ≈ 1): a value, or
+    a radial error with a phase as ``r cos φ``, ``r sin φ``; a tolerance of width 0 none."""
+    cols = []
+    for t in ts.tolerances:
+        if t.kind == "constant" or t.tolerance == 0:
+            continue
+        x = values[t.key]
+        if t.phase:
+            s = math.sqrt(0.5 * t.second_moment_radial) or 1.0
+            ph = values[f"{t.key}_phase_rad"]
+            cols += [x * np.cos(ph) / s, x * np.sin(ph) / s]
+        else:
+            cols.append((x - float(t.nominal)) / (t.sd or 1.0))
+    return np.stack(cols, axis=1) if cols else np.zeros((len(next(iter(values.values()))), 0))
+
+
+def _feature_factor(ts: ToleranceSet, factors: dict[str, list[str]]) -> list[str]:
+    """The factor of each column of :func:`_features`."""
+    fam_factor = {f: name for name, fams in factors.items() for f in fams}
+    out = []
+    for t in ts.tolerances:
+        if t.kind == "constant" or t.tolerance == 0:
+            continue
+        out += [fam_factor[t.family_name]] * (2 if t.phase else 1)
+    return out
+
+
+def _sobol_chunk(chunk: Any, shared: _SobolShared) -> dict[str, Any]:
+    """f(A), f(B), f(A_B⁽ⁱ⁾) of one chunk: ``{quantity: (k + 2, m)}``, and the sums of the
+    linear fit (``"_fit"``)."""
     ts = shared.tolset
     m = chunk.size
-    za, pa = ts.draw_standard(rng, m)
-    zb, pb = ts.draw_standard(rng, m)
-    fams = list(ts.families.values())
-    k = len(fams)
-    # stack the k + 2 matrices and call the model once; factor i = every column of family i
+    if shared.sampling == "qmc":
+        ua, ub = _uniform_halves(shared, chunk.index * shared.chunk_size, m)
+        za, pa = ts.standard_from_uniform(ua)
+        zb, pb = ts.standard_from_uniform(ub)
+    else:
+        rng = chunk.rng()
+        za, pa = ts.draw_standard(rng, m)
+        zb, pb = ts.draw_standard(rng, m)
+    k = len(shared.factor_cols)
+    # stack the k + 2 matrices and call the model once; factor i = every column of its families
     z = np.concatenate([za, zb] + [za] * k)
     p = np.concatenate([pa, pb] + [pa] * k)
-    for i, cols in enumerate(fams):
+    for i, cols in enumerate(shared.factor_cols):
         rows = slice((2 + i) * m, (3 + i) * m)
-        z[rows, cols] = zb[:, cols]
-        p[rows, cols] = pb[:, cols]
-    out = evaluate_checked(shared.model, ts.values(z, p), (k + 2) * m)
-    return {q: out[q].reshape(k + 2, m) for q in shared.quantities}
+        z[rows, list(cols)] = zb[:, list(cols)]
+        p[rows, list(cols)] = pb[:, list(cols)]
+    values = ts.values(z, p)
+    out = evaluate_checked(shared.model, values, (k + 2) * m)
+    res: dict[str, Any] = {q: out[q].reshape(k + 2, m) for q in shared.quantities}
+    # sums of the linear fit over every run with finite outputs
+    X = _features(ts, values)
+    Y = np.stack([out[q] for q in shared.quantities], axis=1)
+    ok = np.all(np.isfinite(Y), axis=1)
+    X, Y = X[ok], Y[ok]
+    res["_fit"] = (int(ok.sum()), X.sum(0), X.T @ X, X.T @ Y, Y.sum(0), (Y * Y).sum(0))
+    return res
 
 
-def _indices(f: np.ndarray, rows: np.ndarray | slice) -> tuple[np.ndarray, np.ndarray, float]:
+def sobol_estimates(
+    f: np.ndarray, rows: np.ndarray | slice = slice(None)
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """First-order and total indices of every factor from the model runs ``f``.
+
+    Parameters
+    ----------
+    f : numpy.ndarray
+        ``(k + 2, n)`` model outputs [unit of the quantity]: rows ``f(A)``, ``f(B)``,
+        ``f(A_B⁽ⁱ⁾)``.
+    rows : numpy.ndarray or slice
+        Base samples to use (a bootstrap resample) [-].
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, float)
+        ``(S, ST, V)`` [-, -, unit²]: zeros when the variance ``V`` is 0.
+    """
     fa, fb, fab = f[0, rows], f[1, rows], f[2:, rows]
     both = np.concatenate([fa, fb])
     var = float(np.var(both, ddof=1))
@@ -99,6 +236,42 @@ def _indices(f: np.ndarray, rows: np.ndarray | slice) -> tuple[np.ndarray, np.nd
     s = np.mean((fb - np.mean(both)) * (fab - fa), axis=1) / var
     st = 0.5 * np.mean((fa - fab) ** 2, axis=1) / var
     return s, st, var
+
+
+def _adjusted(r2: float, n: int, p: int) -> float:
+    """R² adjusted for ``p`` fitted slopes on ``n`` distinct points, floored at 0."""
+    if n - p - 1 <= 0:
+        return 0.0
+    return max(0.0, 1.0 - (1.0 - r2) * (n - 1) / (n - p - 1))
+
+
+def _linear_shares(fit: tuple, j: int, owner: list[str], keys: list[str], n_base: int):
+    """Each factor's share of the variance in the least-squares linear fit of the quantity on
+    that factor's errors alone, and their sum (the R² of the linear fit on all errors).
+
+    A factor's errors take ``2 n`` distinct values over the runs (those of ``A`` and ``B``), so
+    its R² is adjusted for its slopes on ``2 n`` points (and floored at 0)."""
+    cnt, sx, sxx, sxy, sy, syy = fit
+    if cnt < 2 or sx.size == 0:
+        return {k: 0.0 for k in keys}, math.nan
+    mx = sx / cnt
+    C = sxx / cnt - np.outer(mx, mx)
+    c = sxy[:, j] / cnt - mx * (sy[j] / cnt)
+    vy = syy[j] / cnt - (sy[j] / cnt) ** 2
+    if not vy > 0:
+        return {k: 0.0 for k in keys}, math.nan
+    share = {}
+    own = np.array(owner)
+    for k in keys:
+        m = own == k
+        if not m.any():
+            share[k] = 0.0
+            continue
+        b = np.linalg.lstsq(C[np.ix_(m, m)], c[m], rcond=1e-12)[0]
+        share[k] = _adjusted(float(b @ c[m] / vy), 2 * n_base, int(m.sum()))
+    # independent factors: the linear fit on all errors is the sum of the factors' own fits,
+    # its R² the sum of their shares (a joint fit's R² is inflated by its many slopes)
+    return share, float(sum(share.values()))
 
 
 def sobol_tolerances(
@@ -113,8 +286,10 @@ def sobol_tolerances(
     chunk_size: int = 1_000,
     options: Any = None,
     progress: bool | None = False,
+    sampling: str = "qmc",
+    max_ci_width: float = 0.1,
 ) -> dict[str, SobolIndices]:
-    """First-order and total Sobol indices of each quantity per tolerance.
+    """First-order and total Sobol indices of each quantity per independent factor.
 
     Parameters
     ----------
@@ -124,31 +299,59 @@ def sobol_tolerances(
     quantities : sequence of str
         Model outputs to analyse.
     n : int
-        Base samples; the model runs ``n·(k + 2)`` times for ``k`` tolerances.
+        Base samples; the model runs ``n·(k + 2)`` times for ``k`` factors. With
+        ``sampling="qmc"`` a power of 2 keeps the Sobol' set balanced.
     seed : int
+        Seed of the scrambling (``"qmc"``) or of the chunk streams (``"mc"``), and of the
+        bootstrap.
     bootstrap : int
         Bootstrap resamples for the confidence intervals (0: none, intervals collapse).
     confidence : float
         Level of the intervals [-].
     chunk_size : int
-        Base samples per chunk (memory ∝ ``chunk_size·(k + 2)``).
+        Base samples per chunk (memory ∝ ``chunk_size·(k + 2)``; with ``"qmc"`` the result
+        does not depend on it).
     options : RunOptions, optional
         Workers and scheduler.
     progress : bool, optional
         Progress bar.
+    sampling : {"qmc", "mc"}
+        Owen-scrambled Sobol' points (default) or pseudo-random streams.
+    max_ci_width : float
+        An index whose interval is wider than this [-] is named in ``warnings``.
 
     Returns
     -------
     dict
-        ``{quantity: SobolIndices}`` keyed by tolerance family (a key that has no family is
-        its own). A quantity with zero variance gets zeros.
+        ``{quantity: SobolIndices}`` keyed by factor (:meth:`ToleranceSet.factors`: a family,
+        or the families a correlated group joins). A quantity with zero variance gets zeros.
+
+    Examples
+    --------
+    >>> from gearte.tolerance.yield_mc import Tolerance, ToleranceSet
+    >>> ts = ToleranceSet((Tolerance("a", "normal", 3.0), Tolerance("b", "normal", 6.0)))
+    >>> r = sobol_tolerances(lambda e: {"y": e["a"] + e["b"]}, ts, ["y"], 1024)["y"]
+    >>> round(r.first["b"], 2), round(r.total["a"], 2)
+    (0.8, 0.2)
     """
     if n < 50:
         raise ParameterError("n", n, "Sobol estimation needs >= 50 base samples")
     if bootstrap < 0:
         raise ParameterError("bootstrap", bootstrap, "must be >= 0")
+    if sampling not in SAMPLINGS:
+        raise ParameterError("sampling", sampling, f"must be one of {SAMPLINGS}")
+    if not max_ci_width > 0:
+        raise ParameterError("max_ci_width", max_ci_width, "must be > 0")
     quantities = tuple(quantities)
-    shared = _SobolShared(model, tolerances, quantities)
+    factors = tolerances.factors()
+    fam_idx = tolerances.families
+    factor_cols = tuple(
+        tuple(sorted(i for f in fams for i in fam_idx[f])) for fams in factors.values()
+    )
+    entropy = int(np.random.SeedSequence(seed).entropy)  # type: ignore[arg-type]
+    shared = _SobolShared(
+        model, tolerances, quantities, factor_cols, sampling, entropy, int(chunk_size)
+    )
     parts = map_chunks(
         _sobol_chunk,
         seeded_chunks(int(n), int(chunk_size), seed),
@@ -158,23 +361,54 @@ def sobol_tolerances(
         description=f"Sobol indices ({n} base samples)",
         unit="base samples",
     )
-    keys = list(tolerances.families)
+    keys = list(factors)
+    fit = _sum_fits([p["_fit"] for p in parts])
+    owner = _feature_factor(tolerances, factors)
     # bootstrap stream: its own child of the seed, so the intervals are reproducible too
-    rng = np.random.default_rng(None if seed is None else [int(seed), 7919])
+    rng = np.random.default_rng([entropy, 7919])
     a = (1.0 - confidence) / 2.0
-    boots = [rng.integers(0, n, n) for _ in range(bootstrap)]
     res: dict[str, SobolIndices] = {}
-    for q in quantities:
+    for j, q in enumerate(quantities):
         f = np.concatenate([p[q] for p in parts], axis=1)
-        s, st, var = _indices(f, slice(None))
+        finite = np.all(np.isfinite(f), axis=0)
+        bad = int(f.shape[1] - finite.sum())
+        f = f[:, finite]
+        m = f.shape[1]
+        notes: list[str] = []
+        if bad:
+            notes.append(
+                f"Sobol indices of {q}: {bad} of {n} base samples left out (a non-finite value "
+                "in one of their model runs)"
+            )
+        if m >= 2:
+            s, st, var = sobol_estimates(f)
+        else:
+            s, st, var = np.zeros(len(keys)), np.zeros(len(keys)), 0.0
         if bootstrap and var > 0:
-            bs = np.array([_indices(f, b)[0] for b in boots])
-            bt = np.array([_indices(f, b)[1] for b in boots])
+            boots = rng.integers(0, m, size=(bootstrap, m))
+            est = [sobol_estimates(f, b) for b in boots]
+            bs = np.array([e[0] for e in est])
+            bt = np.array([e[1] for e in est])
             s_lo, s_hi = np.quantile(bs, [a, 1 - a], axis=0)
             t_lo, t_hi = np.quantile(bt, [a, 1 - a], axis=0)
+            wide = [
+                (k, which, hi - lo)
+                for i, k in enumerate(keys)
+                for which, lo, hi in (("S", s_lo[i], s_hi[i]), ("ST", t_lo[i], t_hi[i]))
+                if hi - lo > max_ci_width
+            ]
+            if wide:
+                worst = max(wide, key=lambda w: w[2])
+                notes.append(
+                    f"Sobol indices of {q} not converged at {n} base samples: {len(wide)} "
+                    f"{confidence:.0%} interval(s) wider than {max_ci_width:g} (widest: "
+                    f"{worst[1]} of {worst[0]!r}, {worst[2]:.2f}); give more Sobol samples "
+                    "(the width falls as 1/√n)"
+                )
         else:
             s_lo = s_hi = s
             t_lo = t_hi = st
+        lin, r2 = _linear_shares(fit, j, owner, keys, int(finite.sum()))
         res[q] = SobolIndices(
             quantity=q,
             first=dict(zip(keys, s.tolist(), strict=True)),
@@ -183,8 +417,24 @@ def sobol_tolerances(
             total_ci={k: (float(t_lo[i]), float(t_hi[i])) for i, k in enumerate(keys)},
             variance=var,
             n=int(n),
+            factors=factors,
+            sampling=sampling,
+            linear_share=lin,
+            linear_r2=r2,
+            non_finite=bad,
+            max_ci_width=float(max_ci_width),
+            warnings=notes,
         )
     return res
+
+
+def _sum_fits(fits: list[tuple]) -> tuple:
+    """The chunks' sums of the linear fit, added in chunk order (the same bits on any
+    backend)."""
+    acc = list(fits[0])
+    for f in fits[1:]:
+        acc = [x + y for x, y in zip(acc, f, strict=True)]
+    return tuple(acc)
 
 
 @dataclass
@@ -285,6 +535,8 @@ def pareto_rows(
     ----------
     sobol : SobolIndices
     linear : LinearPrediction, optional
+        A delta-method prediction whose shares to show; default: the indices' own linear share
+        (the least-squares fit over the Sobol runs).
     """
     tot = sum(max(v, 0.0) for v in sobol.total.values()) or 1.0
     rows = []
@@ -299,7 +551,9 @@ def pareto_rows(
                 "sobol_total": sobol.total[k],
                 "sobol_total_ci": sobol.total_ci[k],
                 "cumulative_total_share": cum,
-                "linear_share": None if linear is None else linear.share.get(k, 0.0),
+                "linear_share": (
+                    sobol.linear_share.get(k, 0.0) if linear is None else linear.share.get(k, 0.0)
+                ),
             }
         )
     return rows

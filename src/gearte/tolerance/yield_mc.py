@@ -312,14 +312,85 @@ class ToleranceSet:
         k = len(self.tolerances)
         z = rng.standard_normal((n, k))
         if self.groups:
-            zg = rng.standard_normal((n, len(self.groups)))
-            for j, g in enumerate(self.groups):
-                cols = [self.keys.index(key) for key in self.group_members(g)]
-                z[:, cols] = (
-                    math.sqrt(g.rho) * zg[:, j : j + 1] + math.sqrt(1.0 - g.rho) * z[:, cols]
-                )
+            self._correlate(z, rng.standard_normal((n, len(self.groups))))
         phases = rng.uniform(0.0, _TWO_PI, (n, k))
         return z, phases
+
+    def _correlate(self, z: np.ndarray, zg: np.ndarray) -> None:
+        """The Gaussian copula of the groups, in place: ``z_i = √ρ z_g + √(1−ρ) z_i``."""
+        for j, g in enumerate(self.groups):
+            cols = [self.keys.index(key) for key in self.group_members(g)]
+            z[:, cols] = math.sqrt(g.rho) * zg[:, j : j + 1] + math.sqrt(1.0 - g.rho) * z[:, cols]
+
+    @property
+    def uniform_dimension(self) -> int:
+        """Uniforms one drawn drive needs (:meth:`standard_from_uniform`): one per tolerance,
+        one per correlated group, one per phase."""
+        return len(self.tolerances) + len(self.groups) + sum(t.phase for t in self.tolerances)
+
+    def standard_from_uniform(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Standard normals ``(n, k)`` and phases ``(n, k)`` [rad] from uniforms ``u`` of shape
+        ``(n, uniform_dimension)`` (a quasi-random point set): the same laws and groups as
+        :meth:`draw_standard`, columns in the order tolerances, groups, phases."""
+        from scipy.special import ndtri
+
+        k, g = len(self.tolerances), len(self.groups)
+        u = np.asarray(u, dtype=float)
+        if u.ndim != 2 or u.shape[1] != self.uniform_dimension:
+            raise ParameterError(
+                "u", u.shape, f"needs shape (n, {self.uniform_dimension}) for this tolerance set"
+            )
+        tiny = 2.0**-54  # a scrambled point is never 0 or 1 in practice; keep ndtri finite
+        z = ndtri(np.clip(u[:, : k + g], tiny, 1.0 - tiny))
+        zs = np.ascontiguousarray(z[:, :k])
+        if g:
+            self._correlate(zs, z[:, k:])
+        phases = np.zeros((u.shape[0], k))
+        cols = [i for i, t in enumerate(self.tolerances) if t.phase]
+        phases[:, cols] = _TWO_PI * u[:, k + g :]
+        return zs, phases
+
+    def factors(self) -> dict[str, list[str]]:
+        """The independent factors of a variance decomposition: factor name → its families.
+
+        Families are independent of each other unless a correlated group joins them; the
+        families a group joins form one factor (named after the group, or the families joined
+        by ``" + "`` where that name is a family of its own), so that factors are independent
+        and a Sobol index of a factor is well defined. A group within one family leaves it a
+        factor of its own.
+        """
+        fams = list(self.families)
+        fam_of = {t.key: t.family_name for t in self.tolerances}
+        parent = {f: f for f in fams}
+
+        def root(f: str) -> str:
+            while parent[f] != f:
+                f = parent[f]
+            return f
+
+        joined: list[tuple[str, str]] = []
+        for g in self.groups:
+            members = sorted({fam_of[k] for k in self.group_members(g)}, key=fams.index)
+            for f in members[1:]:
+                parent[root(f)] = root(members[0])
+            if len(members) > 1:
+                joined.append((members[0], g.name))
+        names: dict[str, str] = {}
+        for f, name in joined:
+            names.setdefault(root(f), name)
+        out: dict[str, list[str]] = {}
+        for f in fams:
+            out.setdefault(root(f), []).append(f)
+        named: dict[str, list[str]] = {}
+        for r, members in out.items():
+            if len(members) == 1:
+                named[r] = members
+                continue
+            name = names.get(r, r)
+            if name in fams or name in named:
+                name = " + ".join(members)
+            named[name] = members
+        return named
 
     def values(
         self, z: np.ndarray, phases: np.ndarray, widths: Mapping[str, float] | None = None
@@ -411,12 +482,16 @@ def clopper_pearson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[
 
 @dataclass
 class QuantityStats:
-    """Mean, σ, extremes and (with a spec) Cpk and the fraction failing this quantity."""
+    """Mean, σ, extremes and (with a spec) Cpk and the fraction failing this quantity.
+
+    ``stats`` and ``cpk`` are of the finite values; ``non_finite`` counts the samples whose
+    value was NaN or infinite (each one fails a spec on this quantity)."""
 
     name: str
     stats: RunningStats
     fail_fraction: float | None
     cpk: float | None
+    non_finite: int = 0
 
 
 @dataclass
@@ -427,7 +502,9 @@ class YieldResult:
     interval (``ci_method``); ``cpk`` the smallest Cpk of the specified quantities;
     ``quantities`` per-quantity statistics; ``worst`` the samples with the smallest normalised
     margin, each ``{"sample", "chunk", "row", "margin", "errors": {...}, "values": {...}}``;
-    ``head`` the first ``keep`` samples' quantities (for plots).
+    ``head`` the first ``keep`` samples' quantities (for plots); ``non_finite_samples`` the
+    samples with a non-finite value of any quantity (counted as failing every spec limit on
+    it, left out of the mean, σ and Cpk; named in ``warnings``).
     """
 
     n: int
@@ -444,6 +521,8 @@ class YieldResult:
     chunk_size: int
     spec: tuple[SpecLimit, ...]
     extra: dict[str, Any] = field(default_factory=dict)
+    non_finite_samples: int = 0
+    warnings: list[str] = field(default_factory=list)
 
 
 def evaluate_checked(
@@ -469,6 +548,8 @@ class _Partial:
     fails: dict[str, int]
     worst: list[dict[str, Any]]
     head: dict[str, np.ndarray]
+    non_finite: dict[str, int] = field(default_factory=dict)
+    non_finite_samples: int = 0
 
 
 @dataclass(frozen=True)
@@ -502,7 +583,10 @@ def _chunk(chunk: Any, shared: _Shared) -> _Partial:
             )
     margin = _norm_margin(shared, out, n)
     ok = margin >= 0
-    stats = {k: RunningStats.of(v[np.isfinite(v)]) for k, v in out.items()}
+    finite = {k: np.isfinite(v) for k, v in out.items()}
+    stats = {k: RunningStats.of(v[finite[k]]) for k, v in out.items()}
+    non_finite = {k: int(v.size - np.count_nonzero(finite[k])) for k, v in out.items()}
+    bad = int(n - np.count_nonzero(np.logical_and.reduce(list(finite.values())))) if out else 0
     fails = {
         s.quantity: int(np.count_nonzero(~(s.margin(out[s.quantity]) >= 0))) for s in shared.spec
     }
@@ -523,7 +607,7 @@ def _chunk(chunk: Any, shared: _Shared) -> _Partial:
     # chunk's result is O(1) in its samples (counts, moment sums, the worst ``keep_worst``)
     rows = max(0, min(n, shared.keep_head - int(chunk.index) * shared.chunk_size))
     head = {k: v[:rows].copy() for k, v in out.items()}
-    return _Partial(n, int(np.count_nonzero(ok)), stats, fails, worst, head)
+    return _Partial(n, int(np.count_nonzero(ok)), stats, fails, worst, head, non_finite, bad)
 
 
 class _Reducer:
@@ -539,8 +623,16 @@ class _Reducer:
         fails = {k: acc.fails[k] + p.fails[k] for k in acc.fails}
         worst = sorted(acc.worst + p.worst, key=lambda w: (w["margin"], w["chunk"], w["row"]))
         head = {k: np.concatenate([acc.head[k], p.head[k]])[: self.keep_head] for k in acc.head}
+        nf = {k: acc.non_finite.get(k, 0) + p.non_finite.get(k, 0) for k in acc.stats}
         return _Partial(
-            acc.n + p.n, acc.passed + p.passed, stats, fails, worst[: self.keep_worst], head
+            acc.n + p.n,
+            acc.passed + p.passed,
+            stats,
+            fails,
+            worst[: self.keep_worst],
+            head,
+            nf,
+            acc.non_finite_samples + p.non_finite_samples,
         )
 
 
@@ -655,7 +747,7 @@ def run_yield(
                 _, cpk = process_capability(st.mean, st.sd, sp.lower, sp.upper)
             if cpk is not None:
                 cpks.append(cpk)
-        quantities[k] = QuantityStats(k, st, ff, cpk)
+        quantities[k] = QuantityStats(k, st, ff, cpk, total.non_finite.get(k, 0))
     for w in total.worst:
         w["sample"] = w["chunk"] * chunk_size + w["row"]
     return YieldResult(
@@ -672,7 +764,21 @@ def run_yield(
         seed=seed,
         chunk_size=chunk_size,
         spec=spec,
+        non_finite_samples=total.non_finite_samples,
+        warnings=_non_finite_warnings(total),
     )
+
+
+def _non_finite_warnings(total: _Partial) -> list[str]:
+    """What the non-finite samples of a run did to its statistics (nothing when none)."""
+    if not total.non_finite_samples:
+        return []
+    per = ", ".join(f"{k}: {v}" for k, v in total.non_finite.items() if v)
+    return [
+        f"{total.non_finite_samples} of {total.n} samples gave a non-finite value ({per}): "
+        "counted as failing every spec limit on that quantity, left out of its mean, σ and "
+        "Cpk (Cpk of the finite samples only)"
+    ]
 
 
 def redraw_sample(tolerances: ToleranceSet, seed: int | None, chunk_size: int, sample: int, n: int):
