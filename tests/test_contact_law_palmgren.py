@@ -193,3 +193,19 @@ def test_every_rv_result_names_the_law_form():
     for name in ("transmission_error", "catalogue"):
         assert res[name].values["contact_law"] == "palmgren"
         assert res[name].values["contact_law_form"].startswith("palmgren: δ = 3.84e-05 F^0.9")
+
+
+@pytest.mark.parametrize("a0", [0.0, 1e-6, 3e-5])
+def test_power_law_with_a_series_spring_inverts_to_the_closed_form(a0):
+    """Palmgren's law with a linear compliance in series (the pin seat): δ = a0 F + a2 F^a3;
+    the inverse returns every force whose δ it is given, to 1e-10."""
+    from gearte.solvers.contact import power_law_force
+
+    F = np.array([0.0, 1e-3, 1.0, 250.0, 1810.0, 1e4, 1e5])
+    a2, a3 = 3.84e-5 / 11.0**0.8, 0.9
+    delta = a0 * F + _palmgren(F, 11.0)
+    got = power_law_force(delta, np.full(F.shape, a0), np.full(F.shape, a2), np.full(F.shape, a3))
+    np.testing.assert_allclose(got, F, rtol=1e-10, atol=1e-12)
+    assert power_law_force(np.array([-1e-3]), np.array([a0]), np.array([a2]), np.array([a3]))[
+        0
+    ] == pytest.approx(0.0)

@@ -78,8 +78,11 @@ def test_chain_yield_ranks_each_drives_own_tolerances_in_its_contributions():
     assert "cycloid_stage.pin_circle_radius_error" in cyc
     assert "cycloid_stage.cumulative_pitch_error" in cyc
     assert any(k.startswith("spur_pair.") for k in keys)
-    share = y["linear_share"]
-    assert sum(share[k] for k in cyc) > 0.0
+    # both drives' own tolerances are ranked (Sobol total indices; the pair's lost motion is
+    # divided by the stage's ratio 39 at the joint, so its share is small but not zero; its
+    # least-squares linear share is below the fit's noise and reads 0)
+    share = y["sobol_total"]
+    assert sum(share[k] for k in cyc) > 0.5
     assert sum(share[k] for k in share if k.startswith("spur_pair.")) > 0.0
     ranked = sorted(share, key=share.get, reverse=True)
     assert any(k in cyc for k in ranked[:5])

@@ -635,10 +635,11 @@ def solve_rotation(
     implementation : {"numba", "plain"}
         The compiled kernel or its plain twin (the readable reference it is tested against).
     power : (ndarray, ndarray), optional
-        ``(a2, a3)`` [mm/N^a3, -]: the pins follow the power law ``δ = a2 F^a3`` instead
-        (Palmgren's line
-        contact, ``gearte.models.contact_law.law_coefficients``; ``a0``, ``a1`` must then be 0),
-        inverted in closed form, ``F = (δ/a2)^(1/a3)``; solved by the plain implementation.
+        ``(a2, a3)`` [mm/N^a3, -]: the pins follow the power law ``δ = a0 F + a2 F^a3``
+        instead (Palmgren's line contact, ``gearte.models.contact_law.law_coefficients``, with a
+        linear compliance ``a0`` in series, e.g. the pin seat; ``a1`` must then be 0), inverted
+        in closed form where ``a0 = 0`` (``F = (δ/a2)^(1/a3)``), else by Newton's method
+        (:func:`power_law_force`); solved by the plain implementation.
 
     Returns
     -------
@@ -663,8 +664,10 @@ def solve_rotation(
         raise ParameterError("implementation", implementation, "must be 'numba' or 'plain'")
     arm, clearance, a0, a1 = _rotation_inputs(arm, clearance, a0, a1, torque)
     if power is not None:
-        if np.any(a0 != 0.0) or np.any(a1 != 0.0):
-            raise ParameterError("a0/a1", (a0, a1), "must be 0 with a power law (power=)")
+        if np.any(a1 != 0.0) or np.any(a0 < 0.0):
+            raise ParameterError(
+                "a0/a1", (a0, a1), "a power law (power=) takes a1 = 0 and a linear a0 >= 0"
+            )
         a2, a3 = (np.broadcast_to(np.asarray(x, dtype=float), arm.shape) for x in power)
         if not (np.all(a2 > 0.0) and np.all((a3 > 0.0) & (a3 <= 1.0))):
             raise ParameterError("power", power, "needs a2 > 0 and 0 < a3 <= 1")
@@ -681,6 +684,50 @@ def solve_rotation(
         )
     check_torque_balance(np.sum(force * np.where(arm > 0.0, arm, 0.0), axis=1), torque, rtol)
     return rot, force
+
+
+def power_law_force(
+    delta: np.ndarray, a0: np.ndarray, a2: np.ndarray, a3: np.ndarray, *, rtol: float = 1e-12
+) -> np.ndarray:
+    """Inverse of ``δ = a0 F + a2 F^a3`` (a power law with a linear compliance ``a0 ≥ 0`` in
+    series): the force F [N] for an approach δ [mm]; δ ≤ 0 → 0.
+
+    With ``a0 = 0`` the closed form ``F = (δ/a2)^(1/a3)``. Otherwise Newton's method from the
+    lower bound ``min(δ/(2 a0), (δ/(2 a2))^(1/a3))`` (at the root one of the two terms is at
+    least δ/2): g(F) = a0 F + a2 F^a3 − δ is increasing and concave for 0 < a3 ≤ 1, so every
+    Newton step from below stays below the root and the iteration increases monotonically to it.
+
+    Parameters
+    ----------
+    delta : ndarray
+        Approach [mm].
+    a0 : ndarray
+        Linear compliance in series [mm/N], ≥ 0.
+    a2, a3 : ndarray
+        Power law ``δ = a2 F^a3`` [mm/N^a3, -], a2 > 0, 0 < a3 ≤ 1.
+    rtol : float
+        Relative tolerance on F [-].
+
+    Raises
+    ------
+    ConvergenceError
+        Not converged in 100 steps.
+    """
+    d = np.maximum(np.asarray(delta, dtype=float), 0.0)
+    a0, a2, a3 = (np.broadcast_to(np.asarray(x, dtype=float), d.shape) for x in (a0, a2, a3))
+    if not np.any(a0 > 0.0):
+        return (d / a2) ** (1.0 / a3)
+    with np.errstate(divide="ignore"):
+        lo_linear = np.where(a0 > 0.0, d / np.where(a0 > 0.0, 2.0 * a0, 1.0), np.inf)
+    f = np.minimum(lo_linear, (d / (2.0 * a2)) ** (1.0 / a3))
+    for _ in range(100):
+        fp = np.where(f > 0.0, f, 1.0)
+        g = a0 * f + a2 * f**a3 - d
+        step = np.where(f > 0.0, g / (a0 + a3 * a2 * fp ** (a3 - 1.0)), 0.0)
+        f = f - step
+        if np.all(np.abs(step) <= rtol * np.maximum(f, 1e-300)):
+            return f
+    raise ConvergenceError("power_law_force: Newton did not converge in 100 steps")
 
 
 def check_torque_balance(carried: np.ndarray, torque: float, rtol: float) -> None:
@@ -759,7 +806,7 @@ def _solve_rotation_plain(arm, clearance, a0, a1, torque, rtol, rot_start, force
         if power is None:
             f = _log_law_force_plain(delta, a0, a1, force_rtol)
         else:
-            f = (np.maximum(delta, 0.0) / power[0]) ** (1.0 / power[1])
+            f = power_law_force(delta, a0, power[0], power[1], rtol=force_rtol)
         return np.sum(f * la, axis=1), f
 
     def tangent(f: np.ndarray) -> np.ndarray:
@@ -767,7 +814,7 @@ def _solve_rotation_plain(arm, clearance, a0, a1, torque, rtol, rot_start, force
         fp = np.where(pos, f, 1.0)
         if power is None:
             return np.where(pos, 1.0 / (a0 - a1 * np.log(fp) - a1), 0.0)
-        return np.where(pos, fp ** (1.0 - power[1]) / (power[1] * power[0]), 0.0)
+        return np.where(pos, 1.0 / (a0 + power[1] * power[0] * fp ** (power[1] - 1.0)), 0.0)
 
     lo = np.zeros(n)
     hi = np.full(n, 1e-6) if rot_start is None else np.broadcast_to(rot_start, (n,)).copy()

@@ -1078,11 +1078,13 @@ _NEEDS = {
 class CalibratedParameter(StrictModel):
     """One estimate of a bench calibration (gearte units, named by ``unit``)."""
 
-    value: float
+    value: float = Field(description="The estimate, in the unit named by unit.")
     ci95: float | None = Field(default=None, description="95 % half-width (None: not identified)")
-    unit: str
-    identified: bool
-    note: str = ""
+    unit: str = Field(description="Unit of value and ci95 (gearte units).")
+    identified: bool = Field(
+        description="Whether the bench data determine it (false: confounded or unobserved)."
+    )
+    note: str = Field(default="", description="Why it is not identified, or how it was found.")
 
 
 class BenchCalibrationSection(StrictModel):
@@ -1113,7 +1115,10 @@ class BenchCalibrationSection(StrictModel):
         description="Bench value, this serial through the whole model (+ the rig's twist), "
         "relative difference, per catalogue quantity.",
     )
-    not_written: list[str] = Field(default_factory=list)
+    not_written: list[str] = Field(
+        default_factory=list,
+        description="Estimates not applied to [reducer] (unidentifiable or outside the model).",
+    )
 
 
 class Case(CaseBase):
