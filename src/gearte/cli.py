@@ -281,7 +281,8 @@ def run(
         if not no_report:
             from gearte.report.background import ReportWorker
 
-            renderer = ReportWorker.start(case)
+            renderer = ReportWorker.start(case)  # (numba imported first, for both processes)
+        t1b = time.perf_counter()
         try:
             c = load_case(case)
             t2 = time.perf_counter()
@@ -306,7 +307,12 @@ def run(
                 except (KeyboardInterrupt, ClusterLostError) as exc:
                     _write_partial(exc, target)
                     raise
-            result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
+            result.timings = {
+                "imports: gearte": t1 - t0,
+                "imports: numba: before the report process": t1b - t1,
+                "load case": t2 - t1b,
+                **result.timings,
+            }
             paths = write_outputs(result, target, report=not no_report, worker=renderer)
         finally:
             if renderer is not None:
