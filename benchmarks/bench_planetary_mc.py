@@ -207,7 +207,8 @@ def main() -> None:
     print("ratios below: per core (samples per CPU second, each side all its threads; numpy's "
           "BLAS on one thread)")  # fmt: skip
     print(
-        f"naive grid    : {rate_t / 1e6:8.5f} M/CPU-s  ratio {rate_g / rate_t:8.1f} x (goal >= 300x)"
+        f"naive grid    : {rate_t / 1e6:8.5f} M/CPU-s  ratio {rate_g / rate_t:8.1f} x"
+        " (goal >= 300x)"
         f"  [Σe term by term, 2048 points over the common period, numpy, {n_naive:,} samples]"
     )
     print(
@@ -215,7 +216,8 @@ def main() -> None:
         f"  [phasors + one matrix product, same 2048 nodes, {args.naive:,} samples]"
     )
     print(
-        f"numpy grid+Newton: {rate_x / 1e6:8.5f} M/CPU-s  ratio {rate_g / rate_x:8.1f} x (goal >= 20x)"
+        f"numpy grid+Newton: {rate_x / 1e6:8.5f} M/CPU-s  ratio {rate_g / rate_x:8.1f} x"
+        " (goal >= 20x)"
         f"  [phasors + grid 8 n_max + vectorised Newton, {args.naive:,} samples]"
     )
     print(
