@@ -389,7 +389,7 @@ def _run_point(task: tuple[int, dict[str, Any], str, str, dict[str, Any]]) -> di
     except CaseFileError:
         raise
     except GearteError as exc:
-        out = {
+        out: dict[str, Any] = {
             "index": index,
             "values": {},
             "error": f"{type(exc).__name__}: {exc}",
@@ -405,7 +405,7 @@ def _run_point(task: tuple[int, dict[str, Any], str, str, dict[str, Any]]) -> di
             "elapsed": time.perf_counter() - t0,
         }
         del result
-    _free_point_garbage(out["elapsed"])
+    _free_point_garbage(float(out["elapsed"]))
     return out
 
 
