@@ -28,7 +28,6 @@ either way.
 from __future__ import annotations
 
 import csv
-import gc
 import io
 import itertools
 import math
@@ -404,35 +403,24 @@ def _run_point(task: tuple[int, dict[str, Any], str, str, dict[str, Any]]) -> di
             "warnings": list(result.warnings),
             "elapsed": time.perf_counter() - t0,
         }
-        del result
-    _free_point_garbage(float(out["elapsed"]))
+        _unlink(result)
     return out
 
 
-#: A point that ran longer than this [s] is followed by a full collection (~30-50 ms).
-FULL_COLLECTION_AFTER_S = 1.0
-#: Points (in this process) between two full collections otherwise.
-FULL_COLLECTION_EVERY = 8
-_points_since_full = [0]
+def _unlink(result: Any) -> None:
+    """Break the reference cycle of a finished point's result (each analysis refers back to its
+    study result, which holds the analyses), so that the point's arrays are freed as soon as the
+    point is done, by reference counting.
 
-
-def _free_point_garbage(elapsed: float) -> None:
-    """Free the reference cycles a finished point left (its study result and analyses refer to
-    each other, the case's validators hold closures): collect the young and middle generations
-    (~1-4 ms) after each point, and all generations after a point of more than
-    :data:`FULL_COLLECTION_AFTER_S` and after every :data:`FULL_COLLECTION_EVERY` points (~30-50
-    ms: where points run in parallel threads, one point's collection moves the objects of the
-    points still running to the oldest generation, where they die).
-
-    gearte's own processes collect the older generations rarely (:mod:`gearte._gc`: every 2000
-    young collections, ~10^8 allocations), so without this a sweep's memory grew with its
-    points (~2 MB per hu2020_rv80e_initial point: none of it was collected during the sweep);
-    with it the memory stays flat (``tests/test_sweep.py``)."""
-    _points_since_full[0] += 1
-    full = elapsed > FULL_COLLECTION_AFTER_S or _points_since_full[0] >= FULL_COLLECTION_EVERY
-    if full:
-        _points_since_full[0] = 0
-    gc.collect(2 if full else 1)
+    gearte's own processes collect the older generations rarely (:mod:`gearte._gc`: every ~10^8
+    allocations), so left to the collector the cycle of every point of a sweep was kept to the
+    end of the sweep (~2 MB per hu2020_rv80e_initial point); with it unlinked the memory stays
+    flat (``tests/test_sweep.py``). No explicit ``gc.collect`` here: points run in parallel
+    threads, and a collection in one of them while another first imports numba could stall both.
+    """
+    for a in getattr(result, "analyses", ()):
+        a.study = None
+    result.analyses = []
 
 
 @dataclass
