@@ -389,3 +389,92 @@ def solve_batch_numpy_dense(
         if record[t]:
             forces[:, int(np.searchsorted(rec, t))] = F
     return BatchSolution(rot, forces, np.zeros((S, K), np.int64))
+
+
+def newton_mixed_each(K, B, reg, f0, gap, a0, a1, q, F, maxit=30):
+    """:func:`newton_mixed` where every system has its own matrix ``K`` (S, m, m), rows ``B``
+    (S, nc, m), regularisation ``reg`` (S,) and law ``a0, a1`` (S, nc) — the positions of one
+    reducer, each its own geometry — started from ``q`` (S, m) and ``F`` (S, nc). Returns
+    ``(q, F, iterations, failed)`` as :func:`newton_mixed`."""
+    S, nc, m = B.shape
+    q, F = np.array(q, dtype=float), np.array(F, dtype=float)
+    its = np.zeros(S, np.int64)
+    failed = np.zeros(S, bool)
+    live = np.arange(S)
+    Kl, Bl, rl, fl, gl, b0, b1 = K, B, reg, f0, gap, a0, a1
+    ql, Fl = q.copy(), F.copy()
+    d = np.matmul(Bl, ql[..., None])[..., 0] - gl
+    eye = np.eye(m)
+    for it in range(maxit):
+        closing = (Fl <= 0) & (d > 0)
+        changed = closing.any(axis=1)
+        if changed.any():
+            Fl[closing] = law_force_start(d[closing], b0[closing], b1[closing])
+        act = Fl > 0
+        rest = b0 - b1 * np.log(np.where(act, Fl, 1.0))  # δ/F
+        slope = rest - b1  # δ'(F)
+        bad = np.any(act & ~(slope > 0), axis=1)  # beyond the law's range
+        k = np.where(act, 1.0 / np.where(slope > 0, slope, 1.0), 0.0)
+        Ft = np.where(act, Fl + (d - Fl * rest) * k, 0.0)
+        H = Kl + np.matmul(Bl.transpose(0, 2, 1) * k[:, None, :], Bl) + rl[:, None, None] * eye
+        grad = np.matmul(Kl, ql[..., None])[..., 0] - fl + np.matmul(Ft[:, None, :], Bl)[:, 0]
+        dq = np.linalg.solve(H, grad[..., None])[..., 0]
+        ql = ql - dq
+        Bdq = np.matmul(Bl, dq[..., None])[..., 0]
+        Fn = Ft - k * Bdq
+        opened = np.any(act & ~(Fn > 0), axis=1)
+        Fn = np.where(act & (Fn > 0), Fn, 0.0)
+        fbig = np.max(np.abs(Fn - Fl), axis=1)
+        done = ~(changed | opened) & (np.max(np.abs(dq), axis=1) < 1e-9)
+        done &= fbig <= 1e-7 * np.max(Fn, axis=1)
+        Fl, d = Fn, d - Bdq
+        its[live] = it + 1
+        out = done | bad
+        if out.any():
+            idx = live[out]
+            q[idx], F[idx], failed[idx] = ql[out], Fl[out], bad[out]
+            keep = ~out
+            live = live[keep]
+            ql, Fl, d = ql[keep], Fl[keep], d[keep]
+            Kl, Bl, rl, fl, gl, b0, b1 = (a[keep] for a in (Kl, Bl, rl, fl, gl, b0, b1))
+            if live.size == 0:
+                break
+    failed[live] = True
+    return q, F, its, failed
+
+
+def solve_positions_numpy(problem, h, gap, torque):
+    """The output rotation [rad] at every position of one reducer (the ``G`` geometries of
+    ``problem``, its sample 0: ``h`` (1, G, nd), ``gap`` (1, G, nc)) under ``torque`` [N·mm]:
+    gearte's batched algorithm (condensed onto the contact degrees of freedom with gearte's
+    own :func:`~gearte.solvers.rv_batch.condense`, Newton on the equilibrium and the pin law
+    together, the line-searched Newton on Π where that fails), **vectorised over the
+    positions**: the first position solved cold, then every position at once from its answer
+    (the positions are independent and alike: numpy gains more from one batched solve than from
+    warm starts one position after the other). Returns ``(rotation (G,), forces (G, nc))``."""
+    from gearte.solvers.rv_batch import _condensed
+
+    if problem.bearing_k.size:
+        raise NotImplementedError("the numpy baseline codes no clearance bearings")
+    cd = _condensed(problem)
+    m = cd.K.shape[1]
+    Bd = dense_rows(cd.contacts, m)  # (G, nc, m)
+    hc = np.einsum("gmn,gn->gm", cd.M, h[0])  # condensed loads
+    out_h = np.einsum("gn,gn->g", cd.out_hrow, h[0])
+    f0 = torque * cd.u - hc
+    a0, a1 = problem.coef[..., 0], problem.coef[..., 1]
+    # the first position cold, by the line-searched Newton on Π; every position from its answer
+    s0 = Systems(cd.K[:1], Bd[:1], f0[:1], gap[0][:1], a0[:1], a1[:1])
+    s0.reg = cd.reg[:1]
+    q0, F0, _ = newton(s0, np.zeros((1, m)), scheme="exact")
+    G = f0.shape[0]
+    q, F, _, failed = newton_mixed_each(cd.K, Bd, cd.reg, f0, gap[0], a0, a1,
+                                        np.repeat(q0, G, 0), np.repeat(F0, G, 0))  # fmt: skip
+    if failed.any():  # the line-searched Newton on Π from the same start
+        s = Systems(cd.K[failed], Bd[failed], f0[failed], gap[0][failed], a0[failed], a1[failed])
+        s.reg = cd.reg[failed]
+        m_f = int(failed.sum())
+        q[failed], F[failed], _ = newton(s, np.repeat(q0, m_f, 0), F=np.repeat(F0, m_f, 0),
+                                         scheme="exact")  # fmt: skip
+    rot = torque * cd.out_u - out_h + np.einsum("gm,gm->g", q, cd.out_q)
+    return rot, F

@@ -345,7 +345,8 @@ def run(
         if not no_report:
             from gearte.report.background import ReportWorker
 
-            renderer = ReportWorker.start(case)
+            renderer = ReportWorker.start(case)  # (numba imported first, for both processes)
+        t1b = time.perf_counter()
         try:
             beat.stage("loading the case")
             c = load_case(case)
@@ -373,7 +374,12 @@ def run(
                     beat.stage(None)
                     _write_partial(exc, target)
                     raise
-            result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
+            result.timings = {
+                "imports: gearte": t1 - t0,
+                "imports: numba: before the report process": t1b - t1,
+                "load case": t2 - t1b,
+                **result.timings,
+            }
             beat.stage("writing results.json" + ("" if no_report else " and the report (figures)"))
             paths = write_outputs(result, target, report=not no_report, worker=renderer)
         finally:

@@ -9,8 +9,6 @@ report figure gets in one place.
   (pin numbers, counts).
 * :func:`distribution` draws samples as a histogram, or as a strip plot (each sample a point)
   below :data:`STRIP_BELOW` samples, where a histogram would be mostly empty bins.
-* :func:`cache_font_heights` makes matplotlib read a font's height metrics once per font and
-  resolution instead of once per text laid out (the same numbers: the same pixels).
 * :func:`one_pass_layout` places the axes of a figure made with constrained layout in one
   measuring pass before it is drawn once (matplotlib's constrained layout measures every label
   twice and ``savefig`` then draws the figure twice): about a third of the drawing work less,
@@ -28,7 +26,6 @@ __all__ = [
     "decimate",
     "polish",
     "distribution",
-    "cache_font_heights",
     "one_pass_layout",
     "MAX_POINTS",
     "STRIP_BELOW",
@@ -157,68 +154,6 @@ def _legends_outside(fig: Any) -> None:
         )
 
 
-_FONT_HEIGHTS: dict[tuple[Any, ...], tuple[Any, Any, Any]] = {}
-
-
-def _font_height_metrics(
-    renderer: Any, prop: Any, *_more: Any, **_named: Any
-) -> tuple[Any, Any, Any]:
-    """``(ascent, descent, line gap)`` [px] of the font ``prop`` at the renderer's resolution,
-    read from the font's tables as ``matplotlib.text.Text._get_layout`` reads them (its own
-    path looks the font file up and reads three tables for every text it lays out: ~15-25 % of
-    drawing a figure), once per font, size and resolution; ``(None, None, None)`` (matplotlib
-    then measures the font itself) where the font has neither table, or where matplotlib's
-    internals it reads have changed (the hook is private: a newer matplotlib loses only the
-    speed, never the figure)."""
-    try:
-        return _font_height_metrics_cached(renderer, prop)
-    except (AttributeError, KeyError, TypeError, ValueError, RuntimeError):
-        return (None, None, None)
-
-
-def _font_height_metrics_cached(renderer: Any, prop: Any) -> tuple[Any, Any, Any]:
-    key = (
-        tuple(prop.get_family()),
-        prop.get_slant(),
-        prop.get_variant(),
-        prop.get_weight(),
-        prop.get_stretch(),
-        prop.get_size_in_points(),
-        prop.get_file(),
-        prop.get_math_fontfamily(),
-        float(renderer.dpi),
-    )
-    got = _FONT_HEIGHTS.get(key)
-    if got is None:
-        from matplotlib.font_manager import fontManager, get_font
-
-        font: Any = get_font(fontManager._find_fonts_by_props(prop))  # tables by name (str)
-        got = (None, None, None)
-        for table_name, gap_key, ascent_key, descent_key in (
-            ("OS/2", "sTypoLineGap", "sTypoAscender", "sTypoDescender"),
-            ("hhea", "lineGap", "ascent", "descent"),
-        ):
-            table = font.get_sfnt_table(table_name)
-            if table is None:
-                continue
-            scale = 1 / font.get_sfnt_table("head")["unitsPerEm"] * key[5] * renderer.dpi / 72
-            got = (table[ascent_key] * scale, -table[descent_key] * scale, table[gap_key] * scale)
-            break
-        _FONT_HEIGHTS[key] = got
-    return got
-
-
-def cache_font_heights() -> None:
-    """Let matplotlib's Agg renderer give each text's font height metrics from a cache
-    (:func:`_font_height_metrics`, through the ``_get_font_height_metrics`` hook that
-    ``Text._get_layout`` asks a renderer for first); the numbers, hence the pixels, are those
-    matplotlib computes itself. Idempotent; nothing is changed where the hook is missing."""
-    from matplotlib.backends.backend_agg import RendererAgg
-
-    if not hasattr(RendererAgg, "_get_font_height_metrics"):
-        RendererAgg._get_font_height_metrics = _font_height_metrics  # type: ignore[attr-defined]
-
-
 def one_pass_layout(fig: Any) -> bool:
     """Replace the constrained layout of ``fig`` (a matplotlib figure) by margins measured once,
     where that gives the same picture; True where it did, False where the figure is left as it
@@ -228,54 +163,52 @@ def one_pass_layout(fig: Any) -> bool:
     labels, titles, legends) twice, and ``savefig`` draws a figure with a layout engine twice
     (once without rendering, to run the layout, then for real): on gearte's report figures that
     is about a third of the Python calls of drawing one (``docs/report.md``, "Drawing a figure
-    once"). Here the decorations are measured once with the figure's own renderer
-    (``matplotlib._tight_layout.get_tight_layout_figure``: each axes' tight box, the room it
-    needs on each side, the margins shared by a row or column of the grid), the pads those of
-    constrained layout (3 pt), the margins set with ``subplots_adjust`` and the layout engine
-    removed, so ``savefig`` draws once.
+    once"). Here the decorations are measured once by matplotlib's tight layout
+    (:class:`matplotlib.layout_engine.TightLayoutEngine`, run once: each axes' tight box, the
+    room it needs on each side, the margins shared by a row or column of the grid, set with
+    ``subplots_adjust``), with the pads of constrained layout, and the layout engine removed, so
+    ``savefig`` draws once.
 
     Left to constrained layout (False): a figure with a figure legend (``loc="outside ..."``
     is constrained layout's own placement), with axes outside the subplot grid (a colorbar made
     by constrained layout, an inset), with subfigures, with the "compressed" variant, and one
-    whose margins cannot be found (the labels need more room than the figure has).
+    whose margins cannot be found (the labels need more room than the figure has: tight layout
+    warns and sets nothing).
     """
+    import warnings
+
     import matplotlib as mpl
-    from matplotlib._tight_layout import get_subplotspec_list, get_tight_layout_figure
-    from matplotlib.layout_engine import ConstrainedLayoutEngine
+    from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine
 
     engine = fig.get_layout_engine()
+    # "compressed" is ConstrainedLayoutEngine(compress=True); read where the engine keeps it
     if not isinstance(engine, ConstrainedLayoutEngine) or getattr(engine, "_compress", False):
         return False
     if not fig.axes or fig.legends or fig.subfigs:
         return False
-    specs = get_subplotspec_list(fig.axes)
-    if any(spec is None for spec in specs):
+    if any(ax.get_subplotspec() is None for ax in fig.axes):
         return False
     pads = engine.get()
     fontsize = mpl.font_manager.FontProperties(size=mpl.rcParams["font.size"]).get_size_in_points()
-    renderer = fig._get_renderer()
-    with renderer._draw_disabled():
-        margins = get_tight_layout_figure(
-            fig,
-            fig.axes,
-            specs,
-            renderer,
-            pad=72.0 * max(pads["w_pad"], pads["h_pad"]) / fontsize,
-            w_pad=72.0 * pads["w_pad"] / fontsize,
-            h_pad=72.0 * pads["h_pad"] / fontsize,
-        )
-    if not margins:
-        return False
+    tight = TightLayoutEngine(
+        pad=72.0 * max(pads["w_pad"], pads["h_pad"]) / fontsize,
+        w_pad=72.0 * pads["w_pad"] / fontsize,
+        h_pad=72.0 * pads["h_pad"] / fontsize,
+    )
     with mpl.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
-        fig.set_layout_engine(None)
-    fig.subplots_adjust(**margins)
+        fig.set_layout_engine(None)  # (subplots_adjust is refused under constrained layout)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tight.execute(fig)
+    if caught:  # tight layout found no margins and set nothing: constrained layout again
+        fig.set_layout_engine(engine)
+        return False
     return True
 
 
 def polish(fig: Any) -> Any:
     """Decimate long lines of ``fig`` (a matplotlib figure), put legends outside the data,
     integer ticks on integer data and plain-text labels on logarithmic axes."""
-    cache_font_heights()
     _decimate_lines(fig)
     _integer_ticks(fig)
     _legends_outside(fig)

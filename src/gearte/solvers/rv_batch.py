@@ -22,13 +22,13 @@ clearances ``g``) in one compiled loop:
   falling back to LU where a pivot is not positive.
 
 The kernel is ``@njit(cache=True, nogil=True)``, so chunks of samples run in parallel threads;
-``compiled=False`` runs its plain-Python twin (tests). Its results equal the per-case solver's
-to round-off (a test checks 1e-9 on sampled reducers).
+``compiled=False`` runs its plain-Python twin (tests; :func:`gearte.solvers.twins.plain_twins`).
+Its results equal the per-case solver's to round-off (a test checks 1e-9 on sampled reducers).
 """
 
 from __future__ import annotations
 
-import threading
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,8 +57,6 @@ __all__ = [
     "solve_system",
     "solve_positions",
 ]
-
-_TWIN_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -1013,8 +1011,7 @@ def _run(problem, h, en, gap, step_g, step_T, start, rec, tol, maxit, exact, com
     if compiled:
         rot, forces, iters, ST = _solve_batch(*args)
     else:
-        with _TWIN_LOCK:
-            rot, forces, iters, ST = _twin(_solve_batch)(*args)
+        rot, forces, iters, ST = _plain()["_solve_batch"](*args)
     return (rot, forces, iters) + tuple(ST[:, part] for part in parts)
 
 
@@ -1198,19 +1195,10 @@ _KERNELS = ("_solve_batch", "_newton", "_newton_mixed", "_energy", "_assemble",
             "_bearing_terms", "_secant_update", "law_terms")  # fmt: skip
 
 
-def _twin(kernel):
-    """The plain-Python twin of ``kernel``: its ``py_func``, calling the plain-Python versions
-    of the other kernels (swapped into this module's globals while it runs; the caller holds
-    ``_TWIN_LOCK``)."""
-    g = kernel.py_func.__globals__
+@functools.cache
+def _plain() -> dict:
+    """The plain-Python twins of :data:`_KERNELS` (:func:`gearte.solvers.twins.plain_twins`):
+    ``_plain()["_solve_batch"]`` runs the batch with every kernel it calls as plain Python."""
+    from gearte.solvers.twins import plain_twins
 
-    def run(*args):
-        saved = {n: g[n] for n in _KERNELS}
-        for n in _KERNELS:
-            g[n] = getattr(saved[n], "py_func", saved[n])
-        try:
-            return kernel.py_func(*args)
-        finally:
-            g.update(saved)
-
-    return run
+    return plain_twins(globals(), _KERNELS)

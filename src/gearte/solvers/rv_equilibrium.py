@@ -21,13 +21,13 @@ coefficients (its own flank curvature). This outer fixed point is a contraction 
 stiffness varies with ``ln F``) and is iterated to a relative change below ``tol``. Positions are
 solved in sequence, each warm-started from the previous one.
 
-A compiled kernel (numba) and its plain-Python twin (``_solve_all.py_func``) run the same
+A compiled kernel (numba) and its plain-Python twin (``_plain()["_solve_all"]``) run the same
 algorithm; :func:`solve_reference` is an independent scipy check.
 """
 
 from __future__ import annotations
 
-import threading
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,8 +58,6 @@ CLEARANCE_RESIDUAL = 1e-6
 #: 100, docs/metrology.md). A solve that converges stops where it did before; the cap only ends
 #: one that does not.
 NEWTON_MAXIT = 1000
-
-_TWIN_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -533,30 +531,12 @@ def solve_positions(
     q0 = np.zeros(nd) if q0 is None else np.asarray(q0, dtype=float)
     k0 = np.full(ngroups, law.stiffness) if k0 is None else np.asarray(k0, dtype=float)
     coefs = law.coefficients(P, system.contact_gap.shape[1])
-    fn = _solve_all if compiled else _solve_all.py_func
-    if not compiled:
-        # the twin calls the plain-Python versions of the inner kernels too (swapped in under a
-        # lock for the duration of the call; compiled callers do not look these names up)
-        g = _solve_all.py_func.__globals__
-        _TWIN_LOCK.acquire()
-        saved = {n: g[n] for n in ("_newton", "_energy", "law_terms", "_secant_update")}
-        for n in saved:
-            g[n] = saved[n].py_func
-        try:
-            out = fn(
-                K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
-                np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
-                ngroups, law.code, coefs, k0, q0, tol, maxit,
-            )  # fmt: skip
-        finally:
-            g.update(saved)
-            _TWIN_LOCK.release()
-    else:
-        out = fn(
-            K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
-            np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
-            ngroups, law.code, coefs, k0, q0, tol, maxit,
-        )  # fmt: skip
+    fn = _solve_all if compiled else _plain()["_solve_all"]
+    out = fn(
+        K0, f0, Bn, en, kn, cn, np.ascontiguousarray(system.contact_B),
+        np.ascontiguousarray(system.contact_gap), system.contact_group.astype(np.int64),
+        ngroups, law.code, coefs, k0, q0, tol, maxit,
+    )  # fmt: skip
     Q, F, Ks, KC, its = out
     if np.any(its < 0):
         p = int(np.argmax(its < 0))
@@ -636,4 +616,15 @@ def solve_reference(system, torque: float, law: ContactLaw, p: int = 0, k=None, 
     raise ConvergenceError(
         f"solve_reference: scipy root (hybr, then lm) stopped at scaled residual {worst:.3e} "
         f"> tol {tol:.1e} at position {p}"
+    )
+
+
+@functools.cache
+def _plain() -> dict:
+    """The plain-Python twins of the kernels (:func:`gearte.solvers.twins.plain_twins`):
+    ``_plain()["_solve_all"]`` runs the solve with its inner kernels as plain Python too."""
+    from gearte.solvers.twins import plain_twins
+
+    return plain_twins(
+        globals(), ("_solve_all", "_newton", "_energy", "law_terms", "_secant_update")
     )

@@ -198,6 +198,10 @@ class RVDynamicModel:
             "n_fcr": np.size(a_cr),
             "n_rot": np.shape(e.disc_rotation)[1],
         }
+        if set(vals) != set(PF_INDEX):  # every slot of the layout filled, no other
+            raise ValueError(
+                f"kernel_args: pf keys differ from PF_INDEX: {set(vals) ^ set(PF_INDEX)}"
+            )
         for key, val in vals.items():
             pf[PF_INDEX[key]] = val
 

@@ -40,7 +40,11 @@ __all__ = [
     "NPF",
 ]
 
-_SLOT = 16  # t, 6 trigonometric values, 6 involute and 3 cycloid mesh stiffnesses
+# one slot of the memo in ``work``: t, cos/sin of θ_o, θ_s, θ_H, the involute mesh stiffness of
+# each crank (≤ 6) and the cycloid–pin stiffness of each disc (≤ 3), at these offsets
+_M_T, _M_COS_O, _M_SIN_O, _M_COS_S, _M_SIN_S, _M_COS_H, _M_SIN_H, _M_K_SP = range(8)
+_M_K_CR = _M_K_SP + 6
+_SLOT = _M_K_CR + 3
 RHS_WORK_SIZE = 2 * _SLOT + 1
 """Scratch floats :func:`rv_rhs` uses to memoise time-only quantities (≤ 6 cranks, ≤ 3 discs)."""
 
@@ -48,54 +52,95 @@ RHS_SOURCE_KEY = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16]
 """Hash of this file: part of the numba cache key of the integrators built on :func:`rv_rhs`."""
 
 # --- compiled right-hand side ------------------------------------------------------------------
-# layout of the scalar parameter vector ``pf``
-PF_INDEX = {
-    name: i
-    for i, name in enumerate(
-        [
-            "w_o",  # nominal output speed [rad/s]
-            "ratio",  # i
-            "crank_rate",  # crank absolute speed / ω_o = 1 − z_p
-            "phi_h0",  # crank phase at t = 0 [rad]
-            "a_h",  # crank circle radius [mm]
-            "ecc",  # eccentricity [mm]
-            "r_bs",  # base radius of the sun [mm]
-            "alpha",  # working pressure angle of the involute pair [rad]
-            "z_s",
-            "z_p",
-            "k_s",
-            "k_st",
-            "k_sp",  # mean involute mesh stiffness [N/mm]
-            "k_h",
-            "k_ht",
-            "k_hb",
-            "k_cb",
-            "k_cr",  # mean cycloid–pin stiffness [N/mm]
-            "k_o",
-            "beta_cr",  # equivalent pressure angle [rad]
-            "sgn_r",  # sign of the radial component of the pin resultant (+1 outward)
-            "beta_r",  # stiffness-proportional damping coefficient [s]
-            "t_o",  # load torque on the output [N·mm]
-            "m_p",
-            "m_h",
-            "m_c",
-            "cl_oh",  # scalar clearances (the kernel reads the per-bearing array ``clear``)
-            "cl_c",
-            "cl_h",
-            "r_bp",
-            "n_m",
-            "n_n",
-            "cos_alpha",
-            "sin_alpha",
-            "cos_beta_cr",
-            "sin_beta_cr",
-            "n_fsp",  # Fourier terms of the involute mesh stiffness (columns of fsp)
-            "n_fcr",  # Fourier terms of the cycloid–pin stiffness (columns of fcr)
-            "n_rot",  # samples per output revolution of the discs' rotation excitation
-        ]
-    )
-}
-NPF = len(PF_INDEX)
+# --- layout of the scalar parameter vector ``pf``: the one place that names each slot -------
+PF_FIELDS = (
+    "w_o",  # nominal output speed [rad/s]
+    "ratio",  # i
+    "crank_rate",  # crank absolute speed / ω_o = 1 − z_p
+    "phi_h0",  # crank phase at t = 0 [rad]
+    "a_h",  # crank circle radius [mm]
+    "ecc",  # eccentricity [mm]
+    "r_bs",  # base radius of the sun [mm]
+    "alpha",  # working pressure angle of the involute pair [rad]
+    "z_s",
+    "z_p",
+    "k_s",
+    "k_st",
+    "k_sp",  # mean involute mesh stiffness [N/mm]
+    "k_h",
+    "k_ht",
+    "k_hb",
+    "k_cb",
+    "k_cr",  # mean cycloid–pin stiffness [N/mm]
+    "k_o",
+    "beta_cr",  # equivalent pressure angle [rad]
+    "sgn_r",  # sign of the radial component of the pin resultant (+1 outward)
+    "beta_r",  # stiffness-proportional damping coefficient [s]
+    "t_o",  # load torque on the output [N·mm]
+    "m_p",
+    "m_h",
+    "m_c",
+    "cl_oh",  # scalar clearances (the kernel reads the per-bearing array ``clear``)
+    "cl_c",
+    "cl_h",
+    "r_bp",
+    "n_m",
+    "n_n",
+    "cos_alpha",
+    "sin_alpha",
+    "cos_beta_cr",
+    "sin_beta_cr",
+    "n_fsp",  # Fourier terms of the involute mesh stiffness (columns of fsp)
+    "n_fcr",  # Fourier terms of the cycloid–pin stiffness (columns of fcr)
+    "n_rot",  # samples per output revolution of the discs' rotation excitation
+)
+"""The names of the scalar parameters in ``pf``, in their order (filled by
+:meth:`~gearte.models.rv_dynamics.assembly.RVDynamicModel.kernel_args`)."""
+PF_INDEX = {name: i for i, name in enumerate(PF_FIELDS)}
+NPF = len(PF_FIELDS)
+
+# The kernels read ``pf`` through these named indices, each looked up in ``PF_INDEX`` (an unknown
+# name fails at import); numba reads a module's integer globals as compile-time constants, so
+# ``pf[W_O]`` compiles to the same load as ``pf[0]``.
+W_O = PF_INDEX["w_o"]
+RATIO = PF_INDEX["ratio"]
+CRANK_RATE = PF_INDEX["crank_rate"]
+PHI_H0 = PF_INDEX["phi_h0"]
+A_H = PF_INDEX["a_h"]
+ECC = PF_INDEX["ecc"]
+R_BS = PF_INDEX["r_bs"]
+ALPHA = PF_INDEX["alpha"]
+Z_S = PF_INDEX["z_s"]
+Z_P = PF_INDEX["z_p"]
+K_S = PF_INDEX["k_s"]
+K_ST = PF_INDEX["k_st"]
+K_SP = PF_INDEX["k_sp"]
+K_H = PF_INDEX["k_h"]
+K_HT = PF_INDEX["k_ht"]
+K_HB = PF_INDEX["k_hb"]
+K_CB = PF_INDEX["k_cb"]
+K_CR = PF_INDEX["k_cr"]
+K_O = PF_INDEX["k_o"]
+BETA_CR = PF_INDEX["beta_cr"]
+SGN_R = PF_INDEX["sgn_r"]
+BETA_R = PF_INDEX["beta_r"]
+T_O = PF_INDEX["t_o"]
+M_P = PF_INDEX["m_p"]
+M_H = PF_INDEX["m_h"]
+M_C = PF_INDEX["m_c"]
+CL_OH = PF_INDEX["cl_oh"]
+CL_C = PF_INDEX["cl_c"]
+CL_H = PF_INDEX["cl_h"]
+R_BP = PF_INDEX["r_bp"]
+N_M = PF_INDEX["n_m"]
+N_N = PF_INDEX["n_n"]
+COS_ALPHA = PF_INDEX["cos_alpha"]
+SIN_ALPHA = PF_INDEX["sin_alpha"]
+COS_BETA_CR = PF_INDEX["cos_beta_cr"]
+SIN_BETA_CR = PF_INDEX["sin_beta_cr"]
+N_FSP = PF_INDEX["n_fsp"]
+N_FCR = PF_INDEX["n_fcr"]
+N_ROT = PF_INDEX["n_rot"]
 
 
 def kernel_table(inv_mass, err_g, err_m, err_mn, err_n, geo_m, geo_n, clear, fsp, fcr, rot_n):
@@ -169,11 +214,11 @@ def rv_rhs(t, y, args, dydt, work):
     the integrators report as a divergence).
     """
     pf, tab = args
-    nm = np.int64(pf[30])  # counts: exact integers stored as floats
-    nn = np.int64(pf[31])
-    n_sp = np.int64(pf[36])
-    n_cr = np.int64(pf[37])
-    n_rot = np.int64(pf[38])
+    nm = np.int64(pf[N_M])  # counts: exact integers stored as floats
+    nn = np.int64(pf[N_N])
+    n_sp = np.int64(pf[N_FSP])
+    n_cr = np.int64(pf[N_FCR])
+    n_rot = np.int64(pf[N_ROT])
     nd = 3 * (2 * nm + nn + 2)
     # offsets of the arrays in tab, in kernel_table's order (inv_mass at 0)
     o_eg = nd
@@ -195,53 +240,53 @@ def rv_rhs(t, y, args, dydt, work):
     for i0 in range(nd):
         dydt[i0] = v[i0]
         f[i0] = 0.0
-    w_o = pf[0]
+    w_o = pf[W_O]
     th_o = w_o * t
-    th_s = pf[1] * th_o
-    th_h = pf[3] + pf[2] * th_o
+    th_s = pf[RATIO] * th_o
+    th_h = pf[PHI_H0] + pf[CRANK_RATE] * th_o
     # Memo of everything that depends on t only (nominal angles, mesh stiffnesses): two slots
     # [t, cos/sin of θ_o, θ_s, θ_H, k_sp,i (≤ 6), k_cr,j (≤ 3)] and a flag naming the older slot.
-    o = 0 if work[0] == t else _SLOT  # the slot holding t, if one does
-    if work[o] != t:
+    o = 0 if work[_M_T] == t else _SLOT  # the slot holding t, if one does
+    if work[o + _M_T] != t:
         o = _SLOT if work[2 * _SLOT] != 1.0 else 0
         work[2 * _SLOT] = 1.0 if o == _SLOT else 0.0
-        work[o] = t
-        work[o + 1] = np.cos(th_o)
-        work[o + 2] = np.sin(th_o)
-        work[o + 3] = np.cos(th_s)
-        work[o + 4] = np.sin(th_s)
-        work[o + 5] = np.cos(th_h)
-        work[o + 6] = np.sin(th_h)
-        ph_s = pf[8] * (th_s - th_o)
+        work[o + _M_T] = t
+        work[o + _M_COS_O] = np.cos(th_o)
+        work[o + _M_SIN_O] = np.sin(th_o)
+        work[o + _M_COS_S] = np.cos(th_s)
+        work[o + _M_SIN_S] = np.sin(th_s)
+        work[o + _M_COS_H] = np.cos(th_h)
+        work[o + _M_SIN_H] = np.sin(th_h)
+        ph_s = pf[Z_S] * (th_s - th_o)
         cps0 = np.cos(ph_s)
         sps0 = np.sin(ph_s)
         for i1 in range(nm):  # involute mesh stiffness (eq 11), phase z_s(θ_s − θ_o) + z_s ψ_i
             c1 = tab[o_gm + 4 * i1 + 2]
             s1 = tab[o_gm + 4 * i1 + 3]
-            work[o + 7 + i1] = _fourier2(
-                pf[12], tab, o_sp, n_sp, cps0 * c1 - sps0 * s1, sps0 * c1 + cps0 * s1
+            work[o + _M_K_SP + i1] = _fourier2(
+                pf[K_SP], tab, o_sp, n_sp, cps0 * c1 - sps0 * s1, sps0 * c1 + cps0 * s1
             )
-        ph_c = pf[9] * th_h
+        ph_c = pf[Z_P] * th_h
         cpc0 = np.cos(ph_c)
         spc0 = np.sin(ph_c)
         for j1 in range(nn):  # cycloid–pin stiffness (eq 13), phase z_p χ_j
             c2 = tab[o_gn + 4 * j1 + 2]
             s2 = tab[o_gn + 4 * j1 + 3]
-            work[o + 13 + j1] = _fourier2(
-                pf[17], tab, o_cr, n_cr, cpc0 * c2 - spc0 * s2, spc0 * c2 + cpc0 * s2
+            work[o + _M_K_CR + j1] = _fourier2(
+                pf[K_CR], tab, o_cr, n_cr, cpc0 * c2 - spc0 * s2, spc0 * c2 + cpc0 * s2
             )
-    co = work[o + 1]
-    so = work[o + 2]
-    cs = work[o + 3]
-    ss = work[o + 4]
-    chh = work[o + 5]
-    shh = work[o + 6]
-    a_h = pf[4]
-    ecc = pf[5]
-    r_bs = pf[6]
-    ca = pf[32]
-    sa = pf[33]
-    br = pf[21]
+    co = work[o + _M_COS_O]
+    so = work[o + _M_SIN_O]
+    cs = work[o + _M_COS_S]
+    ss = work[o + _M_SIN_S]
+    chh = work[o + _M_COS_H]
+    shh = work[o + _M_SIN_H]
+    a_h = pf[A_H]
+    ecc = pf[ECC]
+    r_bs = pf[R_BS]
+    ca = pf[COS_ALPHA]
+    sa = pf[SIN_ALPHA]
+    br = pf[BETA_R]
     i_out = nd - 3
     # Each body's force [N] and moment [N·mm] is summed in locals, element after element in the
     # order of the element model, from 0.0 (0.0 - a, not -a: the sign of a zero result is kept),
@@ -259,15 +304,15 @@ def rv_rhs(t, y, args, dydt, work):
     voy = v[i_out + 1]
     vot = v[i_out + 2]
     # sun support (ground seat offset = sun assembly error) and input shaft torsion
-    k_s = pf[10]
+    k_s = pf[K_S]
     bsx, bsy = _bearing(qsx - tab[o_eg + 2], qsy - tab[o_eg + 3], vsx, vsy, k_s, br * k_s, 0.0)
     fsx = 0.0 + bsx
     fsy = 0.0 + bsy
-    k_st = pf[11]
+    k_st = pf[K_ST]
     fst = 0.0 + (-k_st * qst - br * k_st * vst)
     # output support
-    k_o = pf[18]
-    box, boy = _bearing(qox - tab[o_eg + 4], qoy - tab[o_eg + 5], vox, voy, k_o, br * k_o, pf[28])
+    k_o = pf[K_O]
+    box, boy = _bearing(qox - tab[o_eg + 4], qoy - tab[o_eg + 5], vox, voy, k_o, br * k_o, pf[CL_H])
     fox = 0.0 + box
     foy = 0.0 + boy
     fot = 0.0
@@ -277,11 +322,11 @@ def rv_rhs(t, y, args, dydt, work):
     sex = es0 * cs - es1 * ss
     sey = es0 * ss + es1 * cs
     w2 = w_o * w_o * a_h
-    mp_w2 = pf[23] * w2
-    mh_w2 = pf[24] * w2
-    k_h = pf[13]
-    k_ht = pf[14]
-    k_hb = pf[15]
+    mp_w2 = pf[M_P] * w2
+    mh_w2 = pf[M_H] * w2
+    k_h = pf[K_H]
+    k_ht = pf[K_HT]
+    k_hb = pf[K_HB]
     for i in range(nm):
         ip = 3 * (1 + i)
         ih = 3 * (1 + nm + i)
@@ -308,7 +353,7 @@ def rv_rhs(t, y, args, dydt, work):
         ny = tx
         px = r_bs * tx
         py = r_bs * ty
-        ksp = work[o + 7 + i]
+        ksp = work[o + _M_K_SP + i]
         ie = o_em + 4 * i
         pe0 = tab[ie]
         pe1 = tab[ie + 1]
@@ -360,13 +405,13 @@ def rv_rhs(t, y, args, dydt, work):
     f[i_out] = fox
     f[i_out + 1] = foy
     # discs
-    w_h = pf[2] * w_o
-    sb = pf[35]
-    cb = pf[34]
-    k_cb = pf[16]
-    sgn_r = pf[20]
-    zp1 = pf[9] - 1.0
-    mc_w2 = pf[25] * w_h * w_h
+    w_h = pf[CRANK_RATE] * w_o
+    sb = pf[SIN_BETA_CR]
+    cb = pf[COS_BETA_CR]
+    k_cb = pf[K_CB]
+    sgn_r = pf[SGN_R]
+    zp1 = pf[Z_P] - 1.0
+    mc_w2 = pf[M_C] * w_h * w_h
     # pin and disc-profile errors: rotation shift Δθ_j(θ_o) of each disc, K samples per
     # output revolution, linearly interpolated (plain twin: assembly.periodic_interp)
     x_rot = th_o / (2.0 * np.pi)
@@ -426,7 +471,7 @@ def rv_rhs(t, y, args, dydt, work):
             fcy -= fay
             fct -= chx2 * fay - chy2 * fax
         # equivalent cycloid–pin contact at the pitch point P = z_p e ê_χ (eq 27, rotating)
-        kcr = work[o + 13 + j]
+        kcr = work[o + _M_K_CR + j]
         # force on the disc along d = sgn sinβ ê + cosβ ẑ×ê ; approach direction n = −d
         nx2 = -(sgn_r * sb * ex - cb * ey)
         ny2 = -(sgn_r * sb * ey + cb * ex)
@@ -444,7 +489,7 @@ def rv_rhs(t, y, args, dydt, work):
         f[ic] = (fcx + fn2 * nx2) + mc_w2 * ccx
         f[ic + 1] = (fcy + fn2 * ny2) + mc_w2 * ccy
         f[ic + 2] = fct + fn2 * g_t
-    f[i_out + 2] = fot - pf[22]
+    f[i_out + 2] = fot - pf[T_O]
     for i3 in range(nd):
         f[i3] *= tab[i3]
 
@@ -454,5 +499,5 @@ def rv_dte(t, y, args):
     """Dynamic transmission error θ_o − θ_s / i [rad] of state ``y`` at time ``t`` [s]; ``args``
     as for :func:`rv_rhs`."""
     pf = args[0]
-    nd = 3 * (2 * np.int64(pf[30]) + np.int64(pf[31]) + 2)
-    return y[nd - 1] - y[2] / pf[1]
+    nd = 3 * (2 * np.int64(pf[N_M]) + np.int64(pf[N_N]) + 2)
+    return y[nd - 1] - y[2] / pf[RATIO]
