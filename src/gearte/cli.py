@@ -43,6 +43,21 @@ def _stop_on_sigterm() -> None:
         signal.signal(signal.SIGTERM, handler)
 
 
+def _exit_after_stop(code: int) -> None:
+    """Exit after a stop. A pool thread still running its chunk (the shutdown does not wait
+    for it beyond its time-out, ``gearte.execution.backends._shutdown_pool``) would keep the
+    interpreter from exiting until it finishes: then end the process at once, the outputs and
+    messages being written and flushed."""
+    from gearte.execution.backends import stuck_worker_threads
+
+    if stuck_worker_threads():
+        with contextlib.suppress(Exception):
+            sys.stdout.flush()
+            sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
 def _error(title: str, message: str) -> None:
     """Print an error without a traceback (rich when available on a terminal)."""
     if sys.stderr.isatty():
@@ -94,7 +109,7 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
             )
         else:
             _error("interrupted", f"stopped by {name}; nothing written, previous outputs kept")
-        sys.exit(128 + signum)
+        _exit_after_stop(128 + signum)
     except BrokenPipeError:  # output piped into `head` and closed: not an error of ours
         sys.stderr.close()
         sys.exit(0)

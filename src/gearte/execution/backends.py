@@ -24,6 +24,7 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from gearte.errors import ClusterLostError, ParameterError, SchedulerError
+from gearte.execution.stop import POLL_S, signals_deferred
 from gearte.execution.streams import default_workers
 
 __all__ = [
@@ -147,19 +148,28 @@ class _PoolBatch(Batch):
         self._jobs: dict[Any, tuple[Callable[[Any], Any], Any, int]] = {}
 
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
-        fut = self._ex._pool.submit(func, task, *self.extra)
-        self.pending[fut] = index
-        self._jobs[fut] = (func, task, self._ex._generation)
+        with signals_deferred():  # the pool's locks: no interrupt inside (gearte.execution.stop)
+            fut = self._ex._pool.submit(func, task, *self.extra)
+            self.pending[fut] = index
+            self._jobs[fut] = (func, task, self._ex._generation)
 
     def next_done(self) -> list[tuple[int, Any]]:
         from concurrent.futures.process import BrokenProcessPool
 
-        done, _ = cf.wait(list(self.pending), return_when=cf.FIRST_COMPLETED)
+        # cf.wait takes every future's lock: a signal is recorded there and acted on between
+        # the short waits, outside the locks (gearte.execution.stop.signals_deferred)
+        done: set[Any] = set()
+        while not done:
+            with signals_deferred():
+                done, _ = cf.wait(
+                    list(self.pending), timeout=POLL_S, return_when=cf.FIRST_COMPLETED
+                )
         out: list[tuple[int, Any]] = []
         broken: int | None = None
         for f in done:
             try:
-                result = f.result()
+                with signals_deferred():
+                    result = f.result()
             except BrokenProcessPool:
                 broken = self._jobs[f][2]
                 continue
@@ -178,17 +188,19 @@ class _PoolBatch(Batch):
         return out
 
     def cancel(self) -> None:
-        for f in self.pending:
-            f.cancel()
+        with signals_deferred():
+            for f in self.pending:
+                f.cancel()
         self._jobs.clear()
         super().cancel()
 
     def finished(self) -> list[tuple[int, Any]]:
         out = []
-        for f, index in list(self.pending.items()):
-            if f.done() and not f.cancelled() and f.exception() is None:
-                out.append((index, f.result()))
-                del self.pending[f]
+        with signals_deferred():
+            for f, index in list(self.pending.items()):
+                if f.done() and not f.cancelled() and f.exception() is None:
+                    out.append((index, f.result()))
+                    del self.pending[f]
         return out
 
 
@@ -267,24 +279,45 @@ def _worker_init() -> None:
 
 
 def _shutdown_pool(pool: cf.Executor, timeout_s: float) -> None:
-    """Shut a pool down without hanging: queued chunks are cancelled; worker processes get
-    ``timeout_s`` to finish, then are terminated, then killed, and always reaped (no orphans).
-    Threads cannot be killed: a thread pool is waited for (its chunks are finite)."""
+    """Shut a pool down without hanging: queued chunks are cancelled; running ones get
+    ``timeout_s`` to finish. Worker processes still alive then are terminated, then killed, and
+    always reaped (no orphans). Threads cannot be killed: a thread still running its chunk after
+    ``timeout_s`` is left to finish in the background (:func:`stuck_worker_threads` lists them;
+    the CLI then ends the process without waiting for them). Every wait is in short slices
+    inside :func:`~gearte.execution.stop.signals_deferred`, so a signal never lands inside the
+    pool's locks."""
+    deadline = time.monotonic() + timeout_s
     if not isinstance(pool, cf.ProcessPoolExecutor):
-        pool.shutdown(wait=True, cancel_futures=True)
+        threads = list(getattr(pool, "_threads", ()) or ())
+        with signals_deferred():
+            pool.shutdown(wait=False, cancel_futures=True)
+        for t in threads:
+            while t.is_alive() and time.monotonic() < deadline:
+                with signals_deferred():
+                    t.join(POLL_S)
         return
     procs = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    deadline = time.monotonic() + timeout_s
+    with signals_deferred():
+        pool.shutdown(wait=False, cancel_futures=True)
     for p in procs:
-        p.join(max(0.0, deadline - time.monotonic()))
+        while p.is_alive() and time.monotonic() < deadline:
+            with signals_deferred():
+                p.join(POLL_S)
     for p in procs:
         if p.is_alive():
             p.terminate()
-            p.join(2.0)
+            with signals_deferred():
+                p.join(2.0)
         if p.is_alive():  # pragma: no cover - SIGTERM ignored
             p.kill()
-            p.join()
+            with signals_deferred():
+                p.join(5.0)
+
+
+def stuck_worker_threads() -> list[threading.Thread]:
+    """gearte's pool threads still running a chunk (after a stop whose shutdown did not wait
+    for them, :func:`_shutdown_pool`)."""
+    return [t for t in threading.enumerate() if t.name.startswith("gearte") and t.is_alive()]
 
 
 def _import_distributed() -> Any:
@@ -557,8 +590,8 @@ class _DaskBatch(Batch):
         cond = getattr(ac, "thread_condition", None)
         while not ac.has_ready() and not ac.is_empty():
             if cond is not None:
-                with cond:
-                    cond.wait(timeout=0.1)
+                with signals_deferred(), cond:  # no interrupt while the lock is held
+                    cond.wait(timeout=POLL_S)
             else:  # pragma: no cover - other distributed versions
                 time.sleep(0.1)
             now = time.monotonic()

@@ -61,7 +61,9 @@ class RunOptions:
 
 
 def _sample_caps(model: Any, prefix: str = "") -> list[tuple[str, int]]:
-    """``(dotted field, upper bound)`` of every sample-count field of a validated case."""
+    """``(dotted field, upper bound)`` of every sample-count field of a validated case that
+    ``--samples`` sets (a Sobol base count or an allocation search count is only capped by it,
+    :func:`sample_cap`, so its own bound does not limit ``--samples``)."""
     from pydantic import BaseModel
 
     caps: list[tuple[str, int]] = []
@@ -70,6 +72,8 @@ def _sample_caps(model: Any, prefix: str = "") -> list[tuple[str, int]]:
         path = f"{prefix}{name}"
         if isinstance(value, BaseModel):
             caps += _sample_caps(value, path + ".")
+        elif name == "sobol_samples" or prefix.endswith("allocation."):
+            continue  # only capped by --samples (sample_cap: min(count, N)), never set by it
         elif "samples" in name and isinstance(value, int) and not isinstance(value, bool):
             bounds = [getattr(m, "le", None) for m in info.metadata]
             bounds += [getattr(m, "lt", None) for m in info.metadata]
