@@ -66,7 +66,7 @@ def test_validate_and_run_both_refuse_the_unit_slip_with_exit_2(tmp_path):
 
 
 def test_eccentricity_of_another_reducer_is_refused(tmp_path):
-    """Eccentricities 2 mm above the design's 1.5 mm: within the format's range, not the design's."""
+    """Eccentricities 2 mm above the design's 1.5 mm: in the format's range, not the design's."""
     folder = _copy_lot(tmp_path)
     p = folder / "crank_eccentricity.csv"
     text = p.read_text(encoding="utf-8")
