@@ -237,6 +237,8 @@ class PoolExecutor(ChunkExecutor):
             return cf.ThreadPoolExecutor(self.workers, thread_name_prefix="gearte")
         methods = multiprocessing.get_all_start_methods()
         ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+        if ctx.get_start_method() == "forkserver":
+            _start_forkserver_ignoring_sigint()
         return cf.ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_worker_init)
 
     def _restart(self, generation: int) -> None:
@@ -259,6 +261,27 @@ class PoolExecutor(ChunkExecutor):
 
     def close(self) -> None:
         _shutdown_pool(self._pool, self.shutdown_timeout_s)
+
+
+def _start_forkserver_ignoring_sigint() -> None:
+    """Start multiprocessing's fork server (once per process) with SIGINT ignored. Ctrl-C reaches
+    the whole process group: a fork server still importing its modules printed a
+    ``KeyboardInterrupt`` traceback (2 of 100 signals of the stress run,
+    ``tests/signal_stress.py``). An ignored signal stays ignored across ``exec``, the server then
+    ignores it as it means to, and so do the workers it forks until :func:`_worker_init`. Only
+    the fork and exec run with SIGINT ignored (milliseconds): a Ctrl-C then is lost, and the
+    next one stops the run."""
+    import signal
+    from multiprocessing import forkserver
+
+    if threading.current_thread() is not threading.main_thread():
+        forkserver.ensure_running()
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _worker_init() -> None:
