@@ -286,7 +286,13 @@ def run(
         t0 = time.perf_counter()
         from gearte.errors import ClusterLostError
         from gearte.io.case_file import load_case
-        from gearte.report.outputs import check_output_dir, safe_label, write_outputs
+        from gearte.report.outputs import (
+            check_free_space,
+            check_output_dir,
+            expected_output_bytes,
+            safe_label,
+            write_outputs,
+        )
         from gearte.studies import RunOptions, run_case
 
         t1 = time.perf_counter()
@@ -302,6 +308,7 @@ def run(
             t2 = time.perf_counter()
             default = os.path.join("out", safe_label(c.case.name or c.case.kind))
             target = check_output_dir(out_dir if out_dir is not None else default)
+            check_free_space(target, expected_output_bytes(c, report=not no_report))
             listening: Any = contextlib.nullcontext()
             if renderer is not None:  # it imports what we did, then draws each analysis's
                 from gearte.results import analysis_listener  # figures as soon as it is done
@@ -389,7 +396,12 @@ def sweep(
     def _sweep() -> None:
         from gearte.errors import ParameterError
         from gearte.io.case_file import load_case
-        from gearte.report.outputs import check_output_dir, safe_label
+        from gearte.report.outputs import (
+            check_free_space,
+            check_output_dir,
+            expected_output_bytes,
+            safe_label,
+        )
         from gearte.sweep import Coupled, Vary, parse_vary, read_points, run_sweep, write_sweep
 
         varies: list[Vary | Coupled] = [parse_vary(v) for v in vary]
@@ -400,6 +412,7 @@ def sweep(
         c = load_case(case)
         default = os.path.join("out", f"sweep_{safe_label(c.case.name or c.case.kind)}")
         target = check_output_dir(out_dir if out_dir is not None else default)
+        check_free_space(target, expected_output_bytes(c, report=False))
         from gearte.errors import Interrupted
 
         try:
