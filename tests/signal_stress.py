@@ -74,6 +74,7 @@ def trial(
     )
     args = [case, "--out", str(out), "--no-report", "--no-progress", "--workers", "2"]
     cmd = [sys.executable, "-c", CLI, "run", *args, "--scheduler", scheduler, *extra]
+    env = {**os.environ, "GEARTE_DEBUG": "1"}  # a bug shows its traceback (counted as bad)
     t0 = time.monotonic()
     p = subprocess.Popen(
         cmd,
@@ -81,6 +82,7 @@ def trial(
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        env=env,
     )
     rec: dict = {"case": name, "scheduler": scheduler, "signal": signal.Signals(sig).name}
     rec["delay_s"] = round(delay_s, 2)
@@ -104,6 +106,7 @@ def trial(
     if "Traceback" in err:
         rec["outcome"] = "bad"
         rec["why"] = "traceback"
+        rec["stderr"] = err[-4000:]
         return rec
     if p.returncode == 0:
         rec["outcome"] = "finished"
@@ -111,6 +114,7 @@ def trial(
     if p.returncode != 128 + sig:
         rec["outcome"] = "bad"
         rec["why"] = f"exit {p.returncode}"
+        rec["stderr"] = err[-4000:]
         return rec
     text = (out / "results.json").read_text()
     if text == "old":
