@@ -91,8 +91,8 @@ def _preparse_problem(text: str) -> str | None:
             return f"line {number} has {len(line)} characters; the limit is {MAX_LINE_CHARS}"
         if line.count(".") >= MAX_NESTING and _dotted_depth(line) > MAX_NESTING:
             return (
-                f"line {number} has a dotted key of {_dotted_depth(line)} parts; tables nest at "
-                f"most {MAX_NESTING} levels"
+                f"line {number} has a dotted key of {_dotted_depth(line)} parts: nested deeper "
+                f"than {MAX_NESTING} levels"
             )
     return None
 
