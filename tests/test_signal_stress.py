@@ -139,3 +139,30 @@ def test_fifty_sigint_and_fifty_sigterm_under_load_never_hang(tmp_path):
     tally = signal_stress.run(50, 2, 120.0, 33, tmp_path / "signals.jsonl")
     bad = {k: n for k, n in tally.items() if k[1] not in ("stopped", "finished")}
     assert not bad, tally
+
+
+@posix_only
+def test_signal_inside_numbas_compiler_waits_for_the_lock_to_be_released():
+    """Raised inside numba's compiler, the interrupt left a half-built library and the run's
+    later kernels failed ("no compiled object yet", exit 3): it is now delivered when the main
+    thread releases the compiler lock."""
+    from numba.core import event
+
+    from gearte.execution.stop import defer_signals_while_compiling
+
+    defer_signals_while_compiling()
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        reached = False
+        with pytest.raises(KeyboardInterrupt):
+            event.start_event("numba:compiler_lock")
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                threading.Event().wait(0.05)
+                reached = True
+            finally:
+                event.end_event("numba:compiler_lock")
+        assert reached
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, old)

@@ -85,6 +85,9 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     )
 
     _stop_on_sigterm()
+    from gearte.execution.backends import quiet_pool_manager_after_stop
+
+    quiet_pool_manager_after_stop()
     try:
         try:
             with fewer_collections():  # numba's compiler: ~1 s less CPU on a cold cache

@@ -285,10 +285,11 @@ def _start_forkserver_ignoring_sigint() -> None:
 
 
 def _worker_init() -> None:
-    """Runs first in every local worker process: ignore SIGINT and SIGTERM. Ctrl-C in a terminal
-    (and a SIGTERM sent to the process group) reaches every process of the group; the main
-    process stops the work and shuts the pool down, and workers must not print a
-    ``KeyboardInterrupt`` traceback each. Then load SciPy's BLAS modules for
+    """Runs first in every local worker process: ignore SIGINT. Ctrl-C in a terminal reaches
+    every process of the group; the main process stops the work and shuts the pool down, and
+    workers must not print a ``KeyboardInterrupt`` traceback each (a SIGTERM to the group ends
+    them at once, as it should: ignoring it left workers and the fork server running after the
+    main process had gone). Then load SciPy's BLAS modules for
     numba (:mod:`gearte._blas`): a worker's first kernel would import all of ``scipy.linalg``
     (~0.3 s CPU per worker), and collect the young generation less often
     (:mod:`gearte._gc`: a worker may compile the kernels on a cold cache)."""
@@ -298,18 +299,14 @@ def _worker_init() -> None:
     from gearte._gc import set_fewer_collections
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    # SIGTERM to the process group (a job scheduler, `kill -- -PGID`) killed the workers first:
-    # the pool broke, and its manager thread raised InvalidStateError on the chunks the main
-    # process had just cancelled (a traceback on the terminal). The main process ends them.
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     preload_scipy_blas()
     set_fewer_collections()
 
 
 def _shutdown_pool(pool: cf.Executor, timeout_s: float) -> None:
     """Shut a pool down without hanging: queued chunks are cancelled; running ones get
-    ``timeout_s`` to finish. Worker processes still alive then are killed (they ignore SIGTERM,
-    :func:`_worker_init`) and always reaped (no orphans). Threads cannot be killed: a thread
+    ``timeout_s`` to finish. Worker processes still alive then are terminated, then killed, and
+    always reaped (no orphans). Threads cannot be killed: a thread
     still running its chunk after ``timeout_s`` is left to finish in the background
     (:func:`stuck_worker_threads` lists them; the CLI then ends the process without waiting
     for them). Every wait is in short slices inside
@@ -332,19 +329,39 @@ def _shutdown_pool(pool: cf.Executor, timeout_s: float) -> None:
         while p.is_alive() and time.monotonic() < deadline:
             with signals_deferred():
                 p.join(POLL_S)
-    if any(p.is_alive() for p in procs):
-        # the pool's manager thread marks every future it still holds as broken when a worker
-        # dies; a cancelled one then raises InvalidStateError (CPython 3.11): drop those first
-        items = getattr(pool, "_pending_work_items", None)
-        if isinstance(items, dict):
-            with signals_deferred():
-                for key in [k for k, w in list(items.items()) if w.future.cancelled()]:
-                    items.pop(key, None)
     for p in procs:
-        if p.is_alive():  # workers ignore SIGTERM (_worker_init): SIGKILL
+        if p.is_alive():
+            p.terminate()
+            with signals_deferred():
+                p.join(2.0)
+        if p.is_alive():  # pragma: no cover - SIGTERM ignored
             p.kill()
             with signals_deferred():
                 p.join(5.0)
+
+
+def quiet_pool_manager_after_stop() -> None:
+    """Silence one known traceback of CPython 3.11's process pool: when a SIGTERM to the process
+    group ends the workers while the main process cancels its queued chunks, the pool's manager
+    thread marks every chunk it still holds as failed and raises ``InvalidStateError`` on the
+    cancelled ones (``terminate_broken``); nothing is lost (the main process has stopped), but
+    the traceback reached the terminal. Every other thread exception is reported as before.
+    Installed by the CLI."""
+    from concurrent.futures.process import _ExecutorManagerThread
+
+    previous = threading.excepthook
+    if getattr(previous, "_gearte_quiet", False):  # installed already
+        return
+
+    def hook(args: Any) -> None:
+        if isinstance(args.thread, _ExecutorManagerThread) and isinstance(
+            args.exc_value, cf.InvalidStateError
+        ):
+            return
+        previous(args)
+
+    hook._gearte_quiet = True  # type: ignore[attr-defined]
+    threading.excepthook = hook
 
 
 def stuck_worker_threads() -> list[threading.Thread]:

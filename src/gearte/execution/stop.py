@@ -144,10 +144,19 @@ def signals_deferred() -> Iterator[None]:
     and for a signal that is ignored or left to the system (``SIG_IGN``, ``SIG_DFL``), the block
     changes nothing.
     """
-    global _depth, _received
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _enter()
+    try:
+        yield
+    finally:
+        _leave()
+
+
+def _enter() -> None:
+    """Start a deferred section of the main thread (nested sections count)."""
+    global _depth, _received
     if _depth == 0:
         _received = 0
         for sig in _DEFERRED:
@@ -156,18 +165,49 @@ def signals_deferred() -> Iterator[None]:
                 _saved[sig] = handler
                 signal.signal(sig, _record)
     _depth += 1
-    try:
-        yield
-    finally:
-        _depth -= 1
-        if _depth == 0:
-            saved = dict(_saved)
-            _saved.clear()
-            for signum, previous in saved.items():
-                signal.signal(signum, previous)
-            if _recorded:
-                first = _recorded[0]
-                _recorded.clear()
-                deliver = saved.get(first)
-                if callable(deliver):
-                    deliver(first, None)
+
+
+def _leave() -> None:
+    """End a deferred section; the outermost puts the handlers back and delivers the first
+    recorded signal (which may raise)."""
+    global _depth
+    _depth -= 1
+    if _depth > 0:
+        return
+    saved = dict(_saved)
+    _saved.clear()
+    for signum, previous in saved.items():
+        signal.signal(signum, previous)
+    if _recorded:
+        first = _recorded[0]
+        _recorded.clear()
+        deliver = saved.get(first)
+        if callable(deliver):
+            deliver(first, None)
+
+
+_COMPILE_LISTENER: list[Any] = []
+
+
+def defer_signals_while_compiling() -> None:
+    """Make numba's compiler a deferred section (:func:`signals_deferred`) in the main thread:
+    a signal that arrives while the main thread holds numba's compiler lock is delivered when
+    the lock is released. Raised inside the compiler, the interrupt left a half-built library
+    behind, and the run's later kernels failed with "RuntimeError: no compiled object yet"
+    (exit 3; seen in the signal stress run). Call it once numba is imported (idempotent)."""
+    if _COMPILE_LISTENER:
+        return
+    from numba.core import event
+
+    class _Listener(event.Listener):
+        def on_start(self, _event: Any) -> None:
+            if threading.current_thread() is threading.main_thread():
+                _enter()
+
+        def on_end(self, _event: Any) -> None:
+            if threading.current_thread() is threading.main_thread():
+                _leave()
+
+    listener = _Listener()
+    event.register("numba:compiler_lock", listener)
+    _COMPILE_LISTENER.append(listener)

@@ -300,6 +300,9 @@ def _numba_timer() -> Iterator[dict[str, float]]:
 
         timer.append(event.TimingListener())
         event.register("numba:compiler_lock", timer[0])
+        from gearte.execution.stop import defer_signals_while_compiling
+
+        defer_signals_while_compiling()  # after the timer: a signal it delivers may raise
 
     hook = None
     if "numba" in sys.modules:
