@@ -284,8 +284,32 @@ def _start_forkserver_ignoring_sigint() -> None:
         signal.signal(signal.SIGINT, previous)
 
 
+def die_with_parent() -> None:
+    """Linux: this process gets SIGKILL when its parent dies (``PR_SET_PDEATHSIG``), so no
+    worker outlives the run. A worker of a process pool is forked by multiprocessing's fork
+    server, which ends when the main process does; a worker left behind after a SIGTERM to the
+    group (one spawned just after it, or one blocked on the queue lock of a worker killed while
+    reading) kept the terminal's pipe open (the stress run counted it as a hang). Where the
+    parent is already gone, the process exits at once."""
+    import os
+    import signal
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    parent = os.getppid()
+    with contextlib.suppress(Exception):
+        import ctypes
+
+        pr_set_pdeathsig = 1
+        ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, int(signal.SIGKILL))
+    if os.getppid() != parent:  # the parent died before the request took effect
+        os._exit(1)
+
+
 def _worker_init() -> None:
-    """Runs first in every local worker process: ignore SIGINT. Ctrl-C in a terminal reaches
+    """Runs first in every local worker process: ignore SIGINT, die with the parent
+    (:func:`die_with_parent`). Ctrl-C in a terminal reaches
     every process of the group; the main process stops the work and shuts the pool down, and
     workers must not print a ``KeyboardInterrupt`` traceback each (a SIGTERM to the group ends
     them at once, as it should: ignoring it left workers and the fork server running after the
@@ -299,6 +323,7 @@ def _worker_init() -> None:
     from gearte._gc import set_fewer_collections
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent()
     preload_scipy_blas()
     set_fewer_collections()
 

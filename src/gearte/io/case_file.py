@@ -105,6 +105,11 @@ def read_case_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
     byte is read), UTF-8 text whose lines are at most :data:`MAX_LINE_CHARS` long and whose
     dotted keys have at most :data:`MAX_NESTING` parts (checked before the TOML parser sees it).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The case file.
+
     Raises
     ------
     CaseFileError

@@ -174,14 +174,11 @@ def _fewer_collections() -> None:
 
 
 def _die_with_parent() -> None:
-    """Linux: this process gets SIGKILL when its parent dies (no orphaned renderer)."""
-    if not sys.platform.startswith("linux"):
-        return
-    with contextlib.suppress(Exception):
-        import ctypes
+    """Linux: this process gets SIGKILL when its parent dies (no orphaned renderer;
+    :func:`gearte.execution.backends.die_with_parent`)."""
+    from gearte.execution.backends import die_with_parent
 
-        pr_set_pdeathsig = 1
-        ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, int(signal.SIGKILL))
+    die_with_parent()
 
 
 def _read_all(fd: int) -> bytes:

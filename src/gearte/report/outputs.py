@@ -221,6 +221,13 @@ def check_free_space(out: Path, nbytes: int) -> None:
     when the result set was written (it is still written as one set, so a disk that fills up
     during the run keeps the previous outputs).
 
+    Parameters
+    ----------
+    out : Path
+        The output folder (it need not exist yet: the nearest existing parent is measured).
+    nbytes : int
+        Expected size of the result set [bytes].
+
     Raises
     ------
     OutputError
