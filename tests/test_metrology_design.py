@@ -131,3 +131,17 @@ def test_validate_refuses_what_run_refuses_for_every_length_unit_slip(tmp_path, 
     assert v.exit_code == r.exit_code, (v.output, r.output)
     if v.exit_code:
         assert v.exit_code == 2 and file in v.output
+
+
+def test_design_check_of_a_serial_with_another_bore_count_does_not_crash(tmp_path):
+    """Found by the fuzz run: a serial with 2 bores where the design has 3 (read without the
+    design's count) broke the comparison (a numpy broadcast error); the count is the reader's
+    check, the bores given are compared."""
+    import numpy as np
+
+    from gearte.io import metrology as mt
+
+    nominal = np.array([[45.0, 0.0], [-22.5, 38.97], [-22.5, -38.97]])
+    mt.write_disc_bores(tmp_path / "b.csv", {"D-1": nominal[:2] + 0.001})
+    rows = mt.read_disc_bores(tmp_path / "b.csv")
+    mt.check_against_design(tmp_path / "b.csv", "disc_bores", rows, nominal, 45.0)
