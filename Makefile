@@ -18,7 +18,7 @@ DEMO_CASE ?= hu2020_rv80e_initial
 TEST_WORKERS ?= auto
 PYTEST := $(BIN)/python -m pytest -q -n $(TEST_WORKERS)
 
-.PHONY: demo test test-slow test-latest lint typecheck bench lock clean fuzz fuzz-extremes docs
+.PHONY: demo test test-slow test-latest lint typecheck bench lock clean fuzz fuzz-extremes docs signal-stress
 
 $(VENV)/bin/python:
 	@echo "==> creating $(VENV) with $(PYTHON)"
@@ -90,6 +90,16 @@ fuzz-extremes: $(DEV_STAMP)
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test nice -n 10 $(BIN)/python tests/fuzzing.py \
 		--count -1 --runs -1 --run-cpu-limit $(FUZZ_RUN_CPU) --run-timeout 600 \
 		--record out/fuzz_extremes.jsonl
+
+# SIGNAL_COUNT SIGINT and SIGNAL_COUNT SIGTERM at random times to real `gearte run` processes
+# (a Monte-Carlo, a planetary Monte-Carlo, a yield run with an allocation search; threads and
+# processes) beside two busy processes: no hang, no traceback, partial results as documented
+# (docs/errors.md, "Signals"); ~15 min on 2 cores. Recorded in out/signals.jsonl.
+SIGNAL_COUNT ?= 50
+signal-stress: $(DEV_STAMP)
+	mkdir -p out
+	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test nice -n 10 $(BIN)/python tests/signal_stress.py \
+		--count $(SIGNAL_COUNT) --load 2 --record out/signals.jsonl
 
 test-slow: $(DEV_STAMP)
 	NUMBA_CACHE_DIR=$(CURDIR)/.numba_cache_test $(PYTEST) -m slow
