@@ -1,13 +1,15 @@
 """Signal stress harness: SIGINT / SIGTERM at random times to real ``gearte run`` processes.
 
-Each trial starts ``gearte run CASE`` (a process of its own session, with Python's own SIGINT
-handler as in a terminal), waits a random delay, sends the signal to the whole process group
-(as Ctrl-C in a terminal does) and waits for the exit, at most ``--timeout`` seconds; a process
-still alive then is a **hang** (its group is killed with SIGKILL and reaped). Outcomes:
+Each trial starts ``gearte run CASE`` (the ``gearte`` command's entry point, a process of its
+own session, with Python's own SIGINT handler as in a terminal), waits a random delay, sends the
+signal to the whole process group (as Ctrl-C in a terminal does) and waits for the exit, at most
+``--timeout`` seconds; a process still alive then is a **hang** (its group is killed with SIGKILL
+and reaped). Outcomes:
 
 * ``stopped``: exit 128 + signal, one ``interrupted`` message, no traceback; the output folder
   holds a set marked ``"partial": true`` whose first warning says what was cut (``partial``), or
-  the previous set stays untouched (``nothing written``);
+  the previous set stays untouched (``nothing written``), or — the signal came after the whole
+  set was written — the complete set, and the message says so (``complete``);
 * ``finished``: exit 0 before the signal came (the delay was longer than the run);
 * ``hang``, or ``bad`` (any other exit code, a traceback, a partial set without its warning).
 
@@ -41,7 +43,7 @@ from pathlib import Path
 #: shell inherits SIGINT ignored), then the CLI.
 CLI = (
     "import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
-    "from gearte.cli import main; sys.exit(main())"
+    "from gearte.cli import entry; entry()"
 )
 
 #: ``(name, case, extra arguments, largest delay before the signal [s])``: each run takes 5 to
@@ -123,6 +125,10 @@ def trial(
         rec["kept"] = "nothing written"
         return rec
     doc = json.loads(text)
+    if doc.get("partial") is not True and "complete results were written" in err:
+        rec["outcome"] = "stopped"  # the signal came after the whole set was written
+        rec["kept"] = "complete"
+        return rec
     warn = (doc.get("warnings") or [""])[0]
     ok = doc.get("partial") is True and warn.startswith("PARTIAL result")
     rec["outcome"] = "stopped" if ok else "bad"

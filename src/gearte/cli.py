@@ -43,6 +43,11 @@ def _stop_on_sigterm() -> None:
         signal.signal(signal.SIGTERM, handler)
 
 
+#: Output folders of this process's commands whose whole result set was written (a signal that
+#: comes after it says so instead of "nothing written").
+_COMPLETE: list[str] = []
+
+
 def _exit_after_stop(code: int) -> None:
     """Exit after a stop. A pool thread still running its chunk (the shutdown does not wait
     for it beyond its time-out, ``gearte.execution.backends._shutdown_pool``) would keep the
@@ -85,6 +90,7 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     )
 
     _stop_on_sigterm()
+    _COMPLETE.clear()
     from gearte.execution.backends import quiet_pool_manager_after_stop
 
     quiet_pool_manager_after_stop()
@@ -109,6 +115,11 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
                 "interrupted",
                 f"stopped by {name}: the finished chunks were written to {written}, marked "
                 'partial ("partial": true; its first warning says what was cut)',
+            )
+        elif _COMPLETE:  # the signal came after the whole result set was written
+            _error(
+                "interrupted",
+                f"stopped by {name} after the complete results were written to {_COMPLETE[-1]}",
             )
         else:
             _error("interrupted", f"stopped by {name}; nothing written, previous outputs kept")
@@ -222,6 +233,7 @@ def entry() -> None:
     import atexit
     import threading
 
+    _stop_on_sigterm()  # as early as can be: a SIGTERM during the imports stops cleanly too
     code: int
     try:
         main()
@@ -333,6 +345,7 @@ def run(
                     raise
             result.timings = {"imports: gearte": t1 - t0, "load case": t2 - t1, **result.timings}
             paths = write_outputs(result, target, report=not no_report, worker=renderer)
+            _COMPLETE.append(str(target))
         finally:
             if renderer is not None:
                 renderer.close()
