@@ -33,7 +33,10 @@ the bundled lot's metrology files (:mod:`gearte.io.metrology`), mutated line- an
 (hostile cells, deleted, duplicated or swapped rows, ×50 blow-ups, renamed or re-united columns,
 hostile metadata, cut or corrupted bytes), read by their reader: a complete object with finite
 numbers, or one ``BenchFileError``/``MeasurementFileError`` line naming the file; anything else
-is a crash.
+is a crash. The lot's bore and eccentricity files are also checked against the lot's design, as
+``validate`` and ``run`` check them, and an accepted file whose header gives a length column
+another unit than its base file's is counted as ``file_unit_slip_accepted`` (silent nonsense:
+must stay 0).
 
 ``--count -1`` replaces the random mutants by the **systematic sweep of extreme values**
 (:func:`extreme_mutants`, ``make fuzz-extremes``): every positive number of every bundled case
@@ -916,10 +919,27 @@ def _finite(obj: Any) -> bool:
     return True
 
 
-def check_measurement(reader: str, text: str, tmp: Path) -> Outcome:
-    """Read one measurement file text with its reader and classify the outcome."""
+_DESIGN: list[Any] = []
+
+
+def _lot_design() -> Any:
+    """The design reducer of the bundled lot (``han2023_rv110e_no_errors``), built once."""
+    if not _DESIGN:
+        from gearte.io.case_file import load_case
+        from gearte.studies.rv_reducer import build_reducer
+
+        _DESIGN.append(build_reducer(load_case("han2023_rv110e_no_errors").reducer))
+    return _DESIGN[0]
+
+
+def check_measurement(reader: str, text: str, tmp: Path, design: bool = False) -> Outcome:
+    """Read one measurement file text with its reader and classify the outcome; with
+    ``design`` (a file of the bundled lot), what the reader accepts is also checked against the
+    lot's design as ``validate`` and ``run`` check it (bore centres, cam eccentricities:
+    :func:`gearte.studies._measured.check_measured_against_design`)."""
     from gearte.errors import BenchFileError, MeasurementFileError
     from gearte.io import bench, metrology
+    from gearte.studies._measured import check_measured_against_design
 
     path = tmp / "measured.csv"
     path.write_text(text, encoding="utf-8", errors="surrogatepass")
@@ -929,7 +949,12 @@ def check_measurement(reader: str, text: str, tmp: Path) -> Outcome:
         else (metrology, METROLOGY_READERS[reader])
     )
     try:
-        got = getattr(module, name)(path)
+        counts = {"disc_bores": {"bores": 3}, "crank_eccentricity": {"cams": 2}}
+        kw = counts.get(reader, {}) if design else {}  # the design's counts, as validate passes
+        got = getattr(module, name)(path, **kw)
+        if design and reader in ("disc_bores", "crank_eccentricity"):
+            key = "bores" if reader == "disc_bores" else "cams"
+            check_measured_against_design(_lot_design(), str(path), **{key: got})
     except (BenchFileError, MeasurementFileError) as exc:
         msg = str(exc)
         lines = msg.splitlines()
@@ -949,6 +974,19 @@ def check_measurement(reader: str, text: str, tmp: Path) -> Outcome:
     return Outcome("accepted")
 
 
+def _length_units(text: str) -> list[tuple[str, str]]:
+    """``(column, length unit)`` of a measurement file's header (the first line that is neither
+    blank nor a ``#`` line), in order."""
+    lines = text.removeprefix("\ufeff").splitlines()  # as the readers see it
+    head = next((ln for ln in lines if ln.strip() and not ln.strip().startswith("#")), "")
+    out = []
+    for cell in re.split(r"[,;\t]", head):
+        m = re.match(r"\s*(.*?)\s*\[\s*(um|µm|micron|mm)\s*\]\s*$", cell.lower())
+        if m:
+            out.append((m[1], "mm" if m[2] == "mm" else "um"))
+    return out
+
+
 def fuzz_measurements(count: int, seed: int, tmp: Path, verbose: bool = False) -> Counter[str]:
     """Fuzz ``count`` mutated measurement files; the tally of outcomes (``file_*``)."""
     rng = random.Random(seed)
@@ -958,7 +996,11 @@ def fuzz_measurements(count: int, seed: int, tmp: Path, verbose: bool = False) -
     for i in range(count):
         reader, text = bases[names[i % len(names)]]
         mutant, done = mutate_csv(text, rng)
-        out = check_measurement(reader, mutant, tmp)
+        out = check_measurement(reader, mutant, tmp, design=names[i % len(names)].startswith("lot"))
+        if out.status == "accepted" and _length_units(mutant) != _length_units(text):
+            # a length column read in another unit than the base file's (a unit slip in the
+            # header): silent nonsense unless a range or the design refuses it
+            out = Outcome("unit_slip_accepted", done)
         tally[f"file_{out.status}"] += 1
         if verbose and out.status not in ("accepted", "rejected"):
             print(f"[file {out.status}] {reader}: {done}\n    {out.detail}", file=sys.stderr)

@@ -53,6 +53,15 @@ def case_path(name_or_path: str | os.PathLike[str]) -> Path:
     key = p.stem if p.suffix == ".toml" else str(name_or_path)
     if key in cases:
         return cases[key]
+    try:
+        exists = p.exists()
+    except (OSError, ValueError):
+        exists = False
+    if exists:  # a folder, a device, a FIFO: not a case file (nothing is read)
+        raise FileNotFoundError(
+            f"{os.fspath(name_or_path)} is not a regular file (a folder, a device or a FIFO), "
+            "so not a case file"
+        )
     raise FileNotFoundError(
         f"no case file {str(name_or_path)!r} and no bundled case of that name; "
         f"bundled cases: {', '.join(cases) or '(none)'}"

@@ -45,6 +45,26 @@ def _stop_on_sigterm() -> None:
         signal.signal(signal.SIGTERM, handler)
 
 
+#: Output folders of this process's commands whose whole result set was written (a signal that
+#: comes after it says so instead of "nothing written").
+_COMPLETE: list[str] = []
+
+
+def _exit_after_stop(code: int) -> None:
+    """Exit after a stop. A pool thread still running its chunk (the shutdown does not wait
+    for it beyond its time-out, ``gearte.execution.backends._shutdown_pool``) would keep the
+    interpreter from exiting until it finishes: then end the process at once, the outputs and
+    messages being written and flushed."""
+    from gearte.execution.backends import stuck_worker_threads
+
+    if stuck_worker_threads():
+        with contextlib.suppress(Exception):
+            sys.stdout.flush()
+            sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
 def _error(title: str, message: str) -> None:
     """Print an error without a traceback (rich when available on a terminal)."""
     if sys.stderr.isatty():
@@ -72,6 +92,10 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
     )
 
     _stop_on_sigterm()
+    _COMPLETE.clear()
+    from gearte.execution.backends import quiet_pool_manager_after_stop
+
+    quiet_pool_manager_after_stop()
     try:
         try:
             with fewer_collections():  # numba's compiler: ~1 s less CPU on a cold cache
@@ -94,9 +118,14 @@ def _guarded(fn: Callable[[], Any], debug: bool) -> Any:
                 f"stopped by {name}: the finished chunks were written to {written}, marked "
                 'partial ("partial": true; its first warning says what was cut)',
             )
+        elif _COMPLETE:  # the signal came after the whole result set was written
+            _error(
+                "interrupted",
+                f"stopped by {name} after the complete results were written to {_COMPLETE[-1]}",
+            )
         else:
             _error("interrupted", f"stopped by {name}; nothing written, previous outputs kept")
-        sys.exit(128 + signum)
+        _exit_after_stop(128 + signum)
     except BrokenPipeError:  # output piped into `head` and closed: not an error of ours
         sys.stderr.close()
         sys.exit(0)
@@ -206,6 +235,7 @@ def entry() -> None:
     import atexit
     import threading
 
+    _stop_on_sigterm()  # as early as can be: a SIGTERM during the imports stops cleanly too
     code: int
     try:
         main()
@@ -335,7 +365,13 @@ def run(
         beat.stage("loading gearte")
         from gearte.errors import ClusterLostError
         from gearte.io.case_file import load_case
-        from gearte.report.outputs import check_output_dir, safe_label, write_outputs
+        from gearte.report.outputs import (
+            check_free_space,
+            check_output_dir,
+            expected_output_bytes,
+            safe_label,
+            write_outputs,
+        )
         from gearte.studies import RunOptions, run_case
 
         t1 = time.perf_counter()
@@ -353,6 +389,7 @@ def run(
             t2 = time.perf_counter()
             default = os.path.join("out", safe_label(c.case.name or c.case.kind))
             target = check_output_dir(out_dir if out_dir is not None else default)
+            check_free_space(target, expected_output_bytes(c, report=not no_report))
             listening: Any = contextlib.nullcontext()
             if renderer is not None:  # it imports what we did, then draws each analysis's
                 from gearte.results import analysis_listener  # figures as soon as it is done
@@ -382,6 +419,7 @@ def run(
             }
             beat.stage("writing results.json" + ("" if no_report else " and the report (figures)"))
             paths = write_outputs(result, target, report=not no_report, worker=renderer)
+            _COMPLETE.append(str(target))
         finally:
             beat.stage(None)
             if renderer is not None:
@@ -450,7 +488,12 @@ def sweep(
     def _sweep() -> None:
         from gearte.errors import ParameterError
         from gearte.io.case_file import load_case
-        from gearte.report.outputs import check_output_dir, safe_label
+        from gearte.report.outputs import (
+            check_free_space,
+            check_output_dir,
+            expected_output_bytes,
+            safe_label,
+        )
         from gearte.sweep import Coupled, Vary, parse_vary, read_points, run_sweep, write_sweep
 
         varies: list[Vary | Coupled] = [parse_vary(v) for v in vary]
@@ -461,6 +504,7 @@ def sweep(
         c = load_case(case)
         default = os.path.join("out", f"sweep_{safe_label(c.case.name or c.case.kind)}")
         target = check_output_dir(out_dir if out_dir is not None else default)
+        check_free_space(target, expected_output_bytes(c, report=False))
         from gearte.errors import Interrupted
 
         try:

@@ -32,7 +32,9 @@ reason.
 
 from __future__ import annotations
 
+import errno
 import os
+import stat
 from typing import Any
 
 from gearte.errors import ParameterError
@@ -50,6 +52,7 @@ __all__ = [
     "check_time",
     "check_sweep_points",
     "no_worker_timeout_s",
+    "read_input_file",
 ]
 
 #: Plausibility floors of physical sizes: ``name -> (smallest value, unit, why)``. A case-file key
@@ -333,3 +336,69 @@ def check_sweep_points(n: int) -> None:
             f"the grid has {n} points, over the limit of {limit} "
             "(raise it with GEARTE_MAX_SWEEP_POINTS if you mean it)",
         )
+
+
+def read_input_file(path: str | os.PathLike[str], max_bytes: int) -> bytes:
+    """The bytes of an input file (a case, measurement, bench or points file), read only when
+    it is a regular file of at most ``max_bytes``.
+
+    The file is opened without blocking (a FIFO with no writer does not wait) and checked on the
+    open descriptor before any byte is read: a device (``/dev/zero``, ``/dev/urandom``), a FIFO,
+    a socket or a folder is refused at once, and so is a file over ``max_bytes``; a file that
+    grows while it is read is cut off at ``max_bytes + 1`` bytes and refused, so no input can
+    make the reader run out of memory or wait for ever.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    max_bytes : int
+        Largest file accepted [bytes].
+
+    Returns
+    -------
+    bytes
+        The file's content.
+
+    Raises
+    ------
+    OSError
+        With ``strerror`` saying why: missing or unreadable (the system's reason), a folder
+        (:class:`IsADirectoryError`), not a regular file, or over ``max_bytes``. ``ValueError``
+        for a path the system cannot take (a NUL byte).
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    name = os.fspath(path)
+    fd = os.open(name, flags)
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise IsADirectoryError(errno.EISDIR, "is a folder, not a file", name)
+        if not stat.S_ISREG(st.st_mode):
+            what = (
+                "a FIFO (named pipe)"
+                if stat.S_ISFIFO(st.st_mode)
+                else "a device"
+                if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode)
+                else "a socket"
+                if stat.S_ISSOCK(st.st_mode)
+                else "not a regular file"
+            )
+            raise OSError(errno.EINVAL, f"is {what}, not a regular file", name)
+        if st.st_size > max_bytes:
+            raise OSError(
+                errno.EFBIG, f"is {st.st_size} bytes; the limit is {max_bytes} bytes", name
+            )
+        parts: list[bytes] = []
+        got = 0
+        while got <= max_bytes:
+            block = os.read(fd, min(1 << 20, max_bytes + 1 - got))
+            if not block:
+                break
+            parts.append(block)
+            got += len(block)
+        if got > max_bytes:
+            raise OSError(errno.EFBIG, f"grew past the limit of {max_bytes} bytes", name)
+        return b"".join(parts)
+    finally:
+        os.close(fd)

@@ -34,13 +34,15 @@ import math
 import os
 import re
 import time
-import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from gearte.errors import CaseFileError, GearteError, ParameterError
+
+#: Largest ``--points`` file read [bytes].
+MAX_POINTS_FILE_BYTES = 10_000_000
 
 __all__ = [
     "Vary",
@@ -222,10 +224,13 @@ def read_points(path: str | os.PathLike[str]) -> Coupled:
     from gearte.limits import check_sweep_points
 
     where = f"--points {os.fspath(path)}"
+    from gearte.limits import read_input_file
+
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ParameterError("--points", os.fspath(path), f"cannot read: {exc}") from None
+        text = read_input_file(path, MAX_POINTS_FILE_BYTES).decode("utf-8")
+    except (OSError, ValueError) as exc:  # (UnicodeDecodeError is a ValueError)
+        reason = getattr(exc, "strerror", None) or exc
+        raise ParameterError("--points", os.fspath(path), f"cannot read: {reason}") from None
     lines = [row for row in csv.reader(io.StringIO(text)) if any(c.strip() for c in row)]
     if len(lines) < 2:
         raise ParameterError(where, len(lines), "needs a header of keys and at least one row")
@@ -336,12 +341,9 @@ def _base_case(case: Any) -> tuple[dict[str, Any], str, str]:
     from gearte.cases import case_path
 
     path = case_path(case)
-    try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CaseFileError(str(path), [("(file)", f"cannot read: {exc}")]) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CaseFileError(str(path), [("(file)", f"TOML syntax error: {exc}")]) from None
+    from gearte.io.case_file import read_case_toml
+
+    data = read_case_toml(path)
     meta = data.get("case")
     if isinstance(meta, dict) and "name" not in meta:
         meta["name"] = Path(path).stem

@@ -24,6 +24,7 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from gearte.errors import ClusterLostError, ParameterError, SchedulerError
+from gearte.execution.stop import POLL_S, signals_deferred
 from gearte.execution.streams import default_workers
 
 __all__ = [
@@ -147,19 +148,28 @@ class _PoolBatch(Batch):
         self._jobs: dict[Any, tuple[Callable[[Any], Any], Any, int]] = {}
 
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
-        fut = self._ex._pool.submit(func, task, *self.extra)
-        self.pending[fut] = index
-        self._jobs[fut] = (func, task, self._ex._generation)
+        with signals_deferred():  # the pool's locks: no interrupt inside (gearte.execution.stop)
+            fut = self._ex._pool.submit(func, task, *self.extra)
+            self.pending[fut] = index
+            self._jobs[fut] = (func, task, self._ex._generation)
 
     def next_done(self) -> list[tuple[int, Any]]:
         from concurrent.futures.process import BrokenProcessPool
 
-        done, _ = cf.wait(list(self.pending), return_when=cf.FIRST_COMPLETED)
+        # cf.wait takes every future's lock: a signal is recorded there and acted on between
+        # the short waits, outside the locks (gearte.execution.stop.signals_deferred)
+        done: set[Any] = set()
+        while not done:
+            with signals_deferred():
+                done, _ = cf.wait(
+                    list(self.pending), timeout=POLL_S, return_when=cf.FIRST_COMPLETED
+                )
         out: list[tuple[int, Any]] = []
         broken: int | None = None
         for f in done:
             try:
-                result = f.result()
+                with signals_deferred():
+                    result = f.result()
             except BrokenProcessPool:
                 broken = self._jobs[f][2]
                 continue
@@ -178,17 +188,19 @@ class _PoolBatch(Batch):
         return out
 
     def cancel(self) -> None:
-        for f in self.pending:
-            f.cancel()
+        with signals_deferred():
+            for f in self.pending:
+                f.cancel()
         self._jobs.clear()
         super().cancel()
 
     def finished(self) -> list[tuple[int, Any]]:
         out = []
-        for f, index in list(self.pending.items()):
-            if f.done() and not f.cancelled() and f.exception() is None:
-                out.append((index, f.result()))
-                del self.pending[f]
+        with signals_deferred():
+            for f, index in list(self.pending.items()):
+                if f.done() and not f.cancelled() and f.exception() is None:
+                    out.append((index, f.result()))
+                    del self.pending[f]
         return out
 
 
@@ -225,6 +237,8 @@ class PoolExecutor(ChunkExecutor):
             return cf.ThreadPoolExecutor(self.workers, thread_name_prefix="gearte")
         methods = multiprocessing.get_all_start_methods()
         ctx = multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+        if ctx.get_start_method() == "forkserver":
+            _start_forkserver_ignoring_sigint()
         return cf.ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_worker_init)
 
     def _restart(self, generation: int) -> None:
@@ -249,10 +263,57 @@ class PoolExecutor(ChunkExecutor):
         _shutdown_pool(self._pool, self.shutdown_timeout_s)
 
 
+def _start_forkserver_ignoring_sigint() -> None:
+    """Start multiprocessing's fork server (once per process) with SIGINT ignored. Ctrl-C reaches
+    the whole process group: a fork server still importing its modules printed a
+    ``KeyboardInterrupt`` traceback (2 of 100 signals of the stress run,
+    ``tests/signal_stress.py``). An ignored signal stays ignored across ``exec``, the server then
+    ignores it as it means to, and so do the workers it forks until :func:`_worker_init`. Only
+    the fork and exec run with SIGINT ignored (milliseconds): a Ctrl-C then is lost, and the
+    next one stops the run."""
+    import signal
+    from multiprocessing import forkserver
+
+    if threading.current_thread() is not threading.main_thread():
+        forkserver.ensure_running()
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def die_with_parent() -> None:
+    """Linux: this process gets SIGKILL when its parent dies (``PR_SET_PDEATHSIG``), so no
+    worker outlives the run. A worker of a process pool is forked by multiprocessing's fork
+    server, which ends when the main process does; a worker left behind after a SIGTERM to the
+    group (one spawned just after it, or one blocked on the queue lock of a worker killed while
+    reading) kept the terminal's pipe open (the stress run counted it as a hang). Where the
+    parent is already gone, the process exits at once."""
+    import os
+    import signal
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    parent = os.getppid()
+    with contextlib.suppress(Exception):
+        import ctypes
+
+        pr_set_pdeathsig = 1
+        ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, int(signal.SIGKILL))
+    if os.getppid() != parent:  # the parent died before the request took effect
+        os._exit(1)
+
+
 def _worker_init() -> None:
-    """Runs first in every local worker process: ignore SIGINT. Ctrl-C in a terminal reaches the
-    whole process group; the main process stops the work and shuts the pool down, and workers
-    must not print a ``KeyboardInterrupt`` traceback each. Then load SciPy's BLAS modules for
+    """Runs first in every local worker process: ignore SIGINT, die with the parent
+    (:func:`die_with_parent`). Ctrl-C in a terminal reaches
+    every process of the group; the main process stops the work and shuts the pool down, and
+    workers must not print a ``KeyboardInterrupt`` traceback each (a SIGTERM to the group ends
+    them at once, as it should: ignoring it left workers and the fork server running after the
+    main process had gone). Then load SciPy's BLAS modules for
     numba (:mod:`gearte._blas`): a worker's first kernel would import all of ``scipy.linalg``
     (~0.3 s CPU per worker), and collect the young generation less often
     (:mod:`gearte._gc`: a worker may compile the kernels on a cold cache)."""
@@ -262,29 +323,76 @@ def _worker_init() -> None:
     from gearte._gc import set_fewer_collections
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent()
     preload_scipy_blas()
     set_fewer_collections()
 
 
 def _shutdown_pool(pool: cf.Executor, timeout_s: float) -> None:
-    """Shut a pool down without hanging: queued chunks are cancelled; worker processes get
-    ``timeout_s`` to finish, then are terminated, then killed, and always reaped (no orphans).
-    Threads cannot be killed: a thread pool is waited for (its chunks are finite)."""
+    """Shut a pool down without hanging: queued chunks are cancelled; running ones get
+    ``timeout_s`` to finish. Worker processes still alive then are terminated, then killed, and
+    always reaped (no orphans). Threads cannot be killed: a thread
+    still running its chunk after ``timeout_s`` is left to finish in the background
+    (:func:`stuck_worker_threads` lists them; the CLI then ends the process without waiting
+    for them). Every wait is in short slices inside
+    :func:`~gearte.execution.stop.signals_deferred`, so a signal never lands inside the pool's
+    locks."""
+    deadline = time.monotonic() + timeout_s
     if not isinstance(pool, cf.ProcessPoolExecutor):
-        pool.shutdown(wait=True, cancel_futures=True)
+        threads = list(getattr(pool, "_threads", ()) or ())
+        with signals_deferred():
+            pool.shutdown(wait=False, cancel_futures=True)
+        for t in threads:
+            while t.is_alive() and time.monotonic() < deadline:
+                with signals_deferred():
+                    t.join(POLL_S)
         return
     procs = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    deadline = time.monotonic() + timeout_s
+    with signals_deferred():
+        pool.shutdown(wait=False, cancel_futures=True)
     for p in procs:
-        p.join(max(0.0, deadline - time.monotonic()))
+        while p.is_alive() and time.monotonic() < deadline:
+            with signals_deferred():
+                p.join(POLL_S)
     for p in procs:
         if p.is_alive():
             p.terminate()
-            p.join(2.0)
+            with signals_deferred():
+                p.join(2.0)
         if p.is_alive():  # pragma: no cover - SIGTERM ignored
             p.kill()
-            p.join()
+            with signals_deferred():
+                p.join(5.0)
+
+
+def quiet_pool_manager_after_stop() -> None:
+    """Silence one known traceback of CPython 3.11's process pool: when a SIGTERM to the process
+    group ends the workers while the main process cancels its queued chunks, the pool's manager
+    thread marks every chunk it still holds as failed and raises ``InvalidStateError`` on the
+    cancelled ones (``terminate_broken``); nothing is lost (the main process has stopped), but
+    the traceback reached the terminal. Every other thread exception is reported as before.
+    Installed by the CLI."""
+    from concurrent.futures.process import _ExecutorManagerThread
+
+    previous = threading.excepthook
+    if getattr(previous, "_gearte_quiet", False):  # installed already
+        return
+
+    def hook(args: Any) -> None:
+        if isinstance(args.thread, _ExecutorManagerThread) and isinstance(
+            args.exc_value, cf.InvalidStateError
+        ):
+            return
+        previous(args)
+
+    hook._gearte_quiet = True  # type: ignore[attr-defined]
+    threading.excepthook = hook
+
+
+def stuck_worker_threads() -> list[threading.Thread]:
+    """gearte's pool threads still running a chunk (after a stop whose shutdown did not wait
+    for them, :func:`_shutdown_pool`)."""
+    return [t for t in threading.enumerate() if t.name.startswith("gearte") and t.is_alive()]
 
 
 def _import_distributed() -> Any:
@@ -557,8 +665,8 @@ class _DaskBatch(Batch):
         cond = getattr(ac, "thread_condition", None)
         while not ac.has_ready() and not ac.is_empty():
             if cond is not None:
-                with cond:
-                    cond.wait(timeout=0.1)
+                with signals_deferred(), cond:  # no interrupt while the lock is held
+                    cond.wait(timeout=POLL_S)
             else:  # pragma: no cover - other distributed versions
                 time.sleep(0.1)
             now = time.monotonic()

@@ -6,8 +6,8 @@ CSV files through :func:`read_text_file`, each with its own error class and size
 
 from __future__ import annotations
 
+import errno
 import os
-from pathlib import Path
 
 from gearte.errors import BenchFileError
 
@@ -30,23 +30,23 @@ def read_text_file(
     Raises
     ------
     BenchFileError
-        (of the class ``error``) for a folder, a missing or unreadable file, a path the system
-        cannot take (a NUL byte), a file over ``max_bytes``, text that is not UTF-8 or holds a
-        NUL byte (the line is named).
+        (of the class ``error``) for a folder, a missing or unreadable file, a device, FIFO or
+        socket (refused before reading: :func:`gearte.limits.read_input_file`), a path the
+        system cannot take (a NUL byte), a file over ``max_bytes``, text that is not UTF-8 or
+        holds a NUL byte (the line is named).
     """
+    from gearte.limits import read_input_file
+
     src = str(path)
-    p = Path(path)
     try:
-        is_dir = p.is_dir()
-        size = 0 if is_dir else p.stat().st_size
-        raw = b"" if is_dir or size > max_bytes else p.read_bytes()
+        raw = read_input_file(path, max_bytes)
+    except IsADirectoryError:
+        raise error(src, None, None, "is a folder, expected a CSV file") from None
     except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
         reason = getattr(exc, "strerror", None) or exc
+        if getattr(exc, "errno", None) in (errno.EINVAL, errno.EFBIG):
+            raise error(src, None, None, str(reason)) from None
         raise error(src, None, None, f"cannot read: {reason}") from None
-    if is_dir:
-        raise error(src, None, None, "is a folder, expected a CSV file")
-    if size > max_bytes:
-        raise error(src, None, None, f"is {size} bytes; the limit is {max_bytes} bytes")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

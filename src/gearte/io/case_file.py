@@ -8,7 +8,11 @@ of its study kind. Every problem of a file is reported at once, one line each, a
 from __future__ import annotations
 
 import os
+import re
 import tomllib
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -24,12 +28,24 @@ __all__ = [
     "format_validation_errors",
     "MAX_NESTING",
     "MAX_FILE_BYTES",
+    "MAX_LINE_CHARS",
+    "read_case_toml",
 ]
 
 #: Deepest nesting of tables/arrays a case file may have (the deepest bundled case has 4).
 MAX_NESTING = 32
 #: Largest case file read [bytes] (the largest bundled case is < 10 kB).
 MAX_FILE_BYTES = 1_000_000
+#: Longest line of a case file [characters] (the longest line of a bundled case has 212).
+MAX_LINE_CHARS = 20_000
+
+#: One token of a TOML line for :func:`_dotted_depth`: a bare key or number, a quoted string,
+#: blanks, or any other single character (linear: no backtracking).
+_TOKEN = re.compile(r"[A-Za-z0-9_\-]+|\"(?:[^\"\\\n]|\\.)*\"|'[^'\n]*'|[ \t]+|.")
+
+#: Real paths of the case files being loaded in this thread, outermost first (a case refers to
+#: another through ``reducer.case`` or a drive's ``case``): a file met twice is a cycle.
+_LOADING: ContextVar[tuple[str, ...]] = ContextVar("gearte_loading_cases", default=())
 
 
 def _too_deep(data: Any, limit: int = MAX_NESTING) -> str | None:
@@ -44,6 +60,115 @@ def _too_deep(data: Any, limit: int = MAX_NESTING) -> str | None:
         elif isinstance(value, list):
             stack.extend((v, (*path, str(i))) for i, v in enumerate(value))
     return None
+
+
+def _dotted_depth(line: str) -> int:
+    """Most segments of one dotted chain (``a.b."c".d`` has 4) on ``line``, in linear time."""
+    best = run = 0
+    after_segment = after_dot = False
+    for m in _TOKEN.finditer(line):
+        t = m.group()
+        if t[0] in " \t":
+            continue
+        if t == ".":
+            after_dot, after_segment = after_segment, False
+            if not after_dot:
+                run = 0
+            continue
+        if t[0].isalnum() or t[0] in "_-\"'":
+            run = run + 1 if after_dot else 1
+            best = max(best, run)
+            after_segment, after_dot = True, False
+            continue
+        run, after_segment, after_dot = 0, False, False
+    return best
+
+
+def _preparse_problem(text: str) -> str | None:
+    """Why ``text`` must not reach the TOML parser, or ``None``: a line over
+    :data:`MAX_LINE_CHARS` or a dotted key (``a.b.c = ...``, ``[a.b.c]``) deeper than
+    :data:`MAX_NESTING` (the parser's time and memory grow with the square of a key's depth:
+    one 80 kB dotted key took over 4 GiB)."""
+    for number, line in enumerate(text.splitlines(), start=1):
+        if len(line) > MAX_LINE_CHARS:
+            return f"line {number} has {len(line)} characters; the limit is {MAX_LINE_CHARS}"
+        if line.count(".") >= MAX_NESTING and _dotted_depth(line) > MAX_NESTING:
+            return (
+                f"line {number} has a dotted key of {_dotted_depth(line)} parts: nested deeper "
+                f"than {MAX_NESTING} levels"
+            )
+    return None
+
+
+def read_case_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The parsed TOML of a case file, read only when it is safe to.
+
+    The file must be a regular file of at most :data:`MAX_FILE_BYTES`
+    (:func:`gearte.limits.read_input_file`: a device, a FIFO or a folder is refused before any
+    byte is read), UTF-8 text whose lines are at most :data:`MAX_LINE_CHARS` long and whose
+    dotted keys have at most :data:`MAX_NESTING` parts (checked before the TOML parser sees it).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The case file.
+
+    Raises
+    ------
+    CaseFileError
+        Naming the file and the reason.
+    """
+    from gearte.limits import read_input_file
+
+    src = str(path)
+    try:
+        raw = read_input_file(path, MAX_FILE_BYTES)
+    except (OSError, ValueError) as exc:
+        reason = getattr(exc, "strerror", None) or exc
+        raise CaseFileError(src, [("(file)", f"cannot read: {reason}")]) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise CaseFileError(src, [("(file)", f"line {line}: not UTF-8 text")]) from None
+    problem = _preparse_problem(text)
+    if problem is not None:
+        raise CaseFileError(src, [("(file)", problem)])
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseFileError(src, [("(file)", f"TOML syntax error: {exc}")]) from None
+    except RecursionError:
+        reason = f"nested deeper than {MAX_NESTING} levels (arrays or inline tables)"
+        raise CaseFileError(src, [("(file)", reason)]) from None
+
+
+@contextmanager
+def _loading(path: Path) -> Iterator[None]:
+    """Mark ``path`` as being loaded in this thread; a case reference back to a file being
+    loaded (itself, or a file that refers to it) is a :class:`CaseFileError` naming the chain."""
+    try:
+        real = os.path.realpath(path)
+    except (OSError, ValueError):
+        real = str(path)
+    stack = _LOADING.get()
+    if real in stack:
+        chain = " → ".join([*stack[stack.index(real) :], real])
+        raise CaseFileError(
+            str(path),
+            [
+                (
+                    "(file)",
+                    f"case files refer to each other in a cycle ({chain}): a reducer.case or "
+                    "drive case names a file that is already being loaded",
+                )
+            ],
+        )
+    token = _LOADING.set((*stack, real))
+    try:
+        yield
+    finally:
+        _LOADING.reset(token)
 
 
 def _short(value: Any, limit: int = 60) -> str:
@@ -407,24 +532,11 @@ def load_case(case: str | os.PathLike[str] | dict[str, Any]) -> CaseBase:
     from gearte.cases import case_path
 
     path = case_path(case)
-    try:
-        size = os.stat(path).st_size
-        if size > MAX_FILE_BYTES:
-            reason = f"{size} bytes; a case file is at most {MAX_FILE_BYTES} bytes"
-            raise CaseFileError(str(path), [("(file)", reason)])
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CaseFileError(str(path), [("(file)", f"cannot read: {exc}")]) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise CaseFileError(str(path), [("(file)", f"TOML syntax error: {exc}")]) from None
-    except RecursionError:
-        reason = f"nested deeper than {MAX_NESTING} levels (arrays or inline tables)"
-        raise CaseFileError(str(path), [("(file)", reason)]) from None
-    return load_case_dict(
-        data, source=str(path), name=Path(path).stem, base_dir=str(Path(path).parent)
-    )
+    with _loading(path):
+        data = read_case_toml(path)
+        return load_case_dict(
+            data, source=str(path), name=Path(path).stem, base_dir=str(Path(path).parent)
+        )
 
 
 def validate_case(case: str | os.PathLike[str] | dict[str, Any]) -> CaseBase:

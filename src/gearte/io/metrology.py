@@ -80,6 +80,8 @@ __all__ = [
     "write_disc_bores",
     "write_runout",
     "write_bearing_clearances",
+    "DESIGN_DEVIATION",
+    "check_against_design",
 ]
 
 MAX_FILE_BYTES = 64 * 1024 * 1024
@@ -147,6 +149,19 @@ FORMATS: dict[str, dict[str, _Col]] = {
     },
 }
 """Columns of each format (name → kind, required, plausible range in mm / rad)."""
+
+
+#: Largest plausible deviation of a measured size from the design's nominal, as a fraction of the
+#: nominal: ``format -> (column, fraction)``. Manufacturing deviations are micrometres on sizes of
+#: millimetres (1e-4 to 1e-3 of the nominal); a value 1000 times off (``x [um]`` written for
+#: millimetres) deviates by about the whole nominal. A crank-bore centre is judged against the
+#: crank circle radius, a cam eccentricity against the design eccentricity, a pin diameter
+#: against the design pin diameter (:func:`check_against_design`).
+DESIGN_DEVIATION: dict[str, tuple[tuple[str, ...], float]] = {
+    "disc_bores": (("x", "y"), 0.02),
+    "crank_eccentricity": (("eccentricity",), 0.2),
+    "pins": (("diameter",), 0.1),
+}
 
 
 # ---- data objects ------------------------------------------------------------------------
@@ -839,3 +854,95 @@ def write_bearing_clearances(
     """
     rows = [[s, b, _f(mm_to_um(c))] for s, d in clearances.items() for b, c in d.items()]
     _write(path, "bearing_clearance", ["serial", "bearing", "radial_clearance [um]"], rows)
+
+
+def check_against_design(
+    path: str | os.PathLike,
+    fmt: str,
+    rows: Mapping[str, np.ndarray],
+    nominal: np.ndarray,
+    scale_mm: float,
+) -> None:
+    """Refuse measured values far from the design: a unit slip in a header (``x [um]`` for
+    millimetres), a file of another reducer.
+
+    Parameters
+    ----------
+    path : str or path
+        The file the values were read from (named in the error).
+    fmt : str
+        Its format, a key of :data:`DESIGN_DEVIATION`.
+    rows : mapping
+        ``serial -> measured values`` in gearte units [mm], as the reader returned them: shape
+        ``(count,)`` (eccentricity per cam, diameter per pin) or ``(count, 2)`` (bore centres).
+    nominal : numpy.ndarray
+        The design's values, broadcastable to each serial's array [mm].
+    scale_mm : float
+        Size the deviation is judged against [mm] (crank circle radius, design eccentricity,
+        design pin diameter); the limit is ``DESIGN_DEVIATION[fmt][1] * scale_mm``.
+
+    Raises
+    ------
+    MeasurementFileError
+        Naming file, line, column and its unit, the value, the design's value and the limit,
+        and the unit that would make the value plausible where one does.
+    """
+    columns, fraction = DESIGN_DEVIATION[fmt]
+    limit = fraction * scale_mm
+    nom = np.asarray(nominal, dtype=float)
+    for serial, values in rows.items():
+        v = np.asarray(values, dtype=float)
+        if nom.ndim and len(v) != len(nom):  # another count: the reader's count check says so
+            k = min(len(v), len(nom))
+            v, nom_s = v[:k], nom[:k]
+        else:
+            nom_s = nom
+        dev = np.abs(v - np.broadcast_to(nom_s, v.shape))
+        if v.ndim == 2:  # bore centres: the distance from the nominal centre
+            dev = np.hypot(dev[:, 0], dev[:, 1])
+        bad = np.flatnonzero(~(dev <= limit))
+        if bad.size:
+            _design_error(path, fmt, columns, serial, int(bad[0]), v, nom_s, limit)
+
+
+def _design_error(
+    path: str | os.PathLike,
+    fmt: str,
+    columns: tuple[str, ...],
+    serial: str,
+    k: int,
+    values: np.ndarray,
+    nominal: np.ndarray,
+    limit: float,
+) -> None:
+    """Raise the error of :func:`check_against_design` for entry ``k`` of ``serial``: the file is
+    read again to name its line, column and unit."""
+    t = _parse(path, fmt)
+    index = {"disc_bores": "bore", "crank_eccentricity": "cam", "pins": "pin"}[fmt]
+    r = next(
+        r
+        for r in range(len(t.lines))
+        if t.values["serial"][r] == serial and t.values[index][r] == k + 1
+    )
+    nom = np.broadcast_to(nominal, values.shape)[k]
+    val = values[k]
+    if values.ndim == 2:  # the coordinate farther from its nominal
+        c = int(np.argmax(np.abs(val - nom)))
+        column, got, want = columns[c], float(val[c]), float(nom[c])
+    else:
+        column, got, want = columns[0], float(val), float(nom)
+    j = t.names.index(column)
+    unit = (t.units[j] or "").strip()
+    factor = _LENGTH[unit.lower()]
+    hint = ""
+    for other, f in _LENGTH.items():
+        if other in ("µm", "micron") or f == factor:
+            continue
+        if abs(got / factor * f - want) <= limit:
+            hint = f"; read as [{other}] it would fit: is the header's unit [{unit}] a mistake?"
+    raise _err(
+        t.source, t.lines[r], t.col(column),
+        f"{got / factor:.6g} [{unit}] ({index} {k + 1} of serial {serial!r}) is "
+        f"{abs(got - want):.4g} mm from the design's {want:.6g} mm; a measured part deviates "
+        f"from its design by at most {limit:.4g} mm here{hint or ' (a unit mistake?)'}",
+    )  # fmt: skip

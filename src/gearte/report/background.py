@@ -89,12 +89,10 @@ def _kind_of(case: Any) -> str | None:
     """The ``[case] kind`` of a case as :func:`gearte.io.case_file.load_case` takes it (a dict,
     a TOML file or a bundled name), read without validating; ``None`` where it has none."""
     if not isinstance(case, dict):
-        import tomllib
-
         from gearte.cases import case_path
+        from gearte.io.case_file import read_case_toml
 
-        with open(case_path(case), "rb") as fh:
-            case = tomllib.load(fh)
+        case = read_case_toml(case_path(case))
     meta = case.get("case") if isinstance(case, dict) else None
     kind = meta.get("kind") if isinstance(meta, dict) else None
     return kind if isinstance(kind, str) else None
@@ -135,14 +133,11 @@ def _fewer_collections() -> None:
 
 
 def _die_with_parent() -> None:
-    """Linux: this process gets SIGKILL when its parent dies (no orphaned renderer)."""
-    if not sys.platform.startswith("linux"):
-        return
-    with contextlib.suppress(Exception):
-        import ctypes
+    """Linux: this process gets SIGKILL when its parent dies (no orphaned renderer;
+    :func:`gearte.execution.backends.die_with_parent`)."""
+    from gearte.execution.backends import die_with_parent
 
-        pr_set_pdeathsig = 1
-        ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, int(signal.SIGKILL))
+    die_with_parent()
 
 
 def _read_all(fd: int) -> bytes:

@@ -33,6 +33,8 @@ __all__ = [
     "write_outputs",
     "write_file_set",
     "check_output_dir",
+    "check_free_space",
+    "expected_output_bytes",
     "safe_label",
     "atomic_write_bytes",
     "atomic_write_text",
@@ -180,6 +182,70 @@ def check_output_dir(out_dir: str | os.PathLike[str]) -> Path:
     except OSError as exc:
         raise _output_error(existing, exc) from None
     return out
+
+
+#: Expected size of a result set [bytes]: this much for the set and for each analysis, without
+#: and with ``report.html``. Of the order of the bundled cases' sets (0.26 - 1.8 MB with the
+#: report, 23 - 280 kB without); the check only has to catch a disk that is (nearly) full.
+OUTPUT_BYTES_BASE = 32_000
+OUTPUT_BYTES_PER_ANALYSIS = 16_000
+REPORT_BYTES_PER_ANALYSIS = 64_000
+
+
+def expected_output_bytes(case: Any, *, report: bool = True) -> int:
+    """A lower estimate of the size of ``case``'s result set [bytes], before computing it.
+
+    Parameters
+    ----------
+    case : Case
+        The validated case; its analyses are counted (the fields set in its ``analyses`` or
+        ``analysis`` section; one where it has neither).
+    report : bool
+        Whether ``report.html`` is written too.
+    """
+    count = 0
+    for name in ("analyses", "analysis"):
+        section = getattr(case, name, None)
+        if section is None:
+            continue
+        fields = getattr(type(section), "model_fields", {})
+        count += sum(1 for f in fields if getattr(section, f, None) is not None) or 1
+    count = max(count, 1)
+    per = OUTPUT_BYTES_PER_ANALYSIS + (REPORT_BYTES_PER_ANALYSIS if report else 0)
+    return OUTPUT_BYTES_BASE + count * per
+
+
+def check_free_space(out: Path, nbytes: int) -> None:
+    """Refuse, before any computation, an output folder whose file system has less free space
+    than ``nbytes`` (:func:`expected_output_bytes`): a full disk was found only after the work,
+    when the result set was written (it is still written as one set, so a disk that fills up
+    during the run keeps the previous outputs).
+
+    Parameters
+    ----------
+    out : Path
+        The output folder (it need not exist yet: the nearest existing parent is measured).
+    nbytes : int
+        Expected size of the result set [bytes].
+
+    Raises
+    ------
+    OutputError
+        Naming the folder, the free space and the expected size.
+    """
+    existing = out
+    while not existing.exists() and existing.parent != existing:
+        existing = existing.parent
+    try:
+        free = shutil.disk_usage(existing).free
+    except OSError:  # the write will say what is wrong
+        return
+    if free < nbytes:
+        raise OutputError(
+            str(out),
+            f"the disk has {free / 1e6:.3g} MB free; the results need about "
+            f"{nbytes / 1e6:.3g} MB (free some space or choose another --out)",
+        )
 
 
 def _write_file(path: Path, data: bytes) -> None:

@@ -32,6 +32,7 @@ __all__ = [
     "preflight",
     "run_case",
     "check_samples_override",
+    "check_sample_time",
     "sample_cap",
 ]
 
@@ -65,7 +66,9 @@ class RunOptions:
 
 
 def _sample_caps(model: Any, prefix: str = "") -> list[tuple[str, int]]:
-    """``(dotted field, upper bound)`` of every sample-count field of a validated case."""
+    """``(dotted field, upper bound)`` of every sample-count field of a validated case that
+    ``--samples`` sets (a Sobol base count or an allocation search count is only capped by it,
+    :func:`sample_cap`, so its own bound does not limit ``--samples``)."""
     from pydantic import BaseModel
 
     caps: list[tuple[str, int]] = []
@@ -74,6 +77,8 @@ def _sample_caps(model: Any, prefix: str = "") -> list[tuple[str, int]]:
         path = f"{prefix}{name}"
         if isinstance(value, BaseModel):
             caps += _sample_caps(value, path + ".")
+        elif name == "sobol_samples" or prefix.endswith("allocation."):
+            continue  # only capped by --samples (sample_cap: min(count, N)), never set by it
         elif "samples" in name and isinstance(value, int) and not isinstance(value, bool):
             bounds = [getattr(m, "le", None) for m in info.metadata]
             bounds += [getattr(m, "lt", None) for m in info.metadata]
@@ -90,6 +95,7 @@ def check_samples_override(case: Any, samples: int | None) -> None:
         Naming ``--samples``, the value and the case field whose cap it exceeds.
     """
     if samples is None:
+        check_sample_time(case, None)
         return
     from gearte.errors import ParameterError
 
@@ -98,6 +104,52 @@ def check_samples_override(case: Any, samples: int | None) -> None:
     for path, cap in _sample_caps(case):
         if samples > cap:
             raise ParameterError("--samples", samples, f"over the cap of {path} (<= {cap})")
+    check_sample_time(case, samples)
+
+
+#: Least time one sample of a sampled analysis takes on one core [s], by ``(kind, field)``: a
+#: tenth of what it took on a 2-core machine (the bundled cases' runs with ``--timings``), so
+#: the estimate is a lower bound: a count refused by it would take at least that long.
+SECONDS_PER_SAMPLE: dict[tuple[str, str], float] = {
+    ("gear_pair", "analysis.monte_carlo_samples"): 2e-9,
+    ("gear_chain", "analysis.monte_carlo_samples"): 2e-9,
+    ("planetary", "analyses.monte_carlo.samples"): 3e-7,
+    ("cycloid_stage", "analyses.yield_.samples"): 2e-5,
+    ("planetary", "analyses.yield_.samples"): 5e-6,
+    ("gear_chain", "analyses.yield_.samples"): 5e-6,
+    ("rv_reducer", "analyses.yield_.samples"): 5e-4,
+    ("rv_reducer", "analyses.batch.samples"): 1e-2,
+}
+
+
+def check_sample_time(case: Any, samples: int | None, workers: int | None = None) -> None:
+    """The sample counts of ``case`` (each replaced by ``--samples`` when given) against the
+    time budget (``GEARTE_MAX_SECONDS``, :func:`gearte.limits.check_time`), before any work: a
+    lower estimate, ``count × SECONDS_PER_SAMPLE / workers``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``--samples`` or the case's field, the count and the estimated time.
+    """
+    from gearte.execution.streams import default_workers
+    from gearte.limits import check_time
+
+    cores = max(1, int(workers or default_workers()))
+    for path, _cap in _sample_caps(case):
+        per = SECONDS_PER_SAMPLE.get((case.case.kind, path))
+        if per is None:
+            continue
+        key = path.replace("yield_", "yield")
+        count = int(_get_path(case, path)) if samples is None else samples
+        field = key if samples is None else "--samples"
+        check_time(field, count, count * per / cores, f"{key} = {count} (on {cores} cores)")
+
+
+def _get_path(model: Any, path: str) -> Any:
+    for part in path.split("."):
+        model = getattr(model, part)
+    return model
 
 
 def sample_cap(section: Any, name: str, options: Any, low: int | None = None) -> Any:
@@ -138,6 +190,7 @@ def preflight(case: Any) -> None:
     gearte.errors.ParameterError
         Naming the key of the first failing check.
     """
+    check_sample_time(case, None)
     fn = getattr(get_kind(case.case.kind), "preflight", None)
     if fn is not None:
         fn(case)
@@ -258,6 +311,10 @@ def _numba_timer() -> Iterator[dict[str, float]]:
         from gearte.execution.heartbeat import numba_ready
 
         numba_ready()  # a status line names the kernels numba compiles from now on
+
+        from gearte.execution.stop import defer_signals_while_compiling
+
+        defer_signals_while_compiling()  # after the timer: a signal it delivers may raise
 
     hook = None
     if "numba" in sys.modules:

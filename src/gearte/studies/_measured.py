@@ -53,3 +53,34 @@ class MeasuredPartsCase(CaseBase):
         except GearteError as exc:
             raise ValueError(str(exc)) from None
         return self
+
+
+def check_measured_against_design(
+    red: Any,
+    path: str,
+    *,
+    bores: dict | None = None,
+    cams: dict | None = None,
+    pins: dict | None = None,
+) -> None:
+    """Measured bore centres, cam eccentricities or pin diameters (as their readers return them)
+    against the design reducer ``red``: a value far from the design's (a unit slip in the file's
+    header) is a :class:`~gearte.errors.MeasurementFileError` naming file, line, column and unit
+    (:func:`gearte.io.metrology.check_against_design`)."""
+    import numpy as np
+
+    from gearte.io import metrology as mt
+
+    if bores is not None:
+        m, r = red.cranks.count, red.cranks.circle_radius
+        ang = 2.0 * np.pi * np.arange(m) / m
+        nominal = r * np.stack([np.cos(ang), np.sin(ang)], -1)
+        mt.check_against_design(path, "disc_bores", bores, nominal, r)
+    if cams is not None:
+        a = red.cranks.eccentricity
+        ecc = {k: c.eccentricity for k, c in cams.items()}
+        mt.check_against_design(path, "crank_eccentricity", ecc, np.asarray(a), a)
+    if pins is not None:
+        d = 2.0 * red.pins.pin_radius
+        dia = {k: p.diameter for k, p in pins.items()}
+        mt.check_against_design(path, "pins", dia, np.asarray(d), d)

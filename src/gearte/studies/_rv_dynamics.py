@@ -19,6 +19,8 @@ Analyses:
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from typing import Any, Literal
 
 import numpy as np
@@ -651,14 +653,55 @@ def run_dynamics(case, red: RVReducer, options) -> tuple[list[AnalysisResult], l
     warnings: list[str] = []
     analyses = []
     a = case.analyses
-    if a.contact is not None:
-        analyses.append(_contact(case, model))
-    if a.modal is not None:
-        analyses.append(_modal(case, model, mp, warnings))
-    if a.dte is not None:
-        analyses.append(_dte(case, red, model, warnings))
-    if a.speed_sweep is not None:
-        analyses.append(_speed_sweep(case, model, options))
-    if a.batch is not None:
-        analyses.append(_batch(case, red, model, options))
+    with _naming_the_inputs(case, "contact"):
+        if a.contact is not None:
+            analyses.append(_contact(case, model))
+    with _naming_the_inputs(case, "modal"):
+        if a.modal is not None:
+            analyses.append(_modal(case, model, mp, warnings))
+    with _naming_the_inputs(case, "dte"):
+        if a.dte is not None:
+            analyses.append(_dte(case, red, model, warnings))
+    with _naming_the_inputs(case, "speed_sweep"):
+        if a.speed_sweep is not None:
+            analyses.append(_speed_sweep(case, model, options))
+    with _naming_the_inputs(case, "batch"):
+        if a.batch is not None:
+            analyses.append(_batch(case, red, model, options))
     return analyses, warnings
+
+
+def _clearance_inputs(case) -> list[str]:
+    """``key = value`` of the case's non-zero bearing clearances (the inputs that make the
+    dynamics' static equilibrium slow or singular)."""
+    c, s = case.reducer.cranks, case.reducer.supports
+    pairs = [
+        ("reducer.cranks.cam_bearing.radial_clearance_um", c.cam_bearing.radial_clearance_um),
+        (
+            "reducer.cranks.carrier_bearing.radial_clearance_um",
+            c.carrier_bearing.radial_clearance_um,
+        ),
+        ("reducer.supports.main_bearing_clearance_um", s.main_bearing_clearance_um),
+    ]
+    return [f"{k} = {v:g}" for k, v in pairs if v]
+
+
+@contextlib.contextmanager
+def _naming_the_inputs(case, analysis: str) -> Iterator[None]:
+    """A solver of the dynamic analysis ``analysis`` that does not converge ends with a
+    :class:`~gearte.errors.ConvergenceError` naming the analysis and the inputs that decide
+    it (the bearing clearances, the load torque) beside the solver's own line."""
+    from gearte.errors import ConvergenceError
+
+    try:
+        yield
+    except ConvergenceError as exc:
+        keys = _clearance_inputs(case)
+        torque = f"operation.output_torque_Nm = {case.operation.output_torque_Nm:g}"
+        why = (
+            f"with {', '.join(keys)} and {torque}: parts float in their bearing clearances; "
+            "a smaller clearance or a larger load torque holds them"
+            if keys
+            else f"with {torque}"
+        )
+        raise ConvergenceError(f"analyses.{analysis}: {exc} — {why}") from None

@@ -712,7 +712,7 @@ def yield_analysis(
         (``te_discretisation_error [arcsec]`` and ``discretisation_error``).
     """
     from gearte.studies import sample_cap
-    from gearte.tolerance.allocation import allocate
+    from gearte.tolerance.allocation import SearchStopped, allocate
     from gearte.tolerance.yield_contributions import pareto_rows, sobol_tolerances
     from gearte.tolerance.yield_mc import SpecLimit, run_yield
 
@@ -854,22 +854,28 @@ def yield_analysis(
             values["te_discretisation_error [arcsec]"] = g["te_arcsec"]
         notes.append(g["note"])
         stat_warnings += g["warnings"]
+    al = None
     if section.allocation is not None:
         # under --samples: capped, but never below what can show the target (validated above)
         alloc_n = sample_cap(section.allocation, "samples", options) or n
         if getattr(options, "samples", None) is not None:
             alloc_n = max(alloc_n, allocation_min_samples(section.allocation.target_yield))
-        al = allocate(
-            model,
-            ts,
-            spec,
-            costs,
-            section.allocation.target_yield,
-            n=alloc_n,
-            seed=seed + 2,
-            chunk_size=section.chunk_size,
-            options=options,
-        )
+        try:
+            al = allocate(
+                model,
+                ts,
+                spec,
+                costs,
+                section.allocation.target_yield,
+                n=alloc_n,
+                seed=seed + 2,
+                chunk_size=section.chunk_size,
+                options=options,
+            )
+        except SearchStopped:  # the run was stopped: keep the yield, report no allocation
+            al = None
+            notes.append("No allocation: the run was stopped before its search finished.")
+    if section.allocation is not None and al is not None:
         values["allocation"] = {
             "target_yield": al.target,
             "tolerances": al.widths,

@@ -277,10 +277,15 @@ class Case(CaseBase):
 
 # ---- run ----------------------------------------------------------------------------------
 def _reducer(ref: ReducerRef):
+    from gearte.errors import ParameterError
     from gearte.io.case_file import load_case
     from gearte.studies.rv_reducer import build_reducer
 
-    rcase: Any = load_case(ref.case)  # an rv_reducer Case (checked at validation)
+    rcase: Any = load_case(ref.case)
+    if rcase.case.kind != "rv_reducer":
+        raise ParameterError(
+            "reducer.case", ref.case, f"is a {rcase.case.kind!r} case; need rv_reducer"
+        )
     return build_reducer(rcase.reducer), rcase
 
 

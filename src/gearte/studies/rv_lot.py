@@ -180,6 +180,7 @@ def build_lot(case: Case):
     from gearte.geometry.measured import MeasuredDisc
     from gearte.io import metrology as mt
     from gearte.runners.selective_assembly import Lot
+    from gearte.studies._measured import check_measured_against_design
 
     _, red = case.design()
     m, n, zc = red.cranks.count, red.discs.count, red.cycloid_teeth
@@ -221,14 +222,13 @@ def build_lot(case: Case):
     kd, kc = len(lot.disc_sets), len(lot.crank_sets)
     bores = None
     if f.disc_bores is not None:
-        b = pick(mt.read_disc_bores(f.disc_bores, bores=m), discs_flat, f.disc_bores, "disc_sets")
+        read_bores = mt.read_disc_bores(f.disc_bores, bores=m)
+        check_measured_against_design(red, f.disc_bores, bores=read_bores)
+        b = pick(read_bores, discs_flat, f.disc_bores, "disc_sets")
         bores = np.asarray(b).reshape(kd, n, m, 2)
-    cams = pick(
-        mt.read_crank_eccentricity(f.crank_eccentricity, cams=n),
-        cranks_flat,
-        f.crank_eccentricity,
-        "crank_sets",
-    )
+    read_cams = mt.read_crank_eccentricity(f.crank_eccentricity, cams=n)
+    check_measured_against_design(red, f.crank_eccentricity, cams=read_cams)
+    cams = pick(read_cams, cranks_flat, f.crank_eccentricity, "crank_sets")
     ecc = np.asarray([c.eccentricity for c in cams]).reshape(kc, m, n)
     phase = np.asarray([c.phase for c in cams]).reshape(kc, m, n)
     planets = None

@@ -172,6 +172,7 @@ def build_serial(case: Case):
     from gearte.errors import ParameterError
     from gearte.geometry.measured import MeasuredDisc, apply_measurements
     from gearte.io import metrology as mt
+    from gearte.studies._measured import check_measured_against_design
 
     design, red = case.design()
     s, f = case.serial, case.serial.files
@@ -211,19 +212,16 @@ def build_serial(case: Case):
                 for j in range(n)
             ]
         if f.disc_bores is not None:
-            kw["disc_bores"] = np.stack(
-                _pick(mt.read_disc_bores(f.disc_bores, bores=m), ds, f.disc_bores, "discs")
-            )
+            bores = mt.read_disc_bores(f.disc_bores, bores=m)
+            check_measured_against_design(red, f.disc_bores, bores=bores)
+            kw["disc_bores"] = np.stack(_pick(bores, ds, f.disc_bores, "discs"))
             note("disc crank-bore positions", f.disc_bores, ds)
     if s.cranks is not None:
         cs = count("cranks", s.cranks, m)
         if f.crank_eccentricity is not None:
-            cams = _pick(
-                mt.read_crank_eccentricity(f.crank_eccentricity, cams=n),
-                cs,
-                f.crank_eccentricity,
-                "cranks",
-            )
+            read = mt.read_crank_eccentricity(f.crank_eccentricity, cams=n)
+            check_measured_against_design(red, f.crank_eccentricity, cams=read)
+            cams = _pick(read, cs, f.crank_eccentricity, "cranks")
             kw["cam_eccentricity"] = np.stack([c.eccentricity for c in cams])
             kw["cam_phase"] = np.stack([c.phase for c in cams])
             note("cam eccentricity and phase", f.crank_eccentricity, cs)
@@ -247,7 +245,9 @@ def build_serial(case: Case):
         kw["sun_runout"] = np.array([r.runout, r.phase])
         note("sun run-out", f.sun_runout, s.sun)
     if s.pins is not None and f.pins is not None:
-        p = _pick(mt.read_pins(f.pins, pins=zp), [s.pins], f.pins, "pins")[0]
+        pin_sets = mt.read_pins(f.pins, pins=zp)
+        check_measured_against_design(red, f.pins, pins=pin_sets)
+        p = _pick(pin_sets, [s.pins], f.pins, "pins")[0]
         kw.update(
             pin_diameters=p.diameter, slot_radial=p.slot_radial, slot_tangential=p.slot_tangential
         )

@@ -31,6 +31,7 @@ import numpy as np
 
 from gearte.errors import ParameterError
 from gearte.execution import map_chunks, seeded_chunks
+from gearte.execution.stop import current_stop_scope
 from gearte.tolerance.yield_mc import (
     Model,
     SpecLimit,
@@ -41,7 +42,14 @@ from gearte.tolerance.yield_mc import (
     wilson_interval,
 )
 
-__all__ = ["CostModel", "PriceTable", "Allocation", "allocate"]
+__all__ = ["CostModel", "PriceTable", "Allocation", "SearchStopped", "allocate"]
+
+
+class SearchStopped(Exception):
+    """The run was stopped (SIGINT/SIGTERM, a lost cluster) before or during :func:`allocate`:
+    the search is given up (its candidates' counts would come from fewer samples than the
+    search's), recorded in the run's stop scope (:mod:`gearte.execution.stop`); the caller
+    reports no allocation and keeps what it computed before."""
 
 
 @dataclass(frozen=True)
@@ -200,6 +208,7 @@ def allocate(
     # start at the ladder level closest to the given width
     level = {k: int(np.argmin([abs(w - t0[k]) for w in ladders[k]])) for k in keys}
     chunks = seeded_chunks(int(n), int(chunk_size), seed)
+    scope = current_stop_scope()
     cache: dict[tuple[int, ...], int] = {}
     evaluations = 0
 
@@ -227,6 +236,11 @@ def allocate(
                 options=options,
                 progress=False,
             )
+            if scope is not None and scope.stopped:  # counts of a prefix of the chunks only
+                scope.cut.append(
+                    f"allocation search: stopped after {evaluations} evaluations, not reported"
+                )
+                raise SearchStopped("the run was stopped during the allocation search")
             for key, cnt in zip(uniq, counts, strict=True):
                 cache[key] = int(cnt)
             evaluations += len(uniq)
@@ -238,81 +252,104 @@ def allocate(
     def total_cost(lv: Mapping[str, int]) -> float:
         return sum(costs[k].cost(ladders[k][lv[k]]) for k in keys)
 
-    history: list[dict[str, Any]] = []
-    cur = dict(level)
-    (cnt,) = passed([cur])
-    steps = 0
-    while not meets(cnt):
-        steps += 1
-        if steps > max_steps:
-            raise ParameterError("max_steps", max_steps, "allocation did not converge")
-        cands = []
-        for k in keys:
-            if cur[k] > 0:
-                c = dict(cur)
-                c[k] -= 1
-                cands.append((k, c))
-        if not cands:
-            raise ParameterError(
-                "target_yield",
-                target,
-                "cannot be reached even with every tolerance at its tightest level",
+    def search() -> Allocation:
+        history: list[dict[str, Any]] = []
+        cur = dict(level)
+        (cnt,) = passed([cur])
+        steps = 0
+        while not meets(cnt):
+            steps += 1
+            if steps > max_steps:
+                raise ParameterError("max_steps", max_steps, "allocation did not converge")
+            cands = []
+            for k in keys:
+                if cur[k] > 0:
+                    c = dict(cur)
+                    c[k] -= 1
+                    cands.append((k, c))
+            if not cands:
+                raise ParameterError(
+                    "target_yield",
+                    target,
+                    "cannot be reached even with every tolerance at its tightest level",
+                )
+            counts = passed([c for _, c in cands])
+            base_cost = total_cost(cur)
+            best = max(
+                range(len(cands)),
+                key=lambda i: (counts[i] - cnt) / max(total_cost(cands[i][1]) - base_cost, 1e-12),
             )
-        counts = passed([c for _, c in cands])
-        base_cost = total_cost(cur)
-        best = max(
-            range(len(cands)),
-            key=lambda i: (counts[i] - cnt) / max(total_cost(cands[i][1]) - base_cost, 1e-12),
-        )
-        cur = cands[best][1]
-        cnt = counts[best]
-        history.append({"step": "tighten", "tolerance": cands[best][0], "passed": cnt})
-    while True:
-        steps += 1
-        if steps > max_steps:
-            raise ParameterError("max_steps", max_steps, "allocation did not converge")
-        cands = []
+            cur = cands[best][1]
+            cnt = counts[best]
+            history.append({"step": "tighten", "tolerance": cands[best][0], "passed": cnt})
+        while True:
+            steps += 1
+            if steps > max_steps:
+                raise ParameterError("max_steps", max_steps, "allocation did not converge")
+            cands = []
+            for k in keys:
+                if cur[k] < len(ladders[k]) - 1:
+                    c = dict(cur)
+                    c[k] += 1
+                    cands.append((k, c))
+            counts = passed([c for _, c in cands])
+            ok = [i for i in range(len(cands)) if meets(counts[i])]
+            if not ok:
+                break
+            base_cost = total_cost(cur)
+            best = max(ok, key=lambda i: base_cost - total_cost(cands[i][1]))
+            cur = cands[best][1]
+            cnt = counts[best]
+            history.append({"step": "loosen", "tolerance": cands[best][0], "passed": cnt})
+        # local optimality: every single one-level loosening misses the target
+        loosen: dict[str, float | None] = {}
         for k in keys:
             if cur[k] < len(ladders[k]) - 1:
                 c = dict(cur)
                 c[k] += 1
-                cands.append((k, c))
-        counts = passed([c for _, c in cands])
-        ok = [i for i in range(len(cands)) if meets(counts[i])]
-        if not ok:
-            break
-        base_cost = total_cost(cur)
-        best = max(ok, key=lambda i: base_cost - total_cost(cands[i][1]))
-        cur = cands[best][1]
-        cnt = counts[best]
-        history.append({"step": "loosen", "tolerance": cands[best][0], "passed": cnt})
-    # local optimality: every single one-level loosening misses the target
-    loosen: dict[str, float | None] = {}
-    for k in keys:
-        if cur[k] < len(ladders[k]) - 1:
-            c = dict(cur)
-            c[k] += 1
-            (lc,) = passed([c])
-            loosen[k] = lc / n
-        else:
-            loosen[k] = None  # already at the loosest level
-    locally_optimal = all(v is None or not meets(int(round(v * n))) for v in loosen.values())
-    widths = widths_of(cur)
-    final = tolerances.with_tolerances(widths)
-    vseed = (0 if seed is None else int(seed)) + 1 if verify_seed is None else verify_seed
-    verified = run_yield(
-        model, final, spec, int(verify_n or n), seed=vseed, chunk_size=chunk_size, options=options
-    )
-    return Allocation(
-        widths=widths,
-        cost=total_cost(cur),
-        cost_by_tolerance={k: costs[k].cost(widths[k]) for k in keys},
-        search_yield=cnt / n,
-        search_ci=wilson_interval(cnt, int(n)),
-        target=target,
-        verified=verified,
-        loosening_yields=loosen,
-        locally_optimal=locally_optimal,
-        evaluations=evaluations,
-        history=history,
-    )
+                (lc,) = passed([c])
+                loosen[k] = lc / n
+            else:
+                loosen[k] = None  # already at the loosest level
+        locally_optimal = all(v is None or not meets(int(round(v * n))) for v in loosen.values())
+        widths = widths_of(cur)
+        final = tolerances.with_tolerances(widths)
+        vseed = (0 if seed is None else int(seed)) + 1 if verify_seed is None else verify_seed
+        verified = run_yield(
+            model,
+            final,
+            spec,
+            int(verify_n or n),
+            seed=vseed,
+            chunk_size=chunk_size,
+            options=options,
+        )
+        return Allocation(
+            widths=widths,
+            cost=total_cost(cur),
+            cost_by_tolerance={k: costs[k].cost(widths[k]) for k in keys},
+            search_yield=cnt / n,
+            search_ci=wilson_interval(cnt, int(n)),
+            target=target,
+            verified=verified,
+            loosening_yields=loosen,
+            locally_optimal=locally_optimal,
+            evaluations=evaluations,
+            history=history,
+        )
+
+    if scope is not None and scope.stopped:
+        scope.cut.append("allocation search: not run (after the stop)")
+        raise SearchStopped("the run was stopped before the allocation search")
+    try:
+        return search()
+    except KeyboardInterrupt as exc:
+        if scope is None or scope.stopped:
+            raise
+        # stopped inside the search (between its Monte-Carlo calls, or in one before any chunk
+        # finished): the search is given up, what the run computed before it is kept
+        scope.cause = exc
+        scope.cut.append(
+            f"allocation search: stopped after {evaluations} evaluations, not reported"
+        )
+        raise SearchStopped("the run was stopped during the allocation search") from None
