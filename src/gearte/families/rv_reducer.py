@@ -3,9 +3,10 @@ contact) with its catalogue virtual test.
 
 Description: ``[reducer]`` (:class:`gearte.studies.rv_reducer.ReducerSection`) ↔ the
 :class:`~gearte.geometry.rv.RVReducer` (:func:`to_object`, through
-:func:`gearte.studies.rv_reducer.build_reducer`, and :func:`to_sections`); ``[analyses]``'s ``catalogue`` options set the drive's virtual test. An RV reducer described with
-its given (measured) errors only has no tolerances: in a chain's yield its lost motion is held at
-its model's value. One whose case has ``[analyses.yield]`` tolerances draws them in a chain's
+:func:`gearte.studies.rv_reducer.build_reducer`, and :func:`to_sections`); ``[analyses]``'s
+``catalogue`` options set the drive's virtual test. An RV reducer described with its given
+(measured) errors only has no tolerances: in a chain's yield its lost motion is held at its
+model's value. One whose case has ``[analyses.yield]`` tolerances draws them in a chain's
 yield too (keys ``<stage slug>.<error key>``), each sample one assembled reducer through the
 catalogue virtual test (:class:`RVLostMotion`).
 """
