@@ -171,42 +171,12 @@ RV_ROUND_TRIP_CASES = [
 ]
 
 
-def _fields(x, path="reducer"):
-    """``(path, value)`` of every leaf of a (nested) dataclass: arrays, numbers, strings."""
-    import dataclasses
-
-    if dataclasses.is_dataclass(x):
-        for f in dataclasses.fields(x):
-            if not f.name.startswith("_"):
-                yield from _fields(getattr(x, f.name), f"{path}.{f.name}")
-    elif isinstance(x, tuple):
-        for i, y in enumerate(x):
-            yield from _fields(y, f"{path}[{i}]")
-    else:
-        yield path, x
-
-
-def assert_same_reducer(got, want):
-    """Every field and array of two RVReducers equal, to the round-off of the unit conversions
-    (µm ↔ mm, deg ↔ rad, vector ↔ length and direction, stiffness ↔ compliance: 1e-12)."""
-    import numpy as np
-
-    a, b = dict(_fields(want)), dict(_fields(got))
-    assert a.keys() == b.keys()
-    for key, x in a.items():
-        y = b[key]
-        if x is None or isinstance(x, str | bool):
-            assert y == x, key
-            continue
-        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        assert y.shape == x.shape, key
-        np.testing.assert_allclose(y, x, rtol=1e-12, atol=1e-15, err_msg=key)
-
-
 @pytest.mark.parametrize("name", RV_ROUND_TRIP_CASES)
 def test_rv_reducer_family_description_round_trips_through_its_section(name):
     """to_sections then to_object gives the same RVReducer, every field and array (its derived
     stiffnesses written back as given ones, its measured errors as [[reducer.errors]])."""
+    from rv_sections import assert_same_reducer
+
     fam = get_family("rv_reducer")
     assert fam.to_sections is not None
     red = fam.to_object(load_case(name))
