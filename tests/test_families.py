@@ -224,3 +224,20 @@ def test_rv_reducer_sections_refuse_a_serials_measured_discs():
     _, red, _ = build_serial(load_case("synthetic_rv110e_serial"))
     with pytest.raises(ParameterError, match="errors.measured_discs|errors.cam_clearance"):
         fam.to_sections(red)
+
+
+@pytest.mark.parametrize(
+    "name", ["wang2013_2kh_derived", "wang2013_2kh_eq9", "wang2013_2kh_eq9_yield"]
+)
+def test_planetary_family_description_round_trips_through_its_sections(name):
+    """to_sections then to_object gives the same set, term set, magnitudes and angles (exactly:
+    the values converted back are written to 15 significant digits, as the case gave them); a
+    derived term set is written as source = "derived", a published table as its terms."""
+    fam = get_family("planetary")
+    assert fam.to_sections is not None
+    case = load_case(name)
+    obj = fam.to_object(case)
+    sections = fam.to_sections(obj)
+    assert sections["errors"]["source"] == case.errors.source
+    again = fam.to_object(load_case_dict({"case": {"kind": "planetary"}, **sections}))
+    assert again == obj
