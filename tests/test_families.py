@@ -158,3 +158,86 @@ def test_chain_yield_rv_stage_draws_its_cases_own_yield_tolerances():
     own = res["rv_reducer_drive"].values["lost_motion [arcmin]"]
     assert q["sd"] > 0
     assert q["mean"] == pytest.approx(own, abs=4 * q["sd"] / 48**0.5)
+
+
+#: The bundled rv_reducer cases whose [reducer] round-trips through the family's sections.
+RV_ROUND_TRIP_CASES = [
+    "han2023_rv110e",
+    "han2023_rv110e_no_errors",
+    "hu2020_rv80e_initial_reducer",
+    "hu2020_rv80e_modified_reducer",
+    "li2023_rv",
+    "li2023_rv_errors",
+]
+
+
+@pytest.mark.parametrize("name", RV_ROUND_TRIP_CASES)
+def test_rv_reducer_family_description_round_trips_through_its_section(name):
+    """to_sections then to_object gives the same RVReducer, every field and array (its derived
+    stiffnesses written back as given ones, its measured errors as [[reducer.errors]])."""
+    from rv_sections import assert_same_reducer
+
+    fam = get_family("rv_reducer")
+    assert fam.to_sections is not None
+    red = fam.to_object(load_case(name))
+    sections = fam.to_sections(red)
+    again = fam.to_object(load_case_dict({"case": {"kind": "rv_reducer"}, **sections}))
+    assert_same_reducer(again, red)
+
+
+def test_rv_reducer_sections_write_derived_stiffnesses_as_given_keys():
+    """han2023_rv110e derives its bearings (Palmgren), stiffness chain (spans, seat length) and
+    keeps the measured errors: the section written back gives each stiffness, no dimension it
+    was derived from, and every measured error entry (length and direction)."""
+    import math
+    import tomllib
+
+    fam = get_family("rv_reducer")
+    case = load_case("han2023_rv110e")
+    assert fam.to_sections is not None
+    sec = fam.to_sections(fam.to_object(case))["reducer"]
+    for key in ("bearing_span_mm", "torsion_length_mm"):
+        assert key not in sec["cranks"]
+    assert {"bending_stiffness_N_per_mm", "torsional_stiffness_Nm_per_rad"} <= set(sec["cranks"])
+    assert "seat_length_mm" not in sec["pins"] and "seat_stiffness_N_per_mm" in sec["pins"]
+    assert "main_bearing" not in sec["supports"]
+    assert set(sec["cranks"]["cam_bearing"]) == {"stiffness_N_per_mm", "radial_clearance_um"}
+    raw = tomllib.loads(case_path("han2023_rv110e").read_text())["reducer"]["errors"]
+    written = {(e["part"], e.get("crank"), e.get("disc")): e for e in sec["errors"]}
+    given = [e for e in raw if e["value_um"] > 0]
+    assert len(written) == len(given)
+    for e in given:
+        w = written[(e["part"], e.get("crank"), e.get("disc"))]
+        assert w["value_um"] == pytest.approx(e["value_um"], rel=1e-12)
+        turn = math.remainder(w["angle_deg"] - e["angle_deg"], 360.0)
+        assert turn == pytest.approx(0.0, abs=1e-10)
+
+
+def test_rv_reducer_sections_refuse_a_serials_measured_discs():
+    """A serial's measured discs and bearing clearances (rv_serial) have no [reducer] key: an
+    error naming the field, not a silently different reducer."""
+    from gearte.errors import ParameterError
+    from gearte.studies.rv_serial import build_serial
+
+    fam = get_family("rv_reducer")
+    assert fam.to_sections is not None
+    _, red, _ = build_serial(load_case("synthetic_rv110e_serial"))
+    with pytest.raises(ParameterError, match="errors.measured_discs|errors.cam_clearance"):
+        fam.to_sections(red)
+
+
+@pytest.mark.parametrize(
+    "name", ["wang2013_2kh_derived", "wang2013_2kh_eq9", "wang2013_2kh_eq9_yield"]
+)
+def test_planetary_family_description_round_trips_through_its_sections(name):
+    """to_sections then to_object gives the same set, term set, magnitudes and angles (exactly:
+    the values converted back are written to 15 significant digits, as the case gave them); a
+    derived term set is written as source = "derived", a published table as its terms."""
+    fam = get_family("planetary")
+    assert fam.to_sections is not None
+    case = load_case(name)
+    obj = fam.to_object(case)
+    sections = fam.to_sections(obj)
+    assert sections["errors"]["source"] == case.errors.source
+    again = fam.to_object(load_case_dict({"case": {"kind": "planetary"}, **sections}))
+    assert again == obj

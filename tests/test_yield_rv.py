@@ -198,3 +198,32 @@ def test_han2023_yield_sobol_totals_sum_below_1_5_and_the_grid_error_is_reported
     assert v["te_discretisation_error [arcsec]"] == pytest.approx(grid["mean"] * 60.0)
     assert grid["mean"] > 0 and grid["relative_mean"] > 0.02
     assert any("angular_te" in w and "under-estimate" in w for w in res.warnings)
+
+
+def test_rv_worst_sample_file_is_the_sampled_reducer_and_gives_the_sampled_values():
+    """The worst sample's case file is written by the rv_reducer family's ``to_sections`` from
+    the sample's reducer: read back it is that reducer (every field and array), and the yield
+    model's per-sample path on it gives every sampled quantity (the batch solver's values, equal
+    to round-off: seen ≤ 3e-13 relative, the backlash, a difference of two angles)."""
+    import tomllib
+
+    from gearte.cases import case_path
+    from gearte.families import get_family
+    from gearte.io.case_file import load_case_dict
+    from gearte.studies import RunOptions
+    from rv_sections import assert_same_reducer
+
+    data = tomllib.loads(case_path("han2023_rv110e_yield").read_text())
+    data["analyses"]["yield"].update(
+        samples=4, chunk_size=4, sobol_samples=0, keep_worst=1, grid_check_samples=0
+    )
+    case = load_case_dict(data, name="rv_worst")
+    y = gearte.run_case(case, RunOptions(progress=False))["yield"]
+    worst = y.values["worst_samples"][0]
+    exported = load_case_dict(tomllib.loads(y.files["worst_sample_1.toml"]), name="worst")
+    red = get_family("rv_reducer").to_object(exported)
+    model = RVReducerYield(build_reducer(case.reducer), positions=case.analyses.yield_.positions)
+    assert_same_reducer(red, model.reducer_for(worst["errors"]))
+    again = model.one(red)
+    for q, v in worst["values"].items():
+        assert again[q] == pytest.approx(v, rel=1e-9), q

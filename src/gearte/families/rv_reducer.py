@@ -1,11 +1,12 @@
 """Drive family ``rv_reducer``: a whole RV reducer (Han et al. 2023 load sharing, Hu et al. 2020
 contact) with its catalogue virtual test.
 
-Description: ``[reducer]`` (:class:`gearte.studies.rv_reducer.ReducerSection`) → the
-:class:`~gearte.models.rv_load_sharing.RVReducer` (:func:`gearte.studies.rv_reducer.build_reducer`);
-``[analyses]``'s ``catalogue`` options set the drive's virtual test. An RV reducer described with
-its given (measured) errors only has no tolerances: in a chain's yield its lost motion is held at
-its model's value. One whose case has ``[analyses.yield]`` tolerances draws them in a chain's
+Description: ``[reducer]`` (:class:`gearte.studies.rv_reducer.ReducerSection`) ↔ the
+:class:`~gearte.geometry.rv.RVReducer` (:func:`to_object`, through
+:func:`gearte.studies.rv_reducer.build_reducer`, and :func:`to_sections`); ``[analyses]``'s
+``catalogue`` options set the drive's virtual test. An RV reducer described with its given
+(measured) errors only has no tolerances: in a chain's yield its lost motion is held at its
+model's value. One whose case has ``[analyses.yield]`` tolerances draws them in a chain's
 yield too (keys ``<stage slug>.<error key>``), each sample one assembled reducer through the
 catalogue virtual test (:class:`RVLostMotion`).
 """
@@ -19,7 +20,14 @@ import numpy as np
 
 from gearte.families import DriveFamily, StageYield
 
-__all__ = ["FAMILY", "to_object", "drive", "chain_yield", "RVLostMotion"]
+__all__ = [
+    "FAMILY",
+    "to_object",
+    "to_sections",
+    "drive",
+    "chain_yield",
+    "RVLostMotion",
+]
 
 
 def to_object(case: Any) -> Any:
@@ -27,6 +35,22 @@ def to_object(case: Any) -> Any:
     from gearte.studies.rv_reducer import build_reducer
 
     return build_reducer(case.reducer)
+
+
+def to_sections(red: Any) -> dict[str, Any]:
+    """The ``[reducer]`` section (and an empty ``[analyses]``) that describes ``red`` (an
+    :class:`~gearte.geometry.rv.RVReducer`): ``to_object`` of a case made of them gives ``red``
+    back (:func:`gearte.studies.rv_reducer.reducer_section`: its derived stiffnesses written as
+    given keys, what the object does not hold left out).
+
+    Parameters
+    ----------
+    red : RVReducer
+        The reducer [mm, N, N·mm, rad].
+    """
+    from gearte.studies.rv_reducer import reducer_section
+
+    return {"reducer": reducer_section(red), "analyses": {}}
 
 
 def drive(case: Any, name: str) -> Any:
@@ -152,6 +176,7 @@ FAMILY = DriveFamily(
     kind="rv_reducer",
     sections=("reducer", "analyses"),
     to_object=to_object,
+    to_sections=to_sections,
     drive=drive,
     chain_yield=chain_yield,
     drive_kinds=("rv_reducer",),

@@ -117,6 +117,7 @@ __all__ = [
     "Case",
     "run",
     "build_reducer",
+    "reducer_section",
     "build_stage_case",
     "load_dynamic_model",
 ]
@@ -1299,6 +1300,275 @@ def build_reducer(
     return red
 
 
+#: ``[reducer]`` keys (by sub-table, ``""`` the table itself) that the
+#: :class:`~gearte.geometry.rv.RVReducer` does not hold: the first stage's backlash input (added
+#: by the catalogue test and the yield beside the reducer model), the dynamics' and the tooth
+#: contact's own inputs, the pressure warning and the density of derived masses.
+CASE_ONLY_KEYS: dict[str, tuple[str, ...]] = {
+    "": (
+        "allowable_contact_pressure_MPa",
+        "material",
+        "density_kg_per_m3",
+        "cycloid_errors",
+        "dynamics",
+    ),
+    "first_stage": (
+        "sun_tooth_thickness_allowance",
+        "planet_tooth_thickness_allowance",
+        "centre_distance_allowance",
+        "backlash_um",
+    ),
+}
+
+
+def _tidy(x: Any) -> float:
+    """``x`` to 15 significant digits: a value that went through a unit conversion (µm → mm →
+    µm, N·m → N·mm → N·m) is written as it was given (``12.0``, not ``12.000000000000002``);
+    the change is below 1e-15 relative."""
+    return float(f"{float(x):.15g}")
+
+
+def _one_stiffness(field: str, compliances: tuple[float, ...] | None) -> float | None:
+    """The one stiffness [N/mm] of a per-disc compliance tuple [mm/N] (``None``: left out).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``field`` when the discs' compliances differ: ``[reducer]`` gives one stiffness
+        for every disc.
+    """
+    if compliances is None:
+        return None
+    c = np.asarray(compliances, dtype=float)
+    if not np.allclose(c, c[0], rtol=1e-12, atol=0.0):
+        raise ParameterError(
+            field,
+            tuple(float(x) for x in c),
+            "the discs' compliances differ; [reducer] gives one stiffness for every disc",
+        )
+    return _tidy(1.0 / c[0])
+
+
+def _error_entries(errors: ManufacturingErrors) -> list[dict[str, Any]]:
+    """``[[reducer.errors]]`` of a :class:`~gearte.geometry.rv.ManufacturingErrors`: one entry
+    per non-zero error vector, its length [µm] and direction [deg] in the part's frame."""
+    from gearte.geometry.planetary import EccentricityError
+
+    out: list[dict[str, Any]] = []
+
+    def add(part: str, vec: np.ndarray, crank: int | None = None, disc: int | None = None):
+        if not np.any(vec):
+            return
+        e = EccentricityError.from_vector(vec, f"errors.{part}")
+        entry: dict[str, Any] = {"part": part}
+        if crank is not None:
+            entry["crank"] = crank
+        if disc is not None:
+            entry["disc"] = disc
+        entry["value_um"] = _tidy(mm_to_um(e.amplitude))
+        entry["angle_deg"] = _tidy(rad_to_deg(e.phase))
+        out.append(entry)
+
+    m, n = errors.planet.shape[0], errors.disc_bore.shape[0]
+    add("sun_eccentricity", errors.sun)
+    add("sun_assembly", errors.sun_seat)
+    for i in range(m):
+        add("planet_eccentricity", errors.planet[i], crank=i + 1)
+    for i in range(m):
+        for j in range(n):
+            add("cam", errors.cam[i, j], crank=i + 1, disc=j + 1)
+    for j in range(n):
+        for i in range(m):
+            add("disc_crank_bore", errors.disc_bore[j, i], crank=i + 1, disc=j + 1)
+    for j in range(n):
+        add("disc_radial_runout", errors.disc_runout[j], disc=j + 1)
+        add("disc_cumulative_pitch", errors.disc_pitch[j], disc=j + 1)
+    for i in range(m):
+        add("carrier_crank_bore", errors.carrier_bore[i], crank=i + 1)
+    add("output_assembly", errors.output_seat)
+    return out
+
+
+def reducer_section(red: RVReducer) -> dict[str, Any]:
+    """The ``[reducer]`` table that describes ``red``, the inverse of :func:`build_reducer`:
+    ``build_reducer`` of it gives ``red`` back (every field and array equal to the
+    round-off of the unit conversions: µm ↔ mm, deg ↔ rad, an error vector ↔ its length and
+    direction, a stiffness ↔ its compliance; converted values are written to 15 significant
+    digits).
+
+    Parameters
+    ----------
+    red : RVReducer
+        The reducer [mm, N, N·mm, rad] (:class:`~gearte.geometry.rv.RVReducer`).
+
+    Returns
+    -------
+    dict
+        The ``[reducer]`` table, JSON-able, units in the keys.
+
+    Raises
+    ------
+    ParameterError
+        Naming the field the section cannot hold: measured discs or measured bearing
+        clearances (a serial's metrology, ``rv_serial``), planets not equally spaced, or
+        per-disc bending compliances that differ.
+
+    Notes
+    -----
+    The object holds the stiffnesses, not how they were obtained, so every stiffness is written
+    as a **given** key, whatever the case it came from derived it from:
+
+    * crank bearings and the main bearing from Palmgren/Stribeck data (linearised at a reference
+      load or, ``at_rated_torque``, at the design's largest load at rated torque) →
+      ``stiffness_N_per_mm`` / ``carrier_radial_stiffness_N_per_mm``;
+    * the stiffness chain derived from dimensions (``bearing_span_mm``, ``torsion_length_mm``,
+      ``seat_length_mm`` at the ideal peak pin force, ``support_span_mm``) →
+      ``bending_stiffness_N_per_mm``, ``torsional_stiffness_Nm_per_rad``,
+      ``seat_stiffness_N_per_mm``;
+    * the ISO 6336 mesh stiffness from ``face_width_mm`` → ``mesh_stiffness_N_per_mm`` (the face
+      width is written too: the masses read it).
+
+    The errors are written as ``[[reducer.errors]]`` entries (non-zero vectors only, direction
+    in (−180, 180] deg), the per-pin and per-disc errors as lists. What the object does not hold
+    (:data:`CASE_ONLY_KEYS`: the first stage's backlash, ``dynamics``, ``cycloid_errors``,
+    density) is not written: :func:`with_case_keys` takes it from the case the object came from.
+    """
+    fs, c, d, p, s = red.first_stage, red.cranks, red.discs, red.pins, red.supports
+    err = red.error_set
+    if err.measured_discs is not None and any(x is not None for x in err.measured_discs):
+        raise ParameterError(
+            "errors.measured_discs", "measured", "a measured disc (rv_serial) has no [reducer] key"
+        )
+    for name in ("cam_clearance", "carrier_clearance"):
+        if getattr(err, name) is not None:
+            raise ParameterError(
+                f"errors.{name}",
+                "measured",
+                "measured per-bearing clearances (rv_serial) have no [reducer] key",
+            )
+    if fs.gears.planet_angles is not None:
+        eta = np.asarray(fs.gears.planet_angles, dtype=float)
+        n = len(eta)
+        if not np.allclose(eta, 2.0 * np.pi * np.arange(n) / n, rtol=0.0, atol=1e-12):
+            raise ParameterError(
+                "first_stage.planet_angles",
+                fs.gears.planet_angles,
+                "[reducer] describes equally spaced planets only",
+            )
+
+    def um(x: float) -> float:
+        return _tidy(mm_to_um(x))
+
+    def opt(table: dict[str, Any], key: str, value: Any) -> None:
+        if value is not None:
+            table[key] = float(value)
+
+    def per_item(values: np.ndarray) -> list[float] | None:
+        v = np.asarray(values, dtype=float)
+        return None if not np.any(v) else [_tidy(x) for x in mm_to_um(v)]
+
+    first: dict[str, Any] = {
+        "sun_teeth": int(fs.sun_teeth),
+        "planet_teeth": int(fs.planet_teeth),
+        "planets": int(fs.gears.n_planets),
+        "module_mm": float(fs.module),
+        "pressure_angle_deg": _tidy(rad_to_deg(fs.pressure_angle)),
+        "mesh_stiffness_N_per_mm": float(fs.mesh_stiffness),
+        "sun_support_stiffness_N_per_mm": float(fs.sun_support_stiffness),
+    }
+    opt(first, "face_width_mm", fs.face_width)
+    cranks: dict[str, Any] = {
+        "count": int(c.count),
+        "circle_radius_mm": float(c.circle_radius),
+        "eccentricity_mm": float(c.eccentricity),
+        "cam_bearing": {
+            "stiffness_N_per_mm": float(c.cam_bearing_stiffness),
+            "radial_clearance_um": um(c.cam_bearing_clearance),
+        },
+        "carrier_bearing": {
+            "stiffness_N_per_mm": float(c.carrier_bearing_stiffness),
+            "radial_clearance_um": um(c.carrier_bearing_clearance),
+        },
+    }
+    opt(cranks, "shaft_diameter_mm", c.shaft_diameter)
+    opt(cranks, "shaft_length_mm", c.shaft_length)
+    opt(
+        cranks,
+        "bending_stiffness_N_per_mm",
+        _one_stiffness("cranks.bending_compliance", c.bending_compliance),
+    )
+    if c.torsional_stiffness is not None:
+        cranks["torsional_stiffness_Nm_per_rad"] = _tidy(
+            c.torsional_stiffness / NM_PER_RAD_TO_NMM_PER_RAD
+        )
+    discs: dict[str, Any] = {
+        "count": int(d.count),
+        "face_width_mm": float(d.face_width),
+        "equidistant_modification_mm": float(d.equidistant_modification),
+        "shift_modification_mm": float(d.shift_modification),
+        "youngs_modulus_MPa": float(d.youngs_modulus),
+        "poisson_ratio": float(d.poisson_ratio),
+    }
+    opt(discs, "crank_bore_diameter_mm", d.crank_bore_diameter)
+    opt(discs, "centre_bore_diameter_mm", d.centre_bore_diameter)
+    for col, key in enumerate(
+        ("equidistant_modification_errors_um", "shift_modification_errors_um")
+    ):
+        if (v := per_item(err.disc_modification[:, col])) is not None:
+            discs[key] = v
+    pins: dict[str, Any] = {
+        "count": int(p.count),
+        "pin_radius_mm": float(p.pin_radius),
+        "circle_radius_mm": float(p.circle_radius),
+    }
+    for name in ("radius_errors", "radial_position_errors", "tangential_position_errors"):
+        if (v := per_item(getattr(p, name))) is not None:
+            pins[f"{name}_um"] = v
+    if p.seat_compliance is not None:
+        pins["seat_stiffness_N_per_mm"] = _tidy(1.0 / p.seat_compliance)
+    opt(
+        pins,
+        "bending_stiffness_N_per_mm",
+        _one_stiffness("pins.bending_compliance", p.bending_compliance),
+    )
+    supports: dict[str, Any] = {
+        "carrier_radial_stiffness_N_per_mm": float(s.carrier_radial_stiffness),
+        "main_bearing_clearance_um": um(s.main_bearing_clearance),
+    }
+    opt(supports, "carrier_outer_diameter_mm", s.carrier_outer_diameter)
+    opt(supports, "carrier_length_mm", s.carrier_length)
+    if s.output_torsional_stiffness is not None:
+        supports["output_flange_torsional_stiffness_Nm_per_rad"] = _tidy(
+            s.output_torsional_stiffness / NM_PER_RAD_TO_NMM_PER_RAD
+        )
+    reducer: dict[str, Any] = {"contact_law": d.contact_law}
+    if red.rated_torque is not None:
+        reducer["rated_torque_Nm"] = _tidy(Nmm_to_Nm(red.rated_torque))
+    reducer.update(
+        first_stage=first,
+        cranks=cranks,
+        discs=discs,
+        pins=pins,
+        supports=supports,
+        errors=_error_entries(err),
+    )
+    return reducer
+
+
+def with_case_keys(reducer: dict[str, Any], case_reducer: dict[str, Any]) -> dict[str, Any]:
+    """``reducer`` (a ``[reducer]`` table written by :func:`reducer_section`) with the keys the
+    object does not hold (:data:`CASE_ONLY_KEYS`) taken from ``case_reducer`` (the JSON dump of
+    the ``[reducer]`` the object came from); a new dict."""
+    out = {**reducer, "first_stage": dict(reducer["first_stage"])}
+    for sub, keys in CASE_ONLY_KEYS.items():
+        src = case_reducer if not sub else case_reducer.get(sub, {})
+        dst = out if not sub else out[sub]
+        for k in keys:
+            if src.get(k) is not None:
+                dst[k] = src[k]
+    return out
+
+
 def stage_section(sec: ReducerSection):
     """The ``cycloid_stage`` kind's ``[stage]`` section of the reducer's cycloid–pin stage: the
     one mapping of the RV description to the stage, built by that kind's one builder
@@ -2136,48 +2406,19 @@ def _yield(case: Case, red, sec: RVYieldSection, options) -> AnalysisResult:
     """``[analyses.yield]``: each sample one assembled reducer (errors drawn from the
     tolerances; errors without a tolerance keep the case's values) → catalogue test, angular TE
     over one output revolution, peak pin load; yield against ``[analyses.yield.spec]``."""
-    from gearte.runners.yield_models import (
-        MODIFICATION_FAMILIES,
-        RV_PIN_FAMILIES,
-        RV_VECTOR_PARTS,
-    )
     from gearte.studies._yield import yield_analysis
 
     model, fs_model = _yield_model(case, red, sec)
     families, defaults, units = _yield_keys(case, red, sec)
 
     def worst_case(errors):
+        """The worst sample's case: its reducer (the yield model's, built for the drawn errors)
+        written back by :func:`reducer_section` (the family's ``to_sections``), the keys the
+        reducer object does not hold taken from the case, the first stage's drawn backlash as
+        ``backlash_um``."""
         d = case.model_dump(mode="json", by_alias=True, exclude_none=True)
-        entries = {(e["part"], e.get("crank"), e.get("disc")): e for e in d["reducer"]["errors"]}
-        for part in RV_VECTOR_PARTS:
-            for key in families[part]:
-                if key not in errors:
-                    continue
-                idx = {i[0]: int(i[1:]) for i in key.split(".")[1:]}  # c<i>, d<j>
-                crank, disc = idx.get("c"), idx.get("d")
-                name = "planet_eccentricity" if part == "planet_base_circle" else part
-                entry = {"part": name, "value_um": float(errors[key])}
-                if crank is not None:
-                    entry["crank"] = crank
-                if disc is not None:
-                    entry["disc"] = disc
-                phase = float(errors.get(f"{key}_phase_rad", 0.0))
-                entry["angle_deg"] = float(np.mod(rad_to_deg(phase) + 180.0, 360.0) - 180.0)
-                entries[(name, crank, disc)] = entry
-        d["reducer"]["errors"] = list(entries.values())
-        discs = d["reducer"]["discs"]
-        for fam in MODIFICATION_FAMILIES:
-            keys = families[fam]
-            if any(k in errors for k in keys):
-                name = fam.split(".")[1] + "_um"
-                old = discs.get(name) or [0.0] * len(keys)
-                discs[name] = [float(errors.get(k, old[i])) for i, k in enumerate(keys)]
-        pins = d["reducer"]["pins"]
-        for f in RV_PIN_FAMILIES:
-            keys = families[f"pins.{f}"]
-            if any(k in errors for k in keys):
-                old = pins.get(f"{f}_um") or [0.0] * len(keys)
-                pins[f"{f}_um"] = [float(errors.get(k, old[i])) for i, k in enumerate(keys)]
+        inner = model if fs_model is None else fs_model.inner
+        d["reducer"] = with_case_keys(reducer_section(inner.reducer_for(errors)), d["reducer"])
         te_torque = sec.te_torque_Nm or case.reducer.rated_torque_Nm
         if fs_model is not None and any(k.startswith("first_stage.") for k in errors):
             fsd = d["reducer"]["first_stage"]
