@@ -1897,7 +1897,7 @@ def _load_sharing(red, red0, sec: LoadSharingSection, law) -> AnalysisResult:
     from gearte.models.rv_stiffness_chain import left_out_elements
 
     left_out = left_out_elements(red)
-    values["stiffness_chain_left_out"] = ", ".join(left_out) or "none"
+    values["stiffness_chain_left_out"] = ", ".join(e.replace("_", " ") for e in left_out) or "none"
     data = {"load": ls}
     notes = [
         "Pin loads from the quasi-static equilibrium of all parts (springs + unilateral pin "
@@ -2078,7 +2078,9 @@ def _catalogue(red, sec: CatalogueSection, law, fs_terms=None, sources=None) -> 
     chain = stiffness_chain(red, theta=deg_to_rad(sec.position_deg), law=law)
     values["tangent_rigidity_at_rated [N*m/arcmin]"] = Nmm_per_rad_to_Nm_per_arcmin(chain.rigidity)
     values["compliance_shares"] = chain.shares
-    values["stiffness_chain_left_out"] = ", ".join(chain.left_out) or "none"
+    values["stiffness_chain_left_out"] = (
+        ", ".join(e.replace("_", " ") for e in chain.left_out) or "none"
+    )
     values["cam_bearing_load_at_rated [N]"] = chain.cam_bearing_load
     values["carrier_bearing_load_at_rated [N]"] = chain.carrier_bearing_load
     if sources is not None:
