@@ -30,7 +30,9 @@ Pin-contact geometry (derived, not taken from a paper's figure): for disc ``j`` 
 direction ``c_j`` the pitch point is ``P_j = a z_p c_j``; the contact normal of pin ``k`` passes
 through ``P_j`` and the pin centre, ``n = (p_k - P_j)/|p_k - P_j|`` with ``|p_k - P_j| = r_p S``,
 ``S = sqrt(1 + K1² - 2 K1 cos phi)`` — hence the lever ``l = r_c sin(phi)/S`` of Hu 2020 eq 36
-and the classical load law ``F ∝ sin(phi)/S`` for a rigid rotation of the disc.
+and the classical load law ``F ∝ sin(phi)/S`` for a rigid rotation of the disc. On a design
+with a shifted modification (Δr_p ≠ 0) the normal is turned to the true contact point of that
+profile (:func:`gearte.geometry.cycloid.true_contact`, docs/contact-law.md "Modified profiles").
 
 References
 ----------
