@@ -144,3 +144,22 @@ def test_rv_rows_keep_eq36_without_shift(hu2020_reducer):
         a=red.cranks.eccentricity, b=STAGE.b,
     ).normal_arm(phase)  # fmt: skip
     np.testing.assert_allclose(arms, arm_36, rtol=0.0, atol=1e-9)
+
+
+def test_peak_pin_force_angle_is_that_of_the_rows_normal(hu2020_reducer):
+    """The root-squeeze check reads the angle between the peak pin's force (the rows' normal,
+    turned to the true contact point) and the radial direction through the pin."""
+    from gearte.geometry.rv import pin_contacts
+    from gearte.models.rv_load_sharing import load_sharing, output_positions, peak_pin
+
+    red = hu2020_reducer
+    th = output_positions(12)
+    pk = peak_pin(red, load_sharing(red, red.rated_torque, th))
+    n = pin_contacts(red, th[pk.position : pk.position + 1]).normal[0, pk.disc - 1, pk.pin - 1]
+    al = 2.0 * np.pi * (pk.pin - 1) / red.pins.count
+    expected = np.arccos(abs(n[0] * np.cos(al) + n[1] * np.sin(al)))
+    assert pk.force_angle_from_radial == pytest.approx(expected, abs=1e-9)
+    k1 = red.cranks.eccentricity * red.pins.count / red.pins.circle_radius
+    s = np.sqrt(1 + k1 * k1 - 2 * k1 * np.cos(pk.phase))
+    eq36 = np.arcsin(k1 * abs(np.sin(pk.phase)) / s)
+    assert abs(pk.force_angle_from_radial - eq36) > 1e-4  # the turn is seen
