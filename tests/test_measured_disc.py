@@ -37,14 +37,24 @@ def test_tooth_numbering_follows_the_pin_through_the_mesh():
 
 def test_measured_profile_equal_to_equidistant_and_shift_reproduces_that_modification(design):
     """The design flank (no modification) with a measured deviation equal to minus the clearance
-    of Δr_rp = +8 µm, Δr_p = +4 µm gives that modification's pin loads and TE. Left: the flank
-    curvature of the contact law, which the modification changes by O(Δr_p / r_p) = 5e-5."""
+    of Δr_rp = +8 µm, Δr_p = +4 µm gives that modification's pin loads and TE.
+
+    Entered as the discs' modification *errors* (through the clearance, as a measured flank) it
+    is the same computation: equal to 1e-9. Entered as the *design's* modification it also turns
+    the contact normals to the true contact point of the shifted profile (the rows' arms,
+    docs/contact-law.md "Modified profiles") and changes the flank curvature by
+    O(Δr_p / r_p) = 5e-5, which a measured flank does not: peak pin load −0.20 %, a pin's force
+    within 1.2 % of the peak, TE within 0.03 %.
+    """
     zp, zc = design.pins.count, design.cycloid_teeth
     d_rp, d_p = 0.008, 0.004
     modified = design.replace(
         discs=dataclasses.replace(
             design.discs, equidistant_modification=d_rp, shift_modification=d_p
         )
+    )
+    as_error = design.with_errors(
+        design.error_set.with_disc_modification(np.tile([d_rp, d_p], (design.discs.count, 1)))
     )
     phi = np.linspace(-np.pi, np.pi, 2001)
     kw = dict(z_p=zp, r_p=design.pins.circle_radius, a=design.cranks.eccentricity)
@@ -55,11 +65,14 @@ def test_measured_profile_equal_to_equidistant_and_shift_reproduces_that_modific
     disc = MeasuredDisc(zc, tuple([phi] * zc), tuple([dev] * zc))
     measured = _with_measured(design, [disc, disc])
     th = output_positions(24)
-    a = load_sharing(modified, TORQUE, th)
     b = load_sharing(measured, TORQUE, th)
-    assert b.peak_pin_load == pytest.approx(a.peak_pin_load, rel=1e-3)
-    np.testing.assert_allclose(b.pin_force, a.pin_force, rtol=0, atol=2e-3 * a.peak_pin_load)
-    np.testing.assert_allclose(b.output_error, a.output_error, rtol=2e-3)
+    c = load_sharing(as_error, TORQUE, th)
+    np.testing.assert_allclose(b.pin_force, c.pin_force, rtol=0, atol=1e-9 * c.peak_pin_load)
+    np.testing.assert_allclose(b.output_error, c.output_error, rtol=1e-9)
+    a = load_sharing(modified, TORQUE, th)
+    assert b.peak_pin_load == pytest.approx(a.peak_pin_load, rel=3e-3)
+    np.testing.assert_allclose(b.pin_force, a.pin_force, rtol=0, atol=1.5e-2 * a.peak_pin_load)
+    np.testing.assert_allclose(b.output_error, a.output_error, rtol=1e-3)
     np.testing.assert_array_equal(b.pairs_in_mesh, a.pairs_in_mesh)
 
 

@@ -1,6 +1,8 @@
 """``assemble`` and ``pin_contacts`` vectorised over cranks, discs and directions: every array
 of the system bit-identical (values and bytes, so the sign of a zero too) to the loops they
-replaced, kept below verbatim as the reference (only the names of the copies changed)."""
+replaced, kept below verbatim as the reference (only the names of the copies changed; the
+reference's pin normals were later turned to the true contact point of a shifted profile, as
+the model's)."""
 
 from __future__ import annotations
 
@@ -66,7 +68,7 @@ def _pin_contacts_reference(reducer: RVReducer, theta: np.ndarray) -> PinContact
     Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481, eq 32, 36.
     doi:10.3390/app10020481
     """
-    from gearte.geometry.cycloid import normal_clearance_unclosed
+    from gearte.geometry.cycloid import normal_clearance_unclosed, true_contact
 
     th = np.atleast_1d(np.asarray(theta, dtype=float))
     P = th.size
@@ -84,9 +86,17 @@ def _pin_contacts_reference(reducer: RVReducer, theta: np.ndarray) -> PinContact
     cdir = np.stack([np.cos(ecc), np.sin(ecc)], -1)  # (P, N, 2)
     v = pin_pos[None, None] - (a * zp * cdir)[:, :, None, :]  # (P, N, zp, 2)
     n = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    phi = alpha_k[None, None, :] - ecc[:, :, None]
+    if reducer.discs.shift_modification != 0.0:
+        # added with the true contact point: the normal turned to it on the design's shifted
+        # profile (gearte.geometry.cycloid.true_contact), the same for every disc
+        turn = true_contact(
+            phi, z_p=zp, r_p=pins.circle_radius, a=a, dr_p=reducer.discs.shift_modification
+        )[2]
+        ct, st = np.cos(turn), np.sin(turn)
+        n = np.stack([ct * n[..., 0] - st * n[..., 1], st * n[..., 0] + ct * n[..., 1]], -1)
     lever = pin_pos[None, None] - pins.pin_radius * n - (a * cdir)[:, :, None, :]
     arm = lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0]
-    phi = alpha_k[None, None, :] - ecc[:, :, None]
     gap = np.empty((P, N, zp))
     c, s_ = np.cos(th), np.sin(th)
     for j in range(N):

@@ -79,3 +79,87 @@ def test_true_contact_is_phi_without_shift():
                                / np.sqrt(1 + (60 / 76) ** 2 - 2 * (60 / 76) * np.cos(phi)),
                                rtol=1e-12)  # fmt: skip
     np.testing.assert_allclose(turn, 0.0, atol=1e-15)
+
+
+@pytest.fixture(scope="module")
+def hu2020_reducer():
+    from gearte.io.case_file import load_case
+    from gearte.studies.rv_reducer import build_reducer
+
+    # Hu 2020 Table 3's modified stage as a whole reducer (Δr_rp = −0.022, Δr_p = −0.0437 mm)
+    return build_reducer(load_case("hu2020_rv80e_initial_reducer").reducer)
+
+
+def _row_arms(reducer, theta):
+    """(P, N, z_p) rotation column of the RV contact rows (the arm of each pin's normal)."""
+    from gearte.models.rv_load_sharing import assemble
+
+    s = assemble(reducer, theta)
+    N, zp = reducer.discs.count, reducer.pins.count
+    d = [s.layout.disc(j) + 2 for j in range(N)]
+    return np.stack([s.contact_B[:, j * zp : (j + 1) * zp, d[j]] for j in range(N)], 1), s
+
+
+def test_rv_rows_take_the_arm_at_the_true_contact_point(hu2020_reducer):
+    """On the Hu 2020 modified stage the RV rows' arm of every pin equals ``true_contact``'s
+    (the envelope-tested arm above) to 1e-9 mm, and differs from eq 36's near the root."""
+    red = hu2020_reducer
+    assert red.discs.shift_modification == pytest.approx(-0.0437)
+    theta = np.linspace(0.0, 2 * np.pi / 39, 5)
+    arms, s = _row_arms(red, theta)
+    phase = s.contact_phase.reshape(arms.shape)
+    kw = {"z_p": red.pins.count, "r_p": red.pins.circle_radius, "a": red.cranks.eccentricity}
+    _, arm_true, _ = true_contact(phase, dr_p=red.discs.shift_modification, **kw)
+    np.testing.assert_allclose(arms, arm_true, rtol=0.0, atol=1e-9)
+    _, arm_36, _ = true_contact(phase, dr_p=0.0, **kw)  # eq 36 (no shift)
+    assert np.max(np.abs(arms - arm_36)) > 1.0  # mm: the turn matters near the root
+
+
+def test_rv_rows_do_not_depend_on_a_discs_modification_error(hu2020_reducer):
+    """The rows (normals and arms) are the design's: a disc's modification error moves only
+    the clearances, so the batched yield can share the rows across its samples."""
+    red = hu2020_reducer
+    theta = np.linspace(0.0, 0.1, 3)
+    errs = np.zeros((red.discs.count, 2))
+    errs[0] = (0.004, -0.006)  # δΔr_rp, δΔr_p of disc 1 [mm]
+    off = red.with_errors(red.error_set.with_disc_modification(errs))
+    arms0, s0 = _row_arms(red, theta)
+    arms1, s1 = _row_arms(off, theta)
+    np.testing.assert_array_equal(s1.contact_B, s0.contact_B)
+    assert np.max(np.abs(s1.contact_gap - s0.contact_gap)) > 1e-3
+
+
+def test_rv_rows_keep_eq36_without_shift(hu2020_reducer):
+    """Without a shifted modification the rows' arm is eq 36's (the normal through the pitch
+    point), whatever the equidistant modification."""
+    import dataclasses
+
+    red = hu2020_reducer
+    red0 = red.replace(discs=dataclasses.replace(red.discs, shift_modification=0.0))
+    theta = np.linspace(0.0, 0.1, 3)
+    arms, s = _row_arms(red0, theta)
+    phase = s.contact_phase.reshape(arms.shape)
+    arm_36 = CycloidStage(
+        z_p=red.pins.count, r_p=red.pins.circle_radius, r_rp=red.pins.pin_radius,
+        a=red.cranks.eccentricity, b=STAGE.b,
+    ).normal_arm(phase)  # fmt: skip
+    np.testing.assert_allclose(arms, arm_36, rtol=0.0, atol=1e-9)
+
+
+def test_peak_pin_force_angle_is_that_of_the_rows_normal(hu2020_reducer):
+    """The root-squeeze check reads the angle between the peak pin's force (the rows' normal,
+    turned to the true contact point) and the radial direction through the pin."""
+    from gearte.geometry.rv import pin_contacts
+    from gearte.models.rv_load_sharing import load_sharing, output_positions, peak_pin
+
+    red = hu2020_reducer
+    th = output_positions(12)
+    pk = peak_pin(red, load_sharing(red, red.rated_torque, th))
+    n = pin_contacts(red, th[pk.position : pk.position + 1]).normal[0, pk.disc - 1, pk.pin - 1]
+    al = 2.0 * np.pi * (pk.pin - 1) / red.pins.count
+    expected = np.arccos(abs(n[0] * np.cos(al) + n[1] * np.sin(al)))
+    assert pk.force_angle_from_radial == pytest.approx(expected, abs=1e-9)
+    k1 = red.cranks.eccentricity * red.pins.count / red.pins.circle_radius
+    s = np.sqrt(1 + k1 * k1 - 2 * k1 * np.cos(pk.phase))
+    eq36 = np.arcsin(k1 * abs(np.sin(pk.phase)) / s)
+    assert abs(pk.force_angle_from_radial - eq36) > 1e-4  # the turn is seen

@@ -454,8 +454,9 @@ def true_contact(
     where the profile's normal passes through the pin's centre — at the profile parameter t,
     not at φ (on a modified profile they differ by 1–3° near the root). The equidistant
     modification Δr_rp moves the profile along its normal and does not change t. The RV load
-    sharing reads the curvature there (:meth:`CycloidStage.contact_curvature_radius`); its rows
-    keep the arm of eq 36 (docs/contact-law.md, "Modified profiles").
+    sharing reads the curvature there (:meth:`CycloidStage.contact_curvature_radius`), and its
+    rows take the normal and arm there for the design's Δr_p
+    (:func:`gearte.geometry.rv.pin_contacts`; docs/contact-law.md, "Modified profiles").
 
     Parameters
     ----------

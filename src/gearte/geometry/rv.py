@@ -752,7 +752,8 @@ class PinContacts:
     theta : numpy.ndarray
         Output (carrier) angles [rad], ``(P,)``.
     normal : numpy.ndarray
-        Unit contact normal ``n`` (from the pitch point towards the pin centre), ground frame.
+        Unit contact normal ``n`` (towards the pin centre: from the pitch point, or on a shifted
+        design profile from the true contact point), ground frame.
     lever : numpy.ndarray
         Contact point − disc centre [mm].
     arm : numpy.ndarray
@@ -811,7 +812,13 @@ def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
     Disc ``j``'s eccentric points along ``χ_j = −z_c θ + 2π j / N`` (module conventions); its
     pitch point is ``P_j = a z_p ê(χ_j)``; the normal of pin ``k`` (centre ``p_k`` at
     ``α_k = 2π k / z_p``) passes through ``P_j`` and ``p_k`` (Hu 2020 eq 36), the contact point
-    lies ``r_rp`` inside the pin centre on it. The clearance of the modified profile is Hu 2020
+    lies ``r_rp`` inside the pin centre on it. On a design with a shifted modification
+    (Δr_p ≠ 0) the normal is turned to where the real pin touches the design's ground profile
+    (:func:`gearte.geometry.cycloid.true_contact`: through the pin's centre, not the pitch
+    point; up to a few degrees near the root), and the arm is that normal's. Only the nominal
+    Δr_p turns it: the normals and arms are a property of the geometry, the same for every
+    sample of a yield; a disc's modification error, like a measured flank, enters the clearance
+    only. The clearance of the modified profile is Hu 2020
     eq 32 (:func:`gearte.geometry.cycloid.normal_clearance_unclosed`). Disc errors are in the
     disc frame, which turns with the carrier (angle ``θ``): the run-out ``r`` translates the
     profile (gap ``−n·r``); the cumulative pitch deviation ``s(ψ) = ΔF_p/2 sin(ψ − angle)`` at
@@ -823,7 +830,7 @@ def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
     Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481, eq 32, 36.
     doi:10.3390/app10020481
     """
-    from gearte.geometry.cycloid import normal_clearance_unclosed
+    from gearte.geometry.cycloid import normal_clearance_unclosed, true_contact
 
     th = np.atleast_1d(np.asarray(theta, dtype=float))
     P = th.size
@@ -846,10 +853,21 @@ def pin_contacts(reducer: RVReducer, theta: np.ndarray) -> PinContacts:
     nx, ny = vx / norm, vy / norm
     lx = pin_pos[:, 0] - pins.pin_radius * nx - a * cx
     ly = pin_pos[:, 1] - pins.pin_radius * ny - a * cy
+    phi = alpha_k[None, None, :] - ecc[:, :, None]
+    dr_p = float(reducer.discs.shift_modification)
+    if dr_p != 0.0:
+        # the design's shifted profile: the real pin touches it where the profile's normal
+        # passes through the pin's centre (gearte.geometry.cycloid.true_contact), not the pitch
+        # point. The nominal Δr_p only: the rows are a property of the geometry, the same for
+        # every sample of a yield; a disc's modification error enters through the gap below.
+        turn = true_contact(phi, z_p=zp, r_p=pins.circle_radius, a=a, dr_p=dr_p)[2]
+        ct, st = np.cos(turn), np.sin(turn)
+        nx, ny = ct * nx - st * ny, st * nx + ct * ny
+        lx = pin_pos[:, 0] - pins.pin_radius * nx - a * cx
+        ly = pin_pos[:, 1] - pins.pin_radius * ny - a * cy
     n = np.stack([nx, ny], -1)
     lever = np.stack([lx, ly], -1)
     arm = lx * ny - ly * nx
-    phi = alpha_k[None, None, :] - ecc[:, :, None]
     # each disc's modified profile (nominal modifications + that disc's modification errors)
     mods = np.stack(
         [

@@ -30,7 +30,9 @@ Pin-contact geometry (derived, not taken from a paper's figure): for disc ``j`` 
 direction ``c_j`` the pitch point is ``P_j = a z_p c_j``; the contact normal of pin ``k`` passes
 through ``P_j`` and the pin centre, ``n = (p_k - P_j)/|p_k - P_j|`` with ``|p_k - P_j| = r_p S``,
 ``S = sqrt(1 + K1² - 2 K1 cos phi)`` — hence the lever ``l = r_c sin(phi)/S`` of Hu 2020 eq 36
-and the classical load law ``F ∝ sin(phi)/S`` for a rigid rotation of the disc.
+and the classical load law ``F ∝ sin(phi)/S`` for a rigid rotation of the disc. On a design
+with a shifted modification (Δr_p ≠ 0) the normal is turned to the true contact point of that
+profile (:func:`gearte.geometry.cycloid.true_contact`, docs/contact-law.md "Modified profiles").
 
 References
 ----------
@@ -49,7 +51,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gearte.errors import ConvergenceError, ParameterError
-from gearte.geometry.cycloid import CycloidStage
+from gearte.geometry.cycloid import CycloidStage, true_contact
 from gearte.geometry.rv import RVReducer, pin_contacts
 from gearte.limits import check_floor
 from gearte.models.contact_law import (
@@ -1065,7 +1067,8 @@ class PeakPin:
         Its angle from the line of centres (the disc's eccentric direction), in (−π, π] [rad].
     force_angle_from_radial : float
         Angle between its force (the contact normal, through the pitch point) and the radial
-        direction through the pin [rad]; ``sin`` of it is ``K1 |sin φ| / S``.
+        direction through the pin [rad]; ``sin`` of it is ``K1 |sin φ| / S`` (on a shifted
+        design profile the normal is turned to the true contact point, see :func:`peak_pin`).
     """
 
     position: int
@@ -1098,7 +1101,9 @@ def peak_pin(reducer: RVReducer, load: LoadSharing) -> PeakPin:
     The contact normal of pin ``k`` passes through the pitch point ``K1 r_p`` on the line of
     centres (Hu 2020 eq 36), so its angle α from the radial direction through the pin has
     ``sin α = K1 |sin φ| / S``, ``S = (1 + K1² − 2 K1 cos φ)^½``: 0 on the line of centres (a
-    pure radial squeeze), 1 where ``cos φ = K1`` (the largest arm).
+    pure radial squeeze), 1 where ``cos φ = K1`` (the largest arm). On a design with a shifted
+    modification the normal is the rows' (turned to the true contact point,
+    :func:`gearte.geometry.cycloid.true_contact`) and α is its angle from the radial direction.
 
     Parameters
     ----------
@@ -1122,6 +1127,23 @@ def peak_pin(reducer: RVReducer, load: LoadSharing) -> PeakPin:
     K1 = cycloid_stage(reducer).K1
     S = math.sqrt(1.0 + K1 * K1 - 2.0 * K1 * math.cos(phi))
     alpha = math.asin(min(1.0, K1 * abs(math.sin(phi)) / S))
+    dr_p = float(reducer.discs.shift_modification)
+    if dr_p != 0.0:  # the rows' normal, turned to the true contact point (pin_contacts)
+        turn = float(
+            true_contact(
+                phi, z_p=reducer.pins.count, r_p=reducer.pins.circle_radius,
+                a=reducer.cranks.eccentricity, dr_p=dr_p,
+            )[2]
+        )  # fmt: skip
+        # the rows' eq-36 normal (pitch point a z_p -> pin centre on r_p) in the frame of the
+        # line of centres, turned
+        k1 = reducer.cranks.eccentricity * reducer.pins.count / reducer.pins.circle_radius
+        ux, uy = math.cos(phi) - k1, math.sin(phi)
+        norm = math.hypot(ux, uy)
+        ux, uy = ux / norm, uy / norm
+        vx = math.cos(turn) * ux - math.sin(turn) * uy
+        vy = math.sin(turn) * ux + math.cos(turn) * uy
+        alpha = math.acos(max(-1.0, min(1.0, vx * math.cos(phi) + vy * math.sin(phi))))
     return PeakPin(int(p), float(load.theta[p]), int(j) + 1, int(k) + 1,
                    float(load.pin_force[p, j, k]), phi, alpha)  # fmt: skip
 

@@ -160,7 +160,9 @@ def plan(model, keys: Sequence[str]) -> RVBatchPlan:
     stage = cycloid_stage(base)
     ph = contact_phase(sys0)
     P = model.theta.size
-    rho = stage.curvature_radius(ph[1:]).reshape(P, ndisc, base.pins.count)
+    # each pin's flank curvature where it really touches the design's profile, as the per-case
+    # read-out (CycloidStage.contact_curvature_radius)
+    rho = stage.contact_curvature_radius(ph[1:]).reshape(P, ndisc, base.pins.count)
     # steps: virtual loop (4 cold sequences at theta = 0), loaded TE, unloaded TE
     tr = float(model.reducer.rated_torque)
     levels = np.array([1.0, 0.5, model.lost_motion_fraction, ZERO_TORQUE_FRACTION])
