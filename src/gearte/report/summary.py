@@ -261,15 +261,23 @@ def analysis_headlines(a: Any) -> list[HeadlineRow]:
             _, af = vals[f"{base}_after"]
             add(label(base), f"{_text(b, unit)} → {_text(af, unit)}")
     if len(picked) < MAX_HEADLINES:
-        for base, (unit, v) in vals.items():
+        # a ranking: a yield's total Sobol indices first (they hold where a linear share is 0:
+        # a peak-to-peak of errors that act through their magnitude), then any share; none
+        # named when its largest entry is 0 (nothing dominates)
+        ranked = sorted(vals, key=lambda b: b != "sobol_total")
+        for base in ranked:
+            unit, v = vals[base]
             if (
-                "share" in base
+                (base == "sobol_total" or "share" in base)
                 and isinstance(v, dict)
                 and v
                 and all(_finite(x) for x in v.values())
             ):
                 item, share = max(v.items(), key=lambda kv: kv[1])
-                add(f"Largest {label(base).lower()}", f"{item_label(item)} ({_text(share, unit)})")
+                if not share > 0:
+                    continue
+                what = "total Sobol index" if base == "sobol_total" else label(base).lower()
+                add(f"Largest {what}", f"{item_label(item)} ({_text(share, unit)})")
                 break
     if not picked:
         for base, (unit, v) in vals.items():
