@@ -321,6 +321,19 @@ def _coercions(given: Any, kept: Any, path: str = "") -> list[str]:
     return out
 
 
+def _one_problem_a_line(msg: str, path: str | None = None) -> bool:
+    """A reader's message is one line, or ``N problems:`` and then one line per problem, each
+    naming its file (``path`` where given; a file name otherwise): what ``gearte validate``
+    prints for a series of bench files (every problem of every file)."""
+    lines = msg.splitlines()
+    if len(lines) == 1:
+        return path is None or path in msg
+    if not re.fullmatch(r"\d+ problems:", lines[0]):
+        return False
+    name = re.compile(r"\S+\.(csv|txt|tsv|dat|toml)\b")
+    return all((path in line) if path else bool(name.search(line)) for line in lines[1:])
+
+
 def check_text(text: str, tmp: Path) -> Outcome:
     """Validate one case file text as ``gearte validate`` would and classify the outcome."""
     from gearte.errors import CaseFileError
@@ -352,7 +365,7 @@ def check_text(text: str, tmp: Path) -> Outcome:
             return Outcome("bad_message", repr(str(exc)))
         return Outcome("rejected", exc.field)
     except BenchFileError as exc:  # rv_bench's pre-flight reads its bench files
-        if "\n" in str(exc) or not exc.file.strip():
+        if not _one_problem_a_line(str(exc)) or not exc.file.strip():
             return Outcome("bad_message", repr(str(exc)))
         return Outcome("rejected", exc.file)
     except CaseFileError as exc:  # a case file the pre-flight loads (a chain's drive case)
@@ -957,14 +970,7 @@ def check_measurement(reader: str, text: str, tmp: Path, design: bool = False) -
             check_measured_against_design(_lot_design(), str(path), **{key: got})
     except (BenchFileError, MeasurementFileError) as exc:
         msg = str(exc)
-        lines = msg.splitlines()
-        if len(lines) > 1:  # every problem of the file, one line each (BenchFileErrors)
-            ok = re.fullmatch(r"\d+ problems:", lines[0]) and all(
-                str(path) in line for line in lines[1:]
-            )
-        else:
-            ok = str(path) in msg
-        if not ok:
+        if not _one_problem_a_line(msg, str(path)):  # every problem of the file, one line each
             return Outcome("bad_message", msg[:300])
         return Outcome("rejected", msg[:120])
     except Exception as exc:  # noqa: BLE001 - what the harness looks for
