@@ -1012,48 +1012,19 @@ def calibrated_case_text(rcase, cal, case, closed=None, record=None) -> str:
     """The serial as an ``rv_reducer`` case: the drive's case with the clearances and the
     stiffness scale that reproduce the bench (``closed``, :func:`_close_loop`) as values of
     ``[reducer]``, and every estimate of the calibration as values of ``[bench_calibration]``."""
-    from gearte.studies.rv_reducer import build_reducer
+    from gearte.runners.bench_calibration import serial_reducer
+    from gearte.studies.rv_reducer import build_reducer, reducer_section, with_case_keys
 
     data = rcase.model_dump(mode="json", exclude_none=True)
-    red = data["reducer"]
     if closed is not None:
-        sc = closed.stiffness_scale
-        # the design's stiffnesses as built (bearings linearised where the case says so), scaled
-        # and written as values: every element gearte.runners.bench_calibration.serial_reducer
-        # scales; those derived from dimensions through the Young's modulus (crank and pin
-        # bending, crank torsion) follow the scaled modulus
-        design = build_reducer(rcase.reducer)
-        palmgren = ("rollers", "roller_length_mm", "reference_load_N", "contact_angle_deg",
-                    "rows", "at_rated_torque")  # fmt: skip
-        built = {"cam_bearing": design.cranks.cam_bearing_stiffness,
-                 "carrier_bearing": design.cranks.carrier_bearing_stiffness}  # fmt: skip
-        for key, c in zip(("cam_bearing", "carrier_bearing"), closed.clearances, strict=True):
-            b = red["cranks"][key]
-            for k in palmgren:
-                b.pop(k, None)
-            b["stiffness_N_per_mm"] = float(sc * built[key])
-            b["radial_clearance_um"] = float(mm_to_um(c))
-        sup = red["supports"]
-        sup.pop("main_bearing", None)
-        sup["carrier_radial_stiffness_N_per_mm"] = float(
-            sc * design.supports.carrier_radial_stiffness
+        # the serial as the whole model runs it (the design built, every stiffness of its load
+        # path scaled, the clearances set), written back by the reducer's one inverse of
+        # build_reducer: derived stiffnesses (Palmgren bearings, the stiffness chain, the ISO
+        # 6336 mesh) become given values; the keys the object does not hold stay the case's
+        serial = serial_reducer(
+            build_reducer(rcase.reducer), closed.stiffness_scale, closed.clearances
         )
-        for sect, key in (
-            (sup, "output_flange_torsional_stiffness_Nm_per_rad"),
-            (red["cranks"], "bending_stiffness_N_per_mm"),
-            (red["cranks"], "torsional_stiffness_Nm_per_rad"),
-            (red["pins"], "bending_stiffness_N_per_mm"),
-            (red["pins"], "seat_stiffness_N_per_mm"),
-        ):
-            if key in sect:
-                sect[key] = float(sc * sect[key])
-        if "seat_length_mm" in red["pins"] and design.pins.seat_compliance is not None:
-            del red["pins"]["seat_length_mm"]  # derived at the design's rated torque
-            red["pins"]["seat_stiffness_N_per_mm"] = float(sc / design.pins.seat_compliance)
-        red["discs"]["youngs_modulus_MPa"] *= sc
-        fs = red["first_stage"]
-        design_mesh = closed_design_mesh(rcase)
-        fs["mesh_stiffness_N_per_mm"] = float(sc * design_mesh)
+        data["reducer"] = with_case_keys(reducer_section(serial), data["reducer"])
     if record is not None:
         data["bench_calibration"] = {
             k: v for k, v in record.items() if k != "round_trip_source" and v is not None
@@ -1066,10 +1037,3 @@ def calibrated_case_text(rcase, cal, case, closed=None, record=None) -> str:
         "# bench's rigidity and backlash; [bench_calibration] every estimate with its interval.",
     ]
     return "\n".join([*head, "", *_toml(data)]) + "\n"
-
-
-def closed_design_mesh(rcase) -> float:
-    """The design's involute mesh stiffness [N/mm] (given, or derived from the face width)."""
-    from gearte.studies.rv_reducer import build_reducer
-
-    return float(build_reducer(rcase.reducer).first_stage.mesh_stiffness)
