@@ -163,3 +163,36 @@ def test_peak_pin_force_angle_is_that_of_the_rows_normal(hu2020_reducer):
     s = np.sqrt(1 + k1 * k1 - 2 * k1 * np.cos(pk.phase))
     eq36 = np.arcsin(k1 * abs(np.sin(pk.phase)) / s)
     assert abs(pk.force_angle_from_radial - eq36) > 1e-4  # the turn is seen
+
+
+def test_true_contact_normal_passes_through_the_pin_centre():
+    """The Newton root (exact derivative): the ground profile's normal at t goes through the real
+    pin's centre, to float precision, over a whole tooth pitch and both signs of Δr_p."""
+    from gearte.geometry.cycloid import _centre_path
+
+    phi = np.linspace(-np.pi, np.pi, 721)
+    for dr_p in (-0.0437, 0.03):
+        t, _, _ = true_contact(phi, z_p=40, r_p=76.0, a=1.5, dr_p=dr_p)
+        cx, cy, _, _ = _centre_path(phi, 76.0, 1.5, 40)
+        x, y, nx, ny = _centre_path(t, 76.0 + dr_p, 1.5, 40)
+        assert np.max(np.abs((cx - x) * ny - (cy - y) * nx)) < 1e-11  # [mm]
+        assert np.max(np.abs(t - phi)) > 1e-3  # the contact did move
+
+
+def test_true_contact_remembered_answers_are_fresh_arrays_of_the_callers_shape():
+    """Repeated phases are answered from memory: the same values, in the caller's shape, and
+    arrays the caller may change without changing the next answer."""
+    phi = np.linspace(0.1, 0.9, 12).reshape(3, 4)
+    kw = {"z_p": 40, "r_p": 76.0, "a": 1.5, "dr_p": -0.0437}
+    first = true_contact(phi, **kw)
+    assert all(v.shape == (3, 4) for v in first)
+    expect = [v.copy() for v in first]
+    for v in first:
+        v[...] = np.nan  # the caller scribbles on its copy
+    again = true_contact(phi.ravel(), **kw)  # same phases, another shape
+    for v, e in zip(again, expect, strict=True):
+        assert v.shape == (12,)
+        np.testing.assert_array_equal(v, e.ravel())
+    big = np.linspace(-3.0, 3.0, (1 << 16) + 1)  # above the size that is remembered
+    t_big = true_contact(big, **kw)[0]
+    np.testing.assert_array_equal(t_big[:1], true_contact(big[:1], **kw)[0])

@@ -25,6 +25,7 @@ Hu Y., Li G., Zhu W., Cui J. (2020). Applied Sciences 10(2), 481. doi:10.3390/ap
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -488,8 +489,8 @@ def true_contact(
     Notes
     -----
     With the pin-centre paths ``C(t; R)`` and their unit normals ``n(t; R)`` (eq 1–2 with the
-    pin radius set to 0), t solves ``(C(φ; r_p) − C(t; R)) × n(t; R) = 0`` (Newton from t = φ,
-    derivative by central differences); ``arm = C(φ; r_p) × n(t; R)``. The disc's closing
+    pin radius set to 0), t solves ``(C(φ; r_p) − C(t; R)) × n(t; R) = 0`` (Newton from t = φ with
+    the exact derivative); ``arm = C(φ; r_p) × n(t; R)``. The disc's closing
     rotation (a few 1e-4 rad) is neglected, as in eq 32.
 
     Examples
@@ -505,20 +506,51 @@ def true_contact(
     generating centre). doi:10.1017/CBO9780511547126
     """
     phi_in = np.asarray(phi, dtype=float)
+    solve = _true_contact_flat if phi_in.size <= _REMEMBER_UP_TO else _true_contact_flat.__wrapped__
+    out = solve(
+        np.ascontiguousarray(phi_in).tobytes(), int(z_p), float(r_p), float(a), float(dr_p), tol
+    )
+    return tuple(v.reshape(phi_in.shape).copy() for v in out)  # type: ignore[return-value]
+
+
+#: Phase arrays up to this size [-] are remembered by :func:`true_contact` (64 of them).
+_REMEMBER_UP_TO = 1 << 16
+
+
+@functools.lru_cache(maxsize=64)
+def _true_contact_flat(
+    phi_bytes: bytes, z_p: int, r_p: float, a: float, dr_p: float, tol: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`true_contact` of the phases ``phi_bytes`` (float64, flat), remembered: an RV
+    analysis asks for the same phases of the same design several times (the rows and the
+    contact law of each equilibrium; the candidates of a compensation), and each answer is a
+    Newton iteration over every pin and position."""
+    phi_in = np.frombuffer(phi_bytes, dtype=float)
     # the profile repeats from tooth to tooth: solve within the tooth, φ in (−π, π]
     phi = np.angle(np.exp(1j * phi_in))
     R = r_p + dr_p
     cx, cy, mx, my = _centre_path(phi, r_p, a, z_p)
 
-    def g(t: np.ndarray) -> np.ndarray:
-        x, y, nx, ny = _centre_path(t, R, a, z_p)
-        return (cx - x) * ny - (cy - y) * nx
+    i_h = z_p / (z_p - 1.0)
+    K1 = a * z_p / R
+
+    def newton_step(t: np.ndarray) -> np.ndarray:
+        # g(t) = (C(φ) − C(t)) × N(t) with the unnormalised normal N = S n (same root as with
+        # n) and its exact derivative g' = −C'(t) × N(t) + (C(φ) − C(t)) × N'(t)
+        A, B = (1.0 - i_h) * t, i_h * t
+        cA, sA, cB, sB = np.cos(A), np.sin(A), np.cos(B), np.sin(B)
+        dx, dy = cx - (R * cA - a * cB), cy - (R * sA + a * sB)
+        nx_, ny_ = cA - K1 * cB, sA + K1 * sB
+        xt, yt = -R * (1.0 - i_h) * sA + a * i_h * sB, R * (1.0 - i_h) * cA + a * i_h * cB
+        nxt, nyt = -(1.0 - i_h) * sA + K1 * i_h * sB, (1.0 - i_h) * cA + K1 * i_h * cB
+        g = dx * ny_ - dy * nx_
+        dg = -xt * ny_ + yt * nx_ + dx * nyt - dy * nxt
+        return g / dg
 
     t = phi.copy()
     if dr_p != 0.0:
-        h = 1e-6
         for _ in range(50):
-            step = g(t) / ((g(t + h) - g(t - h)) / (2.0 * h))
+            step = newton_step(t)
             t = t - step
             if np.all(np.abs(step) <= tol):
                 break

@@ -101,7 +101,16 @@ def _dte_figures(a) -> list[Figure]:
             textcoords="offset points",
             fontsize=7,
             color=PALETTE[1],
-            arrowprops={"arrowstyle": "-", "color": PALETTE[1], "lw": 0.5},
+            # a straight leader from the peak to the label's corner: not clipped to the text's
+            # box nor shrunk (each is a Bézier split: ~40 ms of this figure)
+            arrowprops={
+                "arrowstyle": "-",
+                "color": PALETTE[1],
+                "lw": 0.5,
+                "patchA": None,
+                "shrinkA": 0.0,
+                "shrinkB": 0.0,
+            },
         )
         ax.plot([f], [amp], "o", ms=3, color=PALETTE[1])
     ax.set_xlim(0, max(2.5 * max(a.data["sources"]["cycloid mesh"], 1.0), 10.0))

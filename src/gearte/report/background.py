@@ -3,8 +3,8 @@ as soon as that analysis is done.
 
 Most of a warm ``gearte run`` of a fast case is not the analyses: importing matplotlib (~0.5 s),
 building the figures and drawing them. :class:`ReportWorker` forks, at the command's start
-(before the case is loaded), a process that imports the plotting stack, draws one throw-away
-figure (fonts, text layout caches) and imports the case's study kind and its plotting module
+(before the case is loaded), a process that imports the plotting stack, loads the font
+and imports the case's study kind and its plotting module
 while the parent loads the case, imports numba, loads its kernels and runs the analyses on the
 other core. Once the case is loaded the parent sends it, with the names of the gearte modules it
 imported (the worker imports them too: unpickling an analysis needs them, and some import
@@ -37,35 +37,33 @@ __all__ = ["ReportWorker", "warm_up_plotting"]
 
 
 def warm_up_plotting(case: Any = None) -> Any:
-    """Import what building, rendering and the HTML page need, and draw one small figure with
-    text to PNG (loads the font and fills matplotlib's text caches); with ``case`` (what
-    :func:`gearte.io.case_file.load_case` takes), first import its study kind and plotting
+    """Import what building, rendering and the HTML page need and load the font; with ``case``
+    (what :func:`gearte.io.case_file.load_case` takes), first import its study kind and plotting
     module (what unpickling its result and drawing its figures need; the case is not validated
     here). A case whose kind cannot be read is ignored here (unpickling imports what it needs).
     No figure needs matplotlib's mathtext parser (log axes get plain-text tick labels,
     :func:`gearte.plotting.display.polish`), so the warm-up does not build it. Returns the
     case's plotting module (``None`` without a case or where it cannot be read)."""
     import jinja2  # noqa: F401
+    import matplotlib.figure  # noqa: F401 - what the first figure would import
+    import matplotlib.layout_engine  # noqa: F401
+    from matplotlib import font_manager
     from matplotlib.backends import backend_agg  # noqa: F401
+    from PIL import Image
 
     import gearte.plotting.display  # noqa: F401
     import gearte.report.html  # noqa: F401
     import gearte.report.summary  # noqa: F401
     import gearte.report.tables  # noqa: F401
-    from gearte.plotting import new_figure
-    from gearte.report.html import figure_to_png_base64, report_template
+    from gearte.report.html import report_template
 
     report_template()  # compiled now, not after the result
-
-    module = _plotting_module(case) if case is not None else None
-    fig, ax = new_figure(figsize=(2.0, 1.5))
-    ax.plot([1.0, 2.0], [1.0, 100.0], label="x")
-    ax.set_xlabel("0123456789 [mm]")
-    ax.set_ylabel("−.,e+ [arcmin]")
-    ax.set_title("Warm-up")
-    ax.legend()
-    figure_to_png_base64(fig, dpi=50)  # the report's own path: layout, drawing, PNG
-    return module
+    Image.preinit()  # Pillow's image plugins, imported by the first save
+    # the font every figure uses, read and cached (font_manager.get_font): a throw-away figure
+    # drawn here (as before) would fill nothing else that a real figure reuses: matplotlib's
+    # text-size cache is kept per renderer, and every figure has its own
+    font_manager.get_font(font_manager.findfont(font_manager.FontProperties()))
+    return _plotting_module(case) if case is not None else None
 
 
 def _plotting_module(case: Any) -> Any:
