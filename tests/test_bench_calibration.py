@@ -170,17 +170,19 @@ def test_calibration_coverage_and_diagnosis_rate_over_50_seeds():
 
 def test_analytic_hysteresis_jacobian_matches_central_differences():
     from gearte.models.bench_reduced import (
-        HYSTERESIS_PARAMETERS,
         hysteresis_angle,
         hysteresis_jacobian,
+        hysteresis_parameters,
     )
 
     rng = np.random.default_rng(0)
     p = _truth(rng)
+    p.update(elastic_shape_1=2e-5, elastic_shape_2=-1e-5)  # [rad], the shape terms bent
     t = np.linspace(-784e3, 784e3, 101) + 123.0  # off the exact zero of u
     s = np.where(np.arange(t.size) % 2, 1, -1)
     jac = hysteresis_jacobian(MODEL, p, t, s)
-    for name in HYSTERESIS_PARAMETERS:
+    assert set(jac) == set(hysteresis_parameters(MODEL))
+    for name in hysteresis_parameters(MODEL):
         h = 1e-6 * max(abs(p[name]), 1e-9)
         hi, lo = dict(p), dict(p)
         hi[name] += h
@@ -189,3 +191,35 @@ def test_analytic_hysteresis_jacobian_matches_central_differences():
         np.testing.assert_allclose(
             jac[name], fd, rtol=1e-5, atol=1e-6 * np.abs(fd).max(), err_msg=name
         )
+
+
+def test_shape_terms_bend_the_elastic_law_without_changing_its_catalogue_rigidity():
+    """ψ_q(1) = ψ_q(1/2) in closed form, ψ_q odd, its slope the derivative of its value; so the
+    reducer's curve keeps the catalogue rigidity f K_nom (the play saturated at T_r/2) whatever
+    the shape amplitudes, while its shape between the catalogue points changes."""
+    from gearte.models.bench_reduced import SHAPE_EXPONENTS, hysteresis_angle, shape_basis
+
+    x = np.linspace(-1.0, 1.0, 401) + 1e-3
+    for q in (0.6, 1.5, 2.0):
+        v1, _ = shape_basis(np.array([1.0, 0.5]), q)
+        assert v1[0] == pytest.approx(v1[1], abs=1e-15)
+        v, s = shape_basis(x, q)
+        np.testing.assert_allclose(shape_basis(-x, q)[0], -v, atol=1e-15)
+        h = 1e-7
+        fd = (shape_basis(x + h, q)[0] - shape_basis(x - h, q)[0]) / (2 * h)
+        np.testing.assert_allclose(s, fd, rtol=1e-5)
+    assert MODEL.shape_exponents == SHAPE_EXPONENTS
+    p = _truth(np.random.default_rng(1))
+    p.update(friction_torque=0.0)
+    model = ReducedRV(784e3, 1.455e9, (0.035, 0.02))
+    t = 784e3 * np.array([0.5, 1.0, -0.5, -1.0, 0.3, 0.8])
+    d = np.ones(t.size)
+    thetas = []
+    for a in (0.0, 3e-5, -4e-5):
+        p.update(elastic_shape_1=a, elastic_shape_2=-0.5 * a)
+        th = hysteresis_angle(model, p, t, d) - p["rig_compliance"] * t  # the reducer alone
+        for hi, half in ((1, 0), (3, 2)):  # (T_r/2)/(θ(T_r) − θ(T_r/2)), both signs
+            k = (t[hi] - t[half]) / (th[hi] - th[half])
+            assert k == pytest.approx(p["contact_stiffness_factor"] * 1.455e9, rel=1e-12)
+        thetas.append(th)
+    assert abs(thetas[1][4] - thetas[0][4]) > 1e-6  # the shape between did change [rad]

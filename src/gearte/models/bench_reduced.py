@@ -52,7 +52,10 @@ from numpy.typing import ArrayLike
 
 __all__ = [
     "STIFFNESS_EXPONENT",
+    "SHAPE_EXPONENTS",
     "ReducedRV",
+    "shape_basis",
+    "hysteresis_parameters",
     "play",
     "HYSTERESIS_PARAMETERS",
     "hysteresis_angle",
@@ -77,6 +80,9 @@ HYSTERESIS_PARAMETERS = (
     "angle_offset",  # θ0 [rad]
 )
 TE_COMMON = ("te_offset", "running_windup")  # o [rad], w [rad]
+
+SHAPE_EXPONENTS: tuple[float, ...] = (0.6, 1.5)
+"""Exponents ``q_k`` of the elastic law's shape terms ``ψ_q`` (:func:`shape_basis`)."""
 
 
 @dataclass(frozen=True)
@@ -105,6 +111,11 @@ class ReducedRV:
     families: dict[str, int] = field(default_factory=dict)
     design_backlash: float = 0.0
     design_clearances: tuple[float, float] = (0.0, 0.0)
+    shape_exponents: tuple[float, ...] = SHAPE_EXPONENTS
+
+    def shape_parameters(self) -> tuple[str, ...]:
+        """Names of the shape terms' amplitudes ``a_k`` [rad], one per exponent."""
+        return tuple(f"elastic_shape_{k + 1}" for k in range(len(self.shape_exponents)))
 
     def family_parameters(self) -> tuple[str, ...]:
         names: list[str] = []
@@ -127,7 +138,43 @@ def parameter_names(model: ReducedRV) -> tuple[str, ...]:
     tuple of str
         The names, in the order of the fit's parameter vector.
     """
-    return (*HYSTERESIS_PARAMETERS, *TE_COMMON, *model.family_parameters())
+    return (*hysteresis_parameters(model), *TE_COMMON, *model.family_parameters())
+
+
+def hysteresis_parameters(model: ReducedRV) -> tuple[str, ...]:
+    """The parameters of the hysteresis curve: :data:`HYSTERESIS_PARAMETERS` and the shape
+    terms' amplitudes of ``model`` (:meth:`ReducedRV.shape_parameters`)."""
+    return (*HYSTERESIS_PARAMETERS, *model.shape_parameters())
+
+
+def shape_basis(x: ArrayLike, q: float) -> tuple[np.ndarray, np.ndarray]:
+    """Shape term ``ψ_q(x) = sgn(x) (|x|^q − κ_q |x|^p)`` [-] and its slope ``dψ_q/dx`` [-].
+
+    ``κ_q = (1 − 0.5^q)/(1 − 0.5^p)`` makes ``ψ_q(1) = ψ_q(1/2)``: a shape term bends the elastic
+    law without changing its catalogue rigidity, so ``f K_nom`` stays the rigidity of the
+    elastic part whatever the shape amplitudes. Odd in ``x``, zero at 0. The slope at ``x = 0``
+    is evaluated at ``|x| = 1e-12``.
+
+    Parameters
+    ----------
+    x : array_like
+        ``u / T_r`` [-].
+    q : float
+        Exponent [-] (> 0).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        ``ψ_q(x)`` and ``ψ_q'(x)`` [-].
+    """
+    p = STIFFNESS_EXPONENT
+    xa = np.asarray(x, dtype=float)
+    ax = np.abs(xa)
+    kappa = (1.0 - 0.5**q) / (1.0 - 0.5**p)
+    value = np.sign(xa) * (ax**q - kappa * ax**p)
+    axc = np.maximum(ax, 1e-12)
+    slope = q * axc ** (q - 1.0) - kappa * p * axc ** (p - 1.0)
+    return value, slope
 
 
 def play(model: ReducedRV, p: dict) -> Any:
@@ -197,6 +244,8 @@ def hysteresis_angle(
     """
     t, _, u, x, e = _loading_branch(model, params, torque, direction)
     elastic = e * np.sign(x) * np.abs(x) ** STIFFNESS_EXPONENT
+    for name, q in zip(model.shape_parameters(), model.shape_exponents, strict=True):
+        elastic = elastic + params[name] * shape_basis(x, q)[0]
     play = 0.5 * _play(params, model) * np.tanh(u / params["play_transition_torque"])
     return params["angle_offset"] + play + elastic + params["rig_compliance"] * t
 
@@ -238,7 +287,13 @@ def hysteresis_jacobian(
     sech2 = 1.0 - th**2
     beta = _play(params, model)
     d_du = 0.5 * beta * sech2 / tb + e * p * ax ** (p - 1.0) / tr
+    shape = {}
+    for name, q in zip(model.shape_parameters(), model.shape_exponents, strict=True):
+        value, slope = shape_basis(x, q)
+        shape[name] = value
+        d_du = d_du + params[name] * slope / tr
     return {
+        **shape,
         "cam_bearing_clearance": 0.5 * g_cam * th,
         "carrier_bearing_clearance": 0.5 * g_car * th,
         "play_transition_torque": -0.5 * beta * sech2 * u / tb**2,

@@ -18,11 +18,11 @@ import numpy as np
 from gearte.errors import ParameterError
 from gearte.models.bench_data import HysteresisCurve, TETrace
 from gearte.models.bench_reduced import (
-    HYSTERESIS_PARAMETERS,
     TE_COMMON,
     ReducedRV,
     hysteresis_angle,
     hysteresis_jacobian,
+    hysteresis_parameters,
     parameter_names,
     play,
     te_basis,
@@ -55,6 +55,13 @@ CONFOUNDED_PAIRS = (("contact_stiffness_factor", "rig_compliance"),)
 compliance are both a compliance on the measured torque, told apart only by the curvature of the
 reduced elastic law (on whole-model data their split was off by factors 0.001–8 in 20 seeds)."""
 
+SHAPE_NOTE = (
+    "shape term of the elastic law: absorbs what the reduced law lacks so that the other "
+    "parameters' intervals hold; describes the curve, not a property of the serial"
+)
+"""Flag of every shape amplitude (:meth:`gearte.models.bench_reduced.ReducedRV.shape_parameters`):
+a nuisance parameter, never reported as identified."""
+
 Z95 = 1.959963984540054
 """Two-sided 95 % normal quantile: confidence interval = ± Z95 × standard error."""
 
@@ -85,6 +92,8 @@ def parameter_specs(model: ReducedRV) -> dict[str, ParameterSpec]:
     }
     for name in model.family_parameters():
         specs[name] = ParameterSpec("rad", 1e-5, -0.005, 0.005)
+    for name in model.shape_parameters():
+        specs[name] = ParameterSpec("rad", 0.1 * tr / k, -2.0 * tr / k, 2.0 * tr / k)
     return specs
 
 
@@ -298,7 +307,7 @@ def calibrate(
         )
     available = []
     if hysteresis is not None:
-        available += list(HYSTERESIS_PARAMETERS)
+        available += list(hysteresis_parameters(model))
     if te_rows:
         available += [*TE_COMMON, *model.family_parameters()]
         for c in ("cam_bearing_clearance", "carrier_bearing_clearance"):
@@ -463,6 +472,9 @@ def calibrate(
             )
         elif min(xi - lo[i], hi[i] - xi) < 1e-6 * (hi[i] - lo[i]):
             flags[nm] = "at a bound: interval not valid (the data push it past its range)"
+    for nm in model.shape_parameters():  # nuisance: what the reduced law lacks, no property
+        if nm in fit and nm not in flags:
+            flags[nm] = SHAPE_NOTE
     d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
     corr = cov / np.outer(d, d)
     # two identified parameters the data see almost only together: their split rests on the
