@@ -10,9 +10,10 @@ Hysteresis (input locked, output torque ``T`` [N·mm], branch ``s = +1`` for ris
 ``−1`` for falling)::
 
     θ(T, s) = θ0 + F(T − s T_fr) + C_rig T
-    F(u)    = (β/2) tanh(u / T_β) + (T_r / (f K_nom)) c_p sgn(u) |u/T_r|^p
+    F(u)    = (β/2) tanh(u / T_β) + (T_r / (f K_nom)) c_p sgn(u) |u/T_r|^p + Σ_k a_k ψ_{q_k}(u/T_r)
     β       = B0 + g_cam (c_cam − c0_cam) + g_car (c_car − c0_car),
     c_p     = 0.5 / (1 − 0.5^p),   p = 0.9
+    ψ_q(x)  = sgn(x) (|x|^q − κ_q |x|^p),   κ_q = (1 − 0.5^q) / (1 − 0.5^p)
 
 * ``β`` is the whole model's backlash, linearised in the two crank-bearing clearances about the
   design: ``B0`` the design's backlash (clearances ``c0``, profile modifications and all), ``g`` the
@@ -22,6 +23,11 @@ Hysteresis (input locked, output torque ``T`` [N·mm], branch ``s = +1`` for ris
   then a stiffening elastic law (Palmgren line contact ``δ ∝ Q^0.9``); ``c_p`` makes the
   catalogue rigidity ``(T_r/2)/(θ(T_r) − θ(T_r/2))`` of the elastic part exactly ``f K_nom``, so
   ``f`` is a contact-stiffness factor on the whole model's rigidity.
+* The shape terms ``a_k ψ_{q_k}`` [rad] (exponents :data:`SHAPE_EXPONENTS`) bend the elastic law
+  where one exponent is not the whole model's (pins engaging one by one at low load): each is odd
+  and has ``ψ_q(1) = ψ_q(1/2)``, so the catalogue rigidity stays ``f K_nom``. Nuisance parameters:
+  they let the loop width be read against the reducer's true slope (the friction torque's
+  interval), and describe no property of the serial.
 * Friction is a torque ``T_fr`` opposing the motion inside the reducer (Coulomb), so the loop
   width is the play plus the elastic twist of ``2 T_fr``.
 * ``C_rig`` [rad/(N·mm)] is the compliance of the rig (shafts, couplings, encoder mount) between
