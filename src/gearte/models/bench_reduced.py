@@ -109,6 +109,9 @@ class ReducedRV:
         ``B0`` [rad], the whole model's backlash of the design.
     design_clearances : (float, float)
         ``(c0_cam, c0_car)`` [mm], the design's clearances.
+    shape_exponents : tuple of float
+        Exponents ``q_k`` [-] of the elastic law's shape terms (:func:`shape_basis`), one fitted
+        amplitude each (:meth:`shape_parameters`); ``()`` gives the single-exponent law.
     """
 
     rated_torque: float
