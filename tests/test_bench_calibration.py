@@ -89,6 +89,9 @@ def test_calibration_recovers_identifiable_parameters_and_flags_the_rest():
     assert ("contact_stiffness_factor", "rig_compliance") in cal.groups
     ident = cal.identified()
     assert {"friction_torque", "crank_rotation_cos"} <= set(ident)
+    # the elastic law's shape amplitudes are fitted but never reported as identified
+    assert set(MODEL.shape_parameters()) <= set(cal.fitted) - set(ident)
+    assert all("shape term" in cal.flags[n] for n in MODEL.shape_parameters())
     within = [abs(cal.params[n] - truth[n]) <= cal.ci[n] for n in ident]
     assert np.mean(within) >= 0.8  # 95 % intervals, one seed (the rate over seeds is slow)
     for n in ident:  # and nothing wildly off
