@@ -116,6 +116,49 @@ def test_a_known_rig_compliance_makes_the_contact_stiffness_identifiable():
     )
 
 
+def test_with_the_rig_compliance_given_the_contact_stiffness_is_reported_by_its_definition():
+    """f is defined as the reducer's catalogue rigidity over K_nom: with the rig compliance given
+    the calibration reports it by that definition (the shared catalogue function on the curve
+    less the rig's twist), its interval from the data's noise, and keeps the fit's value as the
+    reduced law's parameter."""
+    from gearte.models.catalogue import hysteresis_values
+    from gearte.runners.bench_calibration import catalogue_stiffness_factor
+
+    rng = np.random.default_rng(11)
+    truth = _truth(rng)
+    hyst, _ = synthetic_bench(MODEL, truth, rng)
+    c_rig = truth["rig_compliance"]
+    cal = calibrate(MODEL, hyst, [], torque_noise=2e-4, fixed={"rig_compliance": c_rig})
+    value, ci = cal.estimate("contact_stiffness_factor")
+    k = hysteresis_values(hyst.torque, hyst.angle - c_rig * hyst.torque, MODEL.rated_torque,
+                          direction=hyst.branch).torsional_rigidity  # fmt: skip
+    assert value == pytest.approx(k / MODEL.nominal_rigidity, rel=1e-12)
+    assert (value, ci / 1.959963984540054) == pytest.approx(
+        catalogue_stiffness_factor(MODEL, hyst, c_rig, torque_noise=2e-4), rel=1e-12
+    )
+    # one seed: within 3 standard errors (coverage over seeds: tests/test_bench_round_trip.py;
+    # over 300 noise draws of this serial the standard error matched the scatter to 2 %)
+    assert abs(value - truth["contact_stiffness_factor"]) <= 3 * ci / 1.959963984540054
+    d = cal.by_definition["contact_stiffness_factor"]
+    assert d.fit_value == cal.params["contact_stiffness_factor"] != value
+    # not where the rig compliance is fitted: there the split rests on the reduced law
+    assert not calibrate(MODEL, hyst, [], torque_noise=2e-4).by_definition
+
+
+def test_hysteresis_noise_of_quantised_angles_on_repeated_runs():
+    """The model-free angle noise of a sweep that passes the same torques twice (virgin loading
+    and the last branch), quantised by a 2^21-count encoder: σ² + q²/12 within 8 % (the old
+    estimate, the MAD of sorted branches, gave 1.6×)."""
+    from gearte.runners.bench_calibration import hysteresis_noise
+
+    rng = np.random.default_rng(5)
+    truth = _truth(rng)
+    hyst, _ = synthetic_bench(MODEL, truth, rng)  # 0 → T_r → −T_r → T_r, 0.3″, 2^21 counts
+    q = 2 * np.pi / 2**21
+    expected = np.sqrt(arcsec_to_rad(0.3) ** 2 + q**2 / 12)
+    assert hysteresis_noise(hyst) == pytest.approx(expected, rel=0.08)
+
+
 def test_fixing_the_encoder_makes_the_output_eccentricity_identifiable():
     rng = np.random.default_rng(3)
     truth = _truth(rng)

@@ -165,13 +165,18 @@ def test_a_residual_far_above_the_noise_is_a_warning(tmp_path):
     assert len(warn) == 1 and "× the data's noise" in warn[0] and "hysteresis" in warn[0]
 
 
-def whole_model_coverage(seeds, fixed_rig=False):
+def whole_model_coverage(seeds, fixed_rig=False, reported=True):
     """Per parameter the calibration reports as identified: how many seeds report it and how many
     of its 95 % intervals hold the whole model's truth. Truths: the friction torque and the rig
     compliance as generated; the angle offset 0 (the whole model's curve is odd in the torque);
-    the contact-stiffness factor the serial's whole-model catalogue rigidity over ``K_nom``. The
-    play transition torque is left out: the whole model takes up its play at zero torque with no
-    transition law, so it has no truth there (it only shapes the curve near zero)."""
+    the contact-stiffness factor the serial's whole-model catalogue rigidity over ``K_nom`` (the
+    virtual test read at exactly ±T_r/2 and ±T_r, without friction or rig; the same definition
+    on the noiseless bench curve, read at the sweep's last descending sample T_r (1 − 1/120) and
+    with friction, differs from it by 0.01 %). The play transition torque is left out: the whole
+    model takes up its play at zero torque with no transition law, so it has no truth there (it
+    only shapes the curve near zero). ``reported``: the value and interval the calibration
+    reports (``estimate``: the contact-stiffness factor by its definition where the rig compliance
+    is given); False: the fit's own."""
     from gearte.runners.bench_calibration import calibrate, reduced_constants
 
     model = None
@@ -187,20 +192,26 @@ def whole_model_coverage(seeds, fixed_rig=False):
         for name in cal.identified():
             if name == "play_transition_torque":
                 continue
-            hit = abs(cal.params[name] - true[name]) <= cal.ci[name]
+            value, ci = cal.estimate(name) if reported else (cal.params[name], cal.ci[name])
+            hit = abs(value - true[name]) <= ci
             n, k = counts.get(name, (0, 0))
             counts[name] = (n + 1, k + int(hit))
     return counts
 
 
 @pytest.mark.slow
-def test_interval_coverage_over_20_held_out_whole_model_seeds():
-    """On whole-model data (rig compliance free), every parameter the calibration reports as
-    identified has its 95 % interval hold the truth in >= 90 % of the seeds that report it, and
-    the friction torque is reported in every seed. The elastic law's shape terms were chosen on
-    seeds 0-19; these are seeds 100-119, not used for the choice."""
-    counts = whole_model_coverage(range(100, 120))
+@pytest.mark.parametrize("fixed_rig", [False, True], ids=["rig_fitted", "rig_given"])
+def test_interval_coverage_over_20_held_out_whole_model_seeds(fixed_rig):
+    """On whole-model data, every parameter the calibration reports as identified has its 95 %
+    interval hold the truth in >= 90 % of the seeds that report it, and the friction torque is
+    reported in every seed; with the rig compliance given (a calibration shaft) the
+    contact-stiffness factor is reported in every seed too, by its catalogue definition. The
+    elastic law's shape terms and the definition estimate were chosen on seeds 0-19; these are
+    seeds 100-119, not used for the choice."""
+    counts = whole_model_coverage(range(100, 120), fixed_rig=fixed_rig)
     print({k: f"{h}/{n}" for k, (n, h) in counts.items()})
     assert counts["friction_torque"][0] == 20
+    if fixed_rig:
+        assert counts["contact_stiffness_factor"][0] == 20
     for name, (n, hits) in counts.items():
         assert hits >= 0.9 * n, (name, hits, n)
