@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gearte.io.bench import HysteresisCurve, read_hysteresis, write_hysteresis
 from gearte.errors import ParameterError
+from gearte.io.bench import HysteresisCurve, read_hysteresis, write_hysteresis
 from gearte.io.case_file import load_case
 from gearte.models.catalogue import (
     branch_directions,

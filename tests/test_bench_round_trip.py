@@ -172,11 +172,11 @@ def whole_model_coverage(seeds, fixed_rig=False, reported=True):
     the contact-stiffness factor the serial's whole-model catalogue rigidity over ``K_nom`` (the
     virtual test read at exactly ±T_r/2 and ±T_r, without friction or rig; the same definition
     on the noiseless bench curve, read at the sweep's last descending sample T_r (1 − 1/120) and
-    with friction, differs from it by 0.01 %). The play transition torque is left out: the whole
-    model takes up its play at zero torque with no transition law, so it has no truth there (it
-    only shapes the curve near zero). ``reported``: the value and interval the calibration
-    reports (``estimate``: the contact-stiffness factor by its definition where the rig compliance
-    is given); False: the fit's own."""
+    with friction, differs from it by 0.01–0.03 %, a tenth of its standard error). The play
+    transition torque is left out: the whole model takes up its play at zero torque with no
+    transition law, so it has no truth there (it only shapes the curve near zero). ``reported``:
+    the value and interval the calibration reports (``estimate``: the contact-stiffness factor
+    by its definition where the rig compliance is given); False: the fit's own."""
     from gearte.runners.bench_calibration import calibrate, reduced_constants
 
     model = None
