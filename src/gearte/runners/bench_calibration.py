@@ -522,7 +522,7 @@ def calibrate(
     by_definition = {}
     f_name = "contact_stiffness_factor"
     if (hysteresis is not None and "rig_compliance" in fixed and f_name in fit
-            and f_name not in flags):  # fmt: skip
+            and f_name not in flags and hysteresis_noise(hysteresis) is not None):  # fmt: skip
         # f is DEFINED as the reducer's catalogue rigidity over K_nom: with the rig's compliance
         # known, read it by that definition (the reduced law's fit of the curve is not the
         # definition at the catalogue points: its bias exceeded its interval)
@@ -657,6 +657,11 @@ def catalogue_stiffness_factor(
     -------
     (float, float)
         ``f`` and its standard error [-].
+
+    Raises
+    ------
+    ParameterError
+        Too few samples to estimate the angle noise, and none given.
     """
     if not (np.isfinite(rig_compliance) and rig_compliance >= 0):
         raise ParameterError("rig_compliance", rig_compliance, "must be finite and >= 0")
@@ -667,8 +672,13 @@ def catalogue_stiffness_factor(
     angle = hysteresis.angle - rig_compliance * hysteresis.torque
     k = hysteresis_values(hysteresis.torque, angle, tr, direction=direction).torsional_rigidity
     sigma = hysteresis_noise(hysteresis) if angle_noise is None else angle_noise
+    if sigma is None:
+        raise ParameterError(
+            "hysteresis", hysteresis.torque.size,
+            "samples: too few to estimate the angle noise (give angle_noise)",
+        )  # fmt: skip
     se = torsional_rigidity_error(
-        hysteresis.torque, angle, tr, sigma or 0.0, torque_std=torque_noise * tr,
+        hysteresis.torque, angle, tr, sigma, torque_std=torque_noise * tr,
         direction=direction,
     )  # fmt: skip
     return k / model.nominal_rigidity, se / model.nominal_rigidity
