@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from gearte.errors import ParameterError
 from gearte.io.bench import HysteresisCurve, read_hysteresis, write_hysteresis
 from gearte.io.case_file import load_case
 from gearte.models.catalogue import (
@@ -15,6 +16,7 @@ from gearte.models.catalogue import (
     hysteresis_values_many,
     split_branches,
     te_peak_to_peak,
+    torsional_rigidity_error,
 )
 from gearte.models.rv_catalogue import catalogue_values
 from gearte.studies.rv_reducer import build_reducer
@@ -117,3 +119,30 @@ def test_virtual_test_and_measured_file_give_the_same_catalogue_numbers(rv80e, t
         for name in ("lost_motion", "backlash", "hysteresis_loss"):
             assert getattr(hv, name) == pytest.approx(getattr(cat, name), rel=1e-9, abs=1e-15)
     assert cat.backlash > 0 and cat.hysteresis_loss == pytest.approx(cat.backlash, rel=1e-6)
+
+
+def test_rigidity_standard_error_matches_the_scatter_of_noisy_sweeps():
+    """torsional_rigidity_error (linear propagation of the readings' angle and torque noise
+    through the definition) against the scatter of the definition over 400 noisy copies of a
+    stiffening loop (θ ∝ T^0.9, play, friction): within 12 % (the Monte-Carlo sd of a sd from 400
+    draws is 3.5 %); with the torque noise left out of the propagation it is too small."""
+    rng = np.random.default_rng(7)
+    n = 121
+    t = np.concatenate([np.linspace(TR, -TR, n), np.linspace(-TR, TR, n)])
+    d = np.concatenate([-np.ones(n), np.ones(n)]).astype(int)
+    u = t + d * 0.01 * TR  # friction: the reducer sees T ∓ T_fr
+
+    def angle(torque):
+        return 2e-3 * np.sign(torque) * np.abs(torque / TR) ** 0.9 + 1e-4 * np.tanh(torque / 1e3)
+
+    sig_a, sig_t = 2e-6, 2e-3 * TR  # torque noise chosen large enough to matter
+    ks = []
+    for _ in range(400):
+        noisy_t = t + rng.normal(0.0, sig_t, t.size)
+        ks.append(hysteresis_values(noisy_t, angle(u) + rng.normal(0.0, sig_a, t.size), TR,
+                                    direction=d).torsional_rigidity)  # fmt: skip
+    se = torsional_rigidity_error(t, angle(u), TR, sig_a, torque_std=sig_t, direction=d)
+    assert se == pytest.approx(np.std(ks), rel=0.12)
+    assert torsional_rigidity_error(t, angle(u), TR, sig_a, direction=d) < 0.85 * np.std(ks)
+    with pytest.raises(ParameterError, match="angle_std"):
+        torsional_rigidity_error(t, angle(u), TR, -1.0)

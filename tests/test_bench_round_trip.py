@@ -32,7 +32,7 @@ def _truth(seed):
     scale = rng.uniform(0.8, 1.1)
     serial = serial_reducer(design, scale, clear)
     k = catalogue_values(serial).torsional_rigidity
-    truth = {"clearances": clear, "stiffness_scale": scale,
+    truth = {"clearances": clear, "stiffness_scale": scale, "rigidity": k,
              "friction_torque": rng.uniform(4e3, 12e3),
              "rig_compliance": rng.uniform(0.0, 0.15) / k}  # fmt: skip
     hyst = synthetic_full_model_hysteresis(
@@ -120,9 +120,9 @@ def test_with_the_rig_compliance_known_the_stiffness_scale_is_recovered(tmp_path
 @pytest.mark.slow
 def test_round_trip_and_recovery_over_20_whole_model_seeds(tmp_path):
     """Over 20 whole-model serials: the round trip holds within 5 % in every seed; with the rig's
-    compliance known the stiffness scale comes back within 6 %. Printed (measured, not asserted,
-    the 95 % coverage is below nominal on whole-model data): the coverage of the friction
-    torque's interval, the one identified parameter with a whole-model truth."""
+    compliance known the stiffness scale comes back within 6 %. Printed: the coverage of the
+    friction torque's interval with the rig compliance free (asserted on held-out seeds in
+    ``test_interval_coverage_over_20_held_out_whole_model_seeds``)."""
     from gearte.runners.bench_calibration import calibrate, reduced_constants
 
     worst, scale_err, cover = 0.0, [], []
@@ -163,3 +163,55 @@ def test_a_residual_far_above_the_noise_is_a_warning(tmp_path):
     res = _calibrate(tmp_path, bad, 5)
     warn = [w for w in res.warnings if "residual" in w]
     assert len(warn) == 1 and "× the data's noise" in warn[0] and "hysteresis" in warn[0]
+
+
+def whole_model_coverage(seeds, fixed_rig=False, reported=True):
+    """Per parameter the calibration reports as identified: how many seeds report it and how many
+    of its 95 % intervals hold the whole model's truth. Truths: the friction torque and the rig
+    compliance as generated; the angle offset 0 (the whole model's curve is odd in the torque);
+    the contact-stiffness factor the serial's whole-model catalogue rigidity over ``K_nom`` (the
+    virtual test read at exactly ±T_r/2 and ±T_r, without friction or rig; the same definition
+    on the noiseless bench curve, read at the sweep's last descending sample T_r (1 − 1/120) and
+    with friction, differs from it by 0.01–0.03 %, a tenth of its standard error). The play
+    transition torque is left out: the whole model takes up its play at zero torque with no
+    transition law, so it has no truth there (it only shapes the curve near zero). ``reported``:
+    the value and interval the calibration reports (``estimate``: the contact-stiffness factor
+    by its definition where the rig compliance is given); False: the fit's own."""
+    from gearte.runners.bench_calibration import calibrate, reduced_constants
+
+    model = None
+    counts: dict = {}
+    for seed in seeds:
+        design, truth, hyst = _truth(seed)
+        model = model or reduced_constants(design, {})
+        true = {"friction_torque": truth["friction_torque"], "angle_offset": 0.0,
+                "rig_compliance": truth["rig_compliance"],
+                "contact_stiffness_factor": truth["rigidity"] / model.nominal_rigidity}  # fmt: skip
+        fixed = {"rig_compliance": truth["rig_compliance"]} if fixed_rig else {}
+        cal = calibrate(model, hyst, [], torque_noise=2e-4, fixed=fixed)
+        for name in cal.identified():
+            if name == "play_transition_torque":
+                continue
+            value, ci = cal.estimate(name) if reported else (cal.params[name], cal.ci[name])
+            hit = abs(value - true[name]) <= ci
+            n, k = counts.get(name, (0, 0))
+            counts[name] = (n + 1, k + int(hit))
+    return counts
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("fixed_rig", [False, True], ids=["rig_fitted", "rig_given"])
+def test_interval_coverage_over_20_held_out_whole_model_seeds(fixed_rig):
+    """On whole-model data, every parameter the calibration reports as identified has its 95 %
+    interval hold the truth in >= 90 % of the seeds that report it, and the friction torque is
+    reported in every seed; with the rig compliance given (a calibration shaft) the
+    contact-stiffness factor is reported in every seed too, by its catalogue definition. The
+    elastic law's shape terms and the definition estimate were chosen on seeds 0-19; these are
+    seeds 100-119, not used for the choice."""
+    counts = whole_model_coverage(range(100, 120), fixed_rig=fixed_rig)
+    print({k: f"{h}/{n}" for k, (n, h) in counts.items()})
+    assert counts["friction_torque"][0] == 20
+    if fixed_rig:
+        assert counts["contact_stiffness_factor"][0] == 20
+    for name, (n, hits) in counts.items():
+        assert hits >= 0.9 * n, (name, hits, n)

@@ -10,9 +10,10 @@ Hysteresis (input locked, output torque ``T`` [N·mm], branch ``s = +1`` for ris
 ``−1`` for falling)::
 
     θ(T, s) = θ0 + F(T − s T_fr) + C_rig T
-    F(u)    = (β/2) tanh(u / T_β) + (T_r / (f K_nom)) c_p sgn(u) |u/T_r|^p
+    F(u)    = (β/2) tanh(u / T_β) + (T_r / (f K_nom)) c_p sgn(u) |u/T_r|^p + Σ_k a_k ψ_{q_k}(u/T_r)
     β       = B0 + g_cam (c_cam − c0_cam) + g_car (c_car − c0_car),
     c_p     = 0.5 / (1 − 0.5^p),   p = 0.9
+    ψ_q(x)  = sgn(x) (|x|^q − κ_q |x|^p),   κ_q = (1 − 0.5^q) / (1 − 0.5^p)
 
 * ``β`` is the whole model's backlash, linearised in the two crank-bearing clearances about the
   design: ``B0`` the design's backlash (clearances ``c0``, profile modifications and all), ``g`` the
@@ -22,6 +23,11 @@ Hysteresis (input locked, output torque ``T`` [N·mm], branch ``s = +1`` for ris
   then a stiffening elastic law (Palmgren line contact ``δ ∝ Q^0.9``); ``c_p`` makes the
   catalogue rigidity ``(T_r/2)/(θ(T_r) − θ(T_r/2))`` of the elastic part exactly ``f K_nom``, so
   ``f`` is a contact-stiffness factor on the whole model's rigidity.
+* The shape terms ``a_k ψ_{q_k}`` [rad] (exponents :data:`SHAPE_EXPONENTS`) bend the elastic law
+  where one exponent is not the whole model's (pins engaging one by one at low load): each is odd
+  and has ``ψ_q(1) = ψ_q(1/2)``, so the catalogue rigidity stays ``f K_nom``. Nuisance parameters:
+  they let the loop width be read against the reducer's true slope (the friction torque's
+  interval), and describe no property of the serial.
 * Friction is a torque ``T_fr`` opposing the motion inside the reducer (Coulomb), so the loop
   width is the play plus the elastic twist of ``2 T_fr``.
 * ``C_rig`` [rad/(N·mm)] is the compliance of the rig (shafts, couplings, encoder mount) between
@@ -52,7 +58,10 @@ from numpy.typing import ArrayLike
 
 __all__ = [
     "STIFFNESS_EXPONENT",
+    "SHAPE_EXPONENTS",
     "ReducedRV",
+    "shape_basis",
+    "hysteresis_parameters",
     "play",
     "HYSTERESIS_PARAMETERS",
     "hysteresis_angle",
@@ -78,6 +87,9 @@ HYSTERESIS_PARAMETERS = (
 )
 TE_COMMON = ("te_offset", "running_windup")  # o [rad], w [rad]
 
+SHAPE_EXPONENTS: tuple[float, ...] = (0.6, 1.5)
+"""Exponents ``q_k`` of the elastic law's shape terms ``ψ_q`` (:func:`shape_basis`)."""
+
 
 @dataclass(frozen=True)
 class ReducedRV:
@@ -97,6 +109,9 @@ class ReducedRV:
         ``B0`` [rad], the whole model's backlash of the design.
     design_clearances : (float, float)
         ``(c0_cam, c0_car)`` [mm], the design's clearances.
+    shape_exponents : tuple of float
+        Exponents ``q_k`` [-] of the elastic law's shape terms (:func:`shape_basis`), one fitted
+        amplitude each (:meth:`shape_parameters`); ``()`` gives the single-exponent law.
     """
 
     rated_torque: float
@@ -105,6 +120,11 @@ class ReducedRV:
     families: dict[str, int] = field(default_factory=dict)
     design_backlash: float = 0.0
     design_clearances: tuple[float, float] = (0.0, 0.0)
+    shape_exponents: tuple[float, ...] = SHAPE_EXPONENTS
+
+    def shape_parameters(self) -> tuple[str, ...]:
+        """Names of the shape terms' amplitudes ``a_k`` [rad], one per exponent."""
+        return tuple(f"elastic_shape_{k + 1}" for k in range(len(self.shape_exponents)))
 
     def family_parameters(self) -> tuple[str, ...]:
         names: list[str] = []
@@ -127,7 +147,43 @@ def parameter_names(model: ReducedRV) -> tuple[str, ...]:
     tuple of str
         The names, in the order of the fit's parameter vector.
     """
-    return (*HYSTERESIS_PARAMETERS, *TE_COMMON, *model.family_parameters())
+    return (*hysteresis_parameters(model), *TE_COMMON, *model.family_parameters())
+
+
+def hysteresis_parameters(model: ReducedRV) -> tuple[str, ...]:
+    """The parameters of the hysteresis curve: :data:`HYSTERESIS_PARAMETERS` and the shape
+    terms' amplitudes of ``model`` (:meth:`ReducedRV.shape_parameters`)."""
+    return (*HYSTERESIS_PARAMETERS, *model.shape_parameters())
+
+
+def shape_basis(x: ArrayLike, q: float) -> tuple[np.ndarray, np.ndarray]:
+    """Shape term ``ψ_q(x) = sgn(x) (|x|^q − κ_q |x|^p)`` [-] and its slope ``dψ_q/dx`` [-].
+
+    ``κ_q = (1 − 0.5^q)/(1 − 0.5^p)`` makes ``ψ_q(1) = ψ_q(1/2)``: a shape term bends the elastic
+    law without changing its catalogue rigidity, so ``f K_nom`` stays the rigidity of the
+    elastic part whatever the shape amplitudes. Odd in ``x``, zero at 0. The slope at ``x = 0``
+    is evaluated at ``|x| = 1e-12``.
+
+    Parameters
+    ----------
+    x : array_like
+        ``u / T_r`` [-].
+    q : float
+        Exponent [-] (> 0).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        ``ψ_q(x)`` and ``ψ_q'(x)`` [-].
+    """
+    p = STIFFNESS_EXPONENT
+    xa = np.asarray(x, dtype=float)
+    ax = np.abs(xa)
+    kappa = (1.0 - 0.5**q) / (1.0 - 0.5**p)
+    value = np.sign(xa) * (ax**q - kappa * ax**p)
+    axc = np.maximum(ax, 1e-12)
+    slope = q * axc ** (q - 1.0) - kappa * p * axc ** (p - 1.0)
+    return value, slope
 
 
 def play(model: ReducedRV, p: dict) -> Any:
@@ -197,6 +253,8 @@ def hysteresis_angle(
     """
     t, _, u, x, e = _loading_branch(model, params, torque, direction)
     elastic = e * np.sign(x) * np.abs(x) ** STIFFNESS_EXPONENT
+    for name, q in zip(model.shape_parameters(), model.shape_exponents, strict=True):
+        elastic = elastic + params[name] * shape_basis(x, q)[0]
     play = 0.5 * _play(params, model) * np.tanh(u / params["play_transition_torque"])
     return params["angle_offset"] + play + elastic + params["rig_compliance"] * t
 
@@ -238,7 +296,13 @@ def hysteresis_jacobian(
     sech2 = 1.0 - th**2
     beta = _play(params, model)
     d_du = 0.5 * beta * sech2 / tb + e * p * ax ** (p - 1.0) / tr
+    shape = {}
+    for name, q in zip(model.shape_parameters(), model.shape_exponents, strict=True):
+        value, slope = shape_basis(x, q)
+        shape[name] = value
+        d_du = d_du + params[name] * slope / tr
     return {
+        **shape,
         "cam_bearing_clearance": 0.5 * g_cam * th,
         "carrier_bearing_clearance": 0.5 * g_car * th,
         "play_transition_torque": -0.5 * beta * sech2 * u / tb**2,

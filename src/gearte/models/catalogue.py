@@ -75,6 +75,7 @@ __all__ = [
     "HysteresisValues",
     "hysteresis_values",
     "hysteresis_values_many",
+    "torsional_rigidity_error",
     "te_peak_to_peak",
     "forward_backward_difference",
     "LoadSeriesValues",
@@ -459,6 +460,73 @@ def hysteresis_values_many(
         "backlash": loss - w_f,
         "hysteresis_loss": loss,
     }
+
+
+def torsional_rigidity_error(
+    torque: ArrayLike,
+    angle: ArrayLike,
+    rated_torque: float,
+    angle_std: float,
+    *,
+    torque_std: float = 0.0,
+    direction: ArrayLike | None = None,
+) -> float:
+    """Standard error [N·mm/rad] of :func:`torsional_rigidity` from the noise of the readings.
+
+    Every reading ``θ_b(T*)`` of the definition is a linear interpolation between two samples of
+    a branch (weights ``1 − w``, ``w``), so the rigidity
+    ``½ (N₊/Δ₊ + N₋/Δ₋)``, ``Δ₊ = θ_mid(T_hi) − θ_mid(T_r/2)``, ``N₊ = T_hi − T_r/2`` (and the
+    same for the negative side), is a function of a few samples' angles. Each sample carries
+    independent errors: the angle's ``σ_θ`` and the torque reading's ``σ_T`` seen through the
+    curve's slope (the side's secant ``Δ/N``), ``σ_i² = σ_θ² + (Δ/N)² σ_T²``; the error is
+    propagated linearly:
+    ``var K = Σ_i (∂K/∂θ_i)² σ_i²``, ``∂K/∂θ_i = −½ (N₊/Δ₊² ∂Δ₊/∂θ_i + N₋/Δ₋² ∂Δ₋/∂θ_i)``.
+    The repeatability between runs and any error correlated along the sweep are not in it.
+
+    Parameters
+    ----------
+    torque : array_like, shape (K,)
+        Output torque in recording order [N·mm].
+    angle : array_like, shape (K,)
+        Output torsion angle [rad].
+    rated_torque : float
+        Rated torque T_r [N·mm].
+    angle_std : float
+        Standard deviation of one angle reading ``σ_θ`` [rad] (≥ 0).
+    torque_std : float
+        Standard deviation of one torque reading ``σ_T`` [N·mm] (≥ 0).
+    direction : array_like, optional
+        +1 rising / −1 falling torque per sample [-]; inferred when omitted.
+
+    Returns
+    -------
+    float
+        Standard error of the torsional rigidity [N·mm/rad].
+    """
+    for name, v in (("angle_std", angle_std), ("torque_std", torque_std)):
+        if not (np.isfinite(v) and v >= 0):
+            raise ParameterError(name, v, "must be finite and >= 0")
+    t = np.asarray(torque, dtype=float)
+    a = np.asarray(angle, dtype=float)
+    if t.shape != a.shape or t.ndim != 1:
+        raise ParameterError("angle", a.shape, f"must have the shape of torque {t.shape}")
+    # the branches of the sample indices: which sample each reading interpolates
+    br = split_branches(t, np.arange(t.size, dtype=float), rated_torque, direction)
+    tr = rated_torque
+    hi = min(tr, br.asc_torque[-1], br.desc_torque[-1])
+    lo = max(-tr, br.asc_torque[0], br.desc_torque[0])
+    query = np.array([lo, -0.5 * tr, 0.5 * tr, hi])
+    mid = np.zeros((query.size, t.size))  # θ_mid(query) = mid @ angle
+    for idx, xp in ((br.asc_angle, br.asc_torque), (br.desc_angle, br.desc_torque)):
+        np.add.at(mid.T, idx.astype(np.int64), 0.5 * _interp_weights(query, xp).T)
+    grad = np.zeros(t.size)
+    slope = np.zeros(t.size)
+    for g, n in ((mid[3] - mid[2], hi - 0.5 * tr), (mid[1] - mid[0], -0.5 * tr - lo)):
+        d = float(g @ a)
+        grad -= 0.5 * n / d**2 * g
+        slope = np.where(g != 0, abs(d / n), slope)
+    var = (angle_std**2 + (slope * torque_std) ** 2) * grad**2
+    return float(np.sqrt(np.sum(var)))
 
 
 def te_peak_to_peak(te: ArrayLike) -> float:

@@ -18,11 +18,11 @@ import numpy as np
 from gearte.errors import ParameterError
 from gearte.models.bench_data import HysteresisCurve, TETrace
 from gearte.models.bench_reduced import (
-    HYSTERESIS_PARAMETERS,
     TE_COMMON,
     ReducedRV,
     hysteresis_angle,
     hysteresis_jacobian,
+    hysteresis_parameters,
     parameter_names,
     play,
     te_basis,
@@ -30,7 +30,11 @@ from gearte.models.bench_reduced import (
     te_orders,
     te_trace,
 )
-from gearte.models.catalogue import branch_directions, hysteresis_values
+from gearte.models.catalogue import (
+    branch_directions,
+    hysteresis_values,
+    torsional_rigidity_error,
+)
 from gearte.units import arcsec_to_rad
 
 __all__ = [
@@ -46,6 +50,9 @@ __all__ = [
     "close_loop",
     "Z95",
     "CONFOUNDED_CORRELATION",
+    "hysteresis_noise",
+    "catalogue_stiffness_factor",
+    "DefinitionEstimate",
 ]
 
 CONFOUNDED_CORRELATION = 0.99
@@ -54,6 +61,13 @@ CONFOUNDED_PAIRS = (("contact_stiffness_factor", "rig_compliance"),)
 """Parameters a hysteresis curve sees almost only together: the reducer's stiffness and the rig's
 compliance are both a compliance on the measured torque, told apart only by the curvature of the
 reduced elastic law (on whole-model data their split was off by factors 0.001–8 in 20 seeds)."""
+
+SHAPE_NOTE = (
+    "shape term of the elastic law: absorbs what the reduced law lacks so that the other "
+    "parameters' intervals hold; describes the curve, not a property of the serial"
+)
+"""Flag of every shape amplitude (:meth:`gearte.models.bench_reduced.ReducedRV.shape_parameters`):
+a nuisance parameter, never reported as identified."""
 
 Z95 = 1.959963984540054
 """Two-sided 95 % normal quantile: confidence interval = ± Z95 × standard error."""
@@ -85,6 +99,8 @@ def parameter_specs(model: ReducedRV) -> dict[str, ParameterSpec]:
     }
     for name in model.family_parameters():
         specs[name] = ParameterSpec("rad", 1e-5, -0.005, 0.005)
+    for name in model.shape_parameters():
+        specs[name] = ParameterSpec("rad", 0.1 * tr / k, -2.0 * tr / k, 2.0 * tr / k)
     return specs
 
 
@@ -113,6 +129,12 @@ class CalibrationResult:
     covariance_inflation : float
         Long-run variance over variance of the hysteresis residuals along the sweep [-]: the
         hysteresis rows' information is divided by it (1: independent residuals).
+    by_definition : dict
+        Parameter → :class:`DefinitionEstimate`: a parameter defined by a catalogue quantity and
+        estimated by that definition on the data rather than by the fit (the contact-stiffness
+        factor where the rig compliance is given: :func:`catalogue_stiffness_factor`). ``params``
+        and ``ci`` keep the fit's values (the reduced model's curve); :meth:`estimate` gives the
+        reported ones.
     """
 
     model: ReducedRV
@@ -133,9 +155,18 @@ class CalibrationResult:
     message: str = ""
     fixed: tuple[str, ...] = ()
     covariance_inflation: float = 1.0
+    by_definition: dict = field(default_factory=dict)
 
     def identified(self) -> list[str]:
         return [n for n in self.fitted if n not in self.flags]
+
+    def estimate(self, name: str) -> tuple[float, float]:
+        """The reported value and 95 % half-width of a fitted parameter: by its definition on
+        the data where :attr:`by_definition` holds it, else the fit's (gearte units)."""
+        if name in self.by_definition:
+            d = self.by_definition[name]
+            return d.value, d.ci
+        return float(self.params[name]), float(self.ci[name])
 
 
 @dataclass(frozen=True)
@@ -277,6 +308,11 @@ def calibrate(
     Where the hysteresis residuals are correlated along the sweep (a law the reduced model
     lacks), its rows count as ``n σ²/σ_LR²`` independent samples, ``σ_LR²`` their long-run
     variance (Bartlett window of 5 % of the samples).
+
+    With the rig compliance given (in ``fixed``) and a hysteresis curve, the contact-stiffness
+    factor is also estimated by its definition (:func:`catalogue_stiffness_factor`) and
+    reported so (``by_definition``, :meth:`CalibrationResult.estimate`); the fitted factor stays
+    the reduced law's parameter (``params``).
     """
     from scipy.optimize import least_squares
 
@@ -298,7 +334,7 @@ def calibrate(
         )
     available = []
     if hysteresis is not None:
-        available += list(HYSTERESIS_PARAMETERS)
+        available += list(hysteresis_parameters(model))
     if te_rows:
         available += [*TE_COMMON, *model.family_parameters()]
         for c in ("cam_bearing_clearance", "carrier_bearing_clearance"):
@@ -463,6 +499,9 @@ def calibrate(
             )
         elif min(xi - lo[i], hi[i] - xi) < 1e-6 * (hi[i] - lo[i]):
             flags[nm] = "at a bound: interval not valid (the data push it past its range)"
+    for nm in model.shape_parameters():  # nuisance: what the reduced law lacks, no property
+        if nm in fit and nm not in flags:
+            flags[nm] = SHAPE_NOTE
     d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
     corr = cov / np.outer(d, d)
     # two identified parameters the data see almost only together: their split rests on the
@@ -480,6 +519,23 @@ def calibrate(
                     "another measurement)"
                 )
             groups.append((a_, b_))
+    by_definition = {}
+    f_name = "contact_stiffness_factor"
+    if (hysteresis is not None and "rig_compliance" in fixed and f_name in fit
+            and f_name not in flags and hysteresis_noise(hysteresis) is not None):  # fmt: skip
+        # f is DEFINED as the reducer's catalogue rigidity over K_nom: with the rig's compliance
+        # known, read it by that definition (the reduced law's fit of the curve is not the
+        # definition at the catalogue points: its bias exceeded its interval)
+        value, se = catalogue_stiffness_factor(
+            model, hysteresis, float(fixed["rig_compliance"]), torque_noise=torque_noise
+        )
+        i = fit.index(f_name)
+        by_definition[f_name] = DefinitionEstimate(
+            value=value, std=se, ci=Z95 * se, fit_value=float(res.x[i] * scale[i]),
+            fit_ci=ci[f_name],
+            note="by its definition: the catalogue rigidity of the curve less the given rig "
+                 "compliance's twist, over K_nom; interval from the data's noise",
+        )  # fmt: skip
     return CalibrationResult(
         model=model,
         params=unpack(res.x),
@@ -499,7 +555,133 @@ def calibrate(
         message=f"{res.message} ({nfev} evaluations)",
         fixed=tuple(fixed),
         covariance_inflation=inflation,
+        by_definition=by_definition,
     )
+
+
+def hysteresis_noise(hysteresis: HysteresisCurve) -> float | None:
+    """The angle noise of a hysteresis curve [rad], independent of any model.
+
+    Along each run of the sweep (contiguous samples of one branch: torque rising or falling),
+    sorted by torque, the angles are differenced twice; for independent errors of ``σ`` the
+    second difference has variance ``6 σ²``, and the smooth curve adds almost nothing at a bench's
+    sampling. The few second differences where the curve bends (the play, the turning points) are
+    left out: those beyond 5 robust deviations (1.4826 MAD) of their median; ``σ² = mean(Δ²θ²)/6``
+    of the others, pooled over the runs. (Runs are differenced apart: two runs over the same
+    torques interleaved by sorting alternate between them, and their second differences carry the
+    curve's slope times the step. The MAD alone is not the estimate: on angles quantised by an
+    encoder it takes only multiples of half a count.)
+
+    Parameters
+    ----------
+    hysteresis : HysteresisCurve
+        The measured curve (torque [N·mm], angle [rad], branch marks or inferred).
+
+    Returns
+    -------
+    float or None
+        ``σ`` [rad]; None with fewer than 6 second differences.
+    """
+    direction = (
+        hysteresis.branch if hysteresis.branch is not None else branch_directions(hysteresis.torque)
+    )
+    d = np.asarray(direction)
+    edges = np.concatenate([[0], np.nonzero(np.diff(d))[0] + 1, [d.size]])
+    parts = []
+    for s, e in zip(edges[:-1], edges[1:], strict=True):
+        if e - s >= 3:
+            a = hysteresis.angle[s:e][np.argsort(hysteresis.torque[s:e], kind="stable")]
+            parts.append(a[2:] - 2 * a[1:-1] + a[:-2])
+    if sum(p.size for p in parts) < 6:
+        return None
+    d2 = np.concatenate(parts)
+    dev = np.abs(d2 - np.median(d2))
+    mad = 1.4826 * float(np.median(dev))
+    keep = dev <= 5.0 * mad if mad > 0 else np.ones(d2.size, dtype=bool)
+    return float(np.sqrt(np.mean(d2[keep] ** 2) / 6.0))
+
+
+@dataclass(frozen=True)
+class DefinitionEstimate:
+    """A quantity estimated by its definition on the data rather than by the fit.
+
+    Attributes
+    ----------
+    value, std, ci : float
+        Estimate, standard error and 95 % half-width (gearte units of the parameter).
+    fit_value, fit_ci : float
+        The reduced model's fitted parameter and its 95 % half-width, for comparison.
+    note : str
+        How it was found.
+    """
+
+    value: float
+    std: float
+    ci: float
+    fit_value: float
+    fit_ci: float
+    note: str
+
+
+def catalogue_stiffness_factor(
+    model: ReducedRV,
+    hysteresis: HysteresisCurve,
+    rig_compliance: float,
+    *,
+    torque_noise: float = 0.0,
+    angle_noise: float | None = None,
+) -> tuple[float, float]:
+    """The contact-stiffness factor by its definition: the reducer's catalogue rigidity over
+    ``K_nom``, read from the curve with the rig's twist removed.
+
+    ``f = K_cat(θ − C_rig T) / K_nom``: the shared catalogue definition
+    (:func:`gearte.models.catalogue.hysteresis_values`) on the measured torques and the angles
+    less the given rig compliance's twist; its standard error from the data's noise by
+    :func:`gearte.models.catalogue.torsional_rigidity_error` (the angle noise estimated by
+    :func:`hysteresis_noise` unless given, the torque reading's from ``torque_noise``).
+
+    Parameters
+    ----------
+    model : ReducedRV
+        ``K_nom`` [N·mm/rad] and ``T_r`` [N·mm].
+    hysteresis : HysteresisCurve
+        The measured curve (torque [N·mm], angle [rad]).
+    rig_compliance : float
+        ``C_rig`` [rad/(N·mm)], known (a calibration shaft).
+    torque_noise : float
+        Standard deviation of the torque reading as a fraction of ``T_r`` [-].
+    angle_noise : float, optional
+        Standard deviation of the angle reading [rad] (default: :func:`hysteresis_noise`).
+
+    Returns
+    -------
+    (float, float)
+        ``f`` and its standard error [-].
+
+    Raises
+    ------
+    ParameterError
+        Too few samples to estimate the angle noise, and none given.
+    """
+    if not (np.isfinite(rig_compliance) and rig_compliance >= 0):
+        raise ParameterError("rig_compliance", rig_compliance, "must be finite and >= 0")
+    tr = model.rated_torque
+    direction = (
+        hysteresis.branch if hysteresis.branch is not None else branch_directions(hysteresis.torque)
+    )
+    angle = hysteresis.angle - rig_compliance * hysteresis.torque
+    k = hysteresis_values(hysteresis.torque, angle, tr, direction=direction).torsional_rigidity
+    sigma = hysteresis_noise(hysteresis) if angle_noise is None else angle_noise
+    if sigma is None:
+        raise ParameterError(
+            "hysteresis", hysteresis.torque.size,
+            "samples: too few to estimate the angle noise (give angle_noise)",
+        )  # fmt: skip
+    se = torsional_rigidity_error(
+        hysteresis.torque, angle, tr, sigma, torque_std=torque_noise * tr,
+        direction=direction,
+    )  # fmt: skip
+    return k / model.nominal_rigidity, se / model.nominal_rigidity
 
 
 LONG_RUN_BANDWIDTH = 0.05

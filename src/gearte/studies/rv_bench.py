@@ -655,7 +655,6 @@ def _calibration(case, reducer, rcase, sources, ref_trace, hyst, warnings, analy
     from gearte.runners.bench_calibration import (
         Z95,
         calibrate,
-        parameter_specs,
         reduced_constants,
     )
 
@@ -682,14 +681,7 @@ def _calibration(case, reducer, rcase, sources, ref_trace, hyst, warnings, analy
         model, hyst, ref, fit=sec.fit, fixed=fixed, max_relative_ci=sec.max_relative_ci,
         torque_noise=case.data.torque_noise_fraction,
     )  # fmt: skip
-    specs = parameter_specs(model)
-    params = {}
-    for n in cal.fitted:
-        unit = specs[n].unit
-        params[n] = {
-            "value": cal.params[n], "ci95": cal.ci[n] if np.isfinite(cal.ci[n]) else None,
-            "unit": unit, "identified": n not in cal.flags, "note": cal.flags.get(n, ""),
-        }  # fmt: skip
+    params = reported_parameters(cal)
     families = {}
     fitted = list(cal.fitted)
     for fam in (*fams, "encoder eccentricity"):
@@ -760,6 +752,29 @@ def _calibration(case, reducer, rcase, sources, ref_trace, hyst, warnings, analy
     return res, cal
 
 
+def reported_parameters(cal) -> dict:
+    """Every fitted parameter as reported: value, 95 % half-width (None where not identified),
+    unit, identified, note. A parameter estimated by its definition on the data
+    (:meth:`gearte.runners.bench_calibration.CalibrationResult.estimate`) is reported so, and its
+    note gives the reduced law's fitted value beside it."""
+    from gearte.runners.bench_calibration import parameter_specs
+
+    specs = parameter_specs(cal.model)
+    out = {}
+    for n in cal.fitted:
+        value, ci = cal.estimate(n)
+        note = cal.flags.get(n, "")
+        if n in cal.by_definition:
+            d = cal.by_definition[n]
+            note = (f"{d.note} (the reduced law's fitted factor {d.fit_value:.5g} ± "
+                    f"{d.fit_ci:.2g} shapes the model's curve)")  # fmt: skip
+        out[n] = {
+            "value": float(value), "ci95": float(ci) if np.isfinite(ci) else None,
+            "unit": specs[n].unit, "identified": n not in cal.flags, "note": note,
+        }  # fmt: skip
+    return out
+
+
 RESIDUAL_WARNING = 3.0
 """A calibration block whose rms residual exceeds this multiple of the data's own noise is a
 warning [-]."""
@@ -767,24 +782,16 @@ warning [-]."""
 
 def _noise(hyst, traces) -> dict:
     """The data's own noise [rad], independent of any model: hysteresis from the second
-    differences along each branch sorted by torque (robust, MAD), TE from the median line of each
+    differences along each run of the sweep
+    (:func:`gearte.runners.bench_calibration.hysteresis_noise`), TE from the median line of each
     trace's order spectrum (:func:`gearte.models.orders.mean_standard_error` × √N)."""
-    from gearte.models.catalogue import branch_directions
     from gearte.models.orders import mean_standard_error, order_spectrum
+    from gearte.runners.bench_calibration import hysteresis_noise
 
     out = {}
-    if hyst is not None:
-        direction = hyst.branch if hyst.branch is not None else branch_directions(hyst.torque)
-        sig = []
-        for sgn in (1, -1):
-            m = np.asarray(direction) == sgn
-            if m.sum() < 8:
-                continue
-            a = hyst.angle[m][np.argsort(hyst.torque[m], kind="stable")]
-            d2 = a[2:] - 2 * a[1:-1] + a[:-2]
-            sig.append(1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0))
-        if sig:
-            out["hysteresis"] = float(np.median(sig))
+    sigma = hysteresis_noise(hyst) if hyst is not None else None
+    if sigma is not None:
+        out["hysteresis"] = sigma
     te = []
     for t in traces:
         for pos, y in t.directions().values():
@@ -828,22 +835,12 @@ def _close_loop(case, reducer, cal, analyses, lmf, warnings):
     (:func:`gearte.runners.bench_calibration.close_loop`); its lost motion is the check. Returns
     ``(ClosedLoop or None, record)`` — the record is the calibrated serial's
     ``[bench_calibration]`` section."""
-    from gearte.runners.bench_calibration import close_loop, parameter_specs
+    from gearte.runners.bench_calibration import close_loop
 
-    specs = parameter_specs(cal.model)
     record: dict = {
         "source": f"rv_bench case {case.case.title or case.case.name}",
         "stiffness_scale": 1.0,
-        "parameters": {
-            n: {
-                "value": float(cal.params[n]),
-                "ci95": float(cal.ci[n]) if np.isfinite(cal.ci[n]) else None,
-                "unit": specs[n].unit,
-                "identified": n not in cal.flags,
-                "note": cal.flags.get(n, ""),
-            }
-            for n in cal.fitted
-        },  # fmt: skip
+        "parameters": reported_parameters(cal),
         "round_trip": {},
         "not_written": [],
     }
@@ -853,7 +850,7 @@ def _close_loop(case, reducer, cal, analyses, lmf, warnings):
         return n in cal.fixed or (n in cal.fitted and n not in cal.flags)
 
     if known("contact_stiffness_factor"):
-        record["contact_stiffness_factor"] = float(p["contact_stiffness_factor"])
+        record["contact_stiffness_factor"] = cal.estimate("contact_stiffness_factor")[0]
     if known("friction_torque"):
         record["friction_torque_Nm"] = float(p["friction_torque"]) / float(Nm_to_Nmm(1.0))
     c_rig = 0.0
