@@ -73,6 +73,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
+from gearte._jit import inner_kernel
 from gearte.errors import ParameterError
 from gearte.geometry.cycloid import CycloidStage
 from gearte.limits import MAX_CONTACT_PRESSURE_MPA, check_floor
@@ -837,7 +838,7 @@ def force(
 # against them to 1e-12.
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _relative_radius_scalar(rho, r):  # pragma: no cover - compiled
     """Twin of :func:`relative_radius` for one pin [mm]."""
     curv = 1.0 / r

@@ -30,6 +30,8 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from gearte._jit import inner_kernel
+
 __all__ = [
     "rv_rhs",
     "rv_dte",
@@ -170,7 +172,7 @@ def kernel_table(inv_mass, err_g, err_m, err_mn, err_n, geo_m, geo_n, clear, fsp
     return np.concatenate([a.ravel() for a in parts])
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _bearing(dx, dy, vx, vy, k, c, cl):
     """Force (on body a) of an isotropic bearing with radial clearance cl; returns fx, fy."""
     if cl <= 0.0:
@@ -182,7 +184,7 @@ def _bearing(dx, dy, vx, vy, k, c, cl):
     return -s * dx - c * vx, -s * dy - c * vy
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _fourier2(mean, tab, o, n, c1, s1):
     """mean + Σ_l a_l cos(l s) + b_l sin(l s) given cos s and sin s (angle-addition recurrence);
     a_l = ``tab[o + l]``, b_l = ``tab[o + n + l]`` (l < n)."""
