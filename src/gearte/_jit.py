@@ -27,10 +27,14 @@ from typing import Any
 from numba import njit
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["InnerKernel", "inner_kernel"]
+__all__ = ["InnerKernel", "inner_kernel", "kernel"]
+
+#: ``numba.njit`` untyped: its type stubs do not list the ``no_cpython_wrapper`` and
+#: ``no_cfunc_wrapper`` target options (numba accepts them: ``numba.core.cpu``'s option list)
+_njit: Any = njit
 
 
-class InnerKernel(CPUDispatcher):  # type: ignore[misc]  # numba has no type information
+class InnerKernel(CPUDispatcher):
     """A numba dispatcher compiled without the CPython and cfunc wrappers (:func:`inner_kernel`).
 
     Compiled callers call its machine code; a call from Python runs its Python code
@@ -44,6 +48,16 @@ def inner_kernel(fn: Callable[..., Any]) -> Any:
     """``@njit(cache=True, nogil=True)`` for a kernel called only from other kernels: compiled
     without the CPython and cfunc wrappers (``no_cpython_wrapper``, ``no_cfunc_wrapper``), a
     call from Python runs ``fn`` itself (:class:`InnerKernel`)."""
-    dispatcher = njit(cache=True, nogil=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)(fn)
+    dispatcher = _njit(cache=True, nogil=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)(fn)
     dispatcher.__class__ = InnerKernel
     return dispatcher
+
+
+def kernel(fn: Callable[..., Any] | None = None, /, **options: Any) -> Any:
+    """``@njit(cache=True, nogil=True, **options)`` without the cfunc wrapper: a kernel that
+    Python code calls (it keeps the CPython wrapper). Every gearte kernel is a :func:`kernel`
+    or an :func:`inner_kernel` (or ``inline="always"``): numba compiles a numpy or builtin
+    overload once per set of compile flags, so one flag set for all entry points keeps
+    ``np.empty``, ``max`` & co. compiled once per run."""
+    jit = _njit(cache=True, nogil=True, no_cfunc_wrapper=True, **options)
+    return jit if fn is None else jit(fn)

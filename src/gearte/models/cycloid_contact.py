@@ -35,6 +35,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
+from gearte._jit import kernel
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.cycloid import CycloidStage, geometry_radii
 from gearte.geometry.cycloid_kernels import pin_mesh_table
@@ -561,7 +562,7 @@ def _check_deformation(dmax: np.ndarray, stage: CycloidStage, torque: float) -> 
         )
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _outputs(n, z):  # pragma: no cover - compiled
     """F_max, δ_max, evaluations, status (n,); approach, force, in-mesh, pressure (n, z)."""
     return (
@@ -576,7 +577,7 @@ def _outputs(n, z):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _hu2020_kernel(
     lr, clr, r_c, A, B, F0, warm, T_c, rtol, max_iter, rho, r, E_star, b
 ):  # pragma: no cover - compiled
@@ -615,7 +616,7 @@ def _hu2020_kernel(
     return F, dmax, nev, status, approach, force, in_mesh, pressure
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _line_contact_kernel(
     lr, clr, r_c, T_c, rtol, frtol, max_iter, rho, r, E_star, b, a1, rho_cap, b0
 ):  # pragma: no cover - compiled

@@ -38,9 +38,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from gearte._jit import inner_kernel
+from gearte._jit import inner_kernel, kernel
 from gearte.errors import ConvergenceError, ParameterError
 
 __all__ = [
@@ -122,7 +121,7 @@ def _solve_one(lr, clr, T_c, r_c, A, B, F0, rtol, max_iter):  # pragma: no cover
     return F, n_eval, _NO_CONV
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _solve_batch(lr, clr, T_c, r_c, A, B, F0, rtol, max_iter):  # pragma: no cover - compiled
     n = lr.shape[0]
     F = np.empty(n)
@@ -376,7 +375,7 @@ def _log_force(delta, a0, a1, u0, rtol):  # pragma: no cover - compiled
     return math.nan, math.nan
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _log_force_flat(delta, a0, a1, rtol):  # pragma: no cover - compiled
     out = np.empty(delta.shape[0])
     for i in range(delta.shape[0]):
@@ -538,7 +537,7 @@ def _rotation_one(arm, clr, a0, a1, T, rot, u, f, rtol, frtol, max_iter):  # pra
     return rot, n, _NO_CONV
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _rotation_batch(arm, clr, a0, a1, T, rot0, rtol, frtol, max_iter):  # pragma: no cover
     n, z = arm.shape
     rot = np.empty(n)

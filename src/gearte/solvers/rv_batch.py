@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from gearte._jit import inner_kernel
+from gearte._jit import inner_kernel, kernel
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.solvers.dense import copy_into as _copy
 from gearte.solvers.dense import solve_spd_into as _spd_solve
@@ -636,7 +636,7 @@ def _log_update(lf, f, r):
     return np.log(f)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _solve_batch(
     K0s, us, regs, cidx, cvals, nidx, nvals, kn, cn, group, ngroups, law, coefs, kstart, Hs, ENs,
     GAPs, step_g, step_T, start, rec, nrec, out_u, out_h, out_q, tol, maxit, exact, given_state,

@@ -31,9 +31,8 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
-from gearte._jit import inner_kernel
+from gearte._jit import inner_kernel, kernel
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.solvers.dense import dot, max_abs, solve_spd_into
 
@@ -176,7 +175,7 @@ def law_terms(lf, a0, a1, a2, a3):
     return rest, slope
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def law_delta(f, a0, a1, a2, a3):
     """Approach ``δ = F (a0 − a1 ln F) + a2 F^a3`` [mm] of the solver's law form at ``F = f``."""
     return f * law_terms(np.log(f), a0, a1, a2, a3)[0]
@@ -369,7 +368,7 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
     return q, maxit, False
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _solve_all(
     K0s, f0s, Bns, ens, kn, cn, Bcs, gcs, group, ngroups, law, coefs, k0, q0, tol, maxit
 ):

@@ -28,9 +28,8 @@ import hashlib
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
-from gearte._jit import inner_kernel
+from gearte._jit import inner_kernel, kernel
 
 __all__ = [
     "rv_rhs",
@@ -200,7 +199,7 @@ def _fourier2(mean, tab, o, n, c1, s1):
 # no_rewrites (a numba target option its type stubs do not list): numba's IR rewrite passes
 # (array expressions, constant getitems, raises) find nothing to rewrite in this kernel; skipping
 # them saves ~10 % of its compile's Python work, for the same LLVM IR
-@njit(cache=True, nogil=True, no_rewrites=True)  # type: ignore[call-overload]
+@kernel(no_rewrites=True)
 def rv_rhs(t, y, args, dydt, work):
     """dy/dt of the lumped RV model at time ``t`` [s], written into ``dydt`` (compiled; plain twin:
     ``RVDynamicModel.rhs_numpy``).
@@ -496,7 +495,7 @@ def rv_rhs(t, y, args, dydt, work):
         f[i3] *= tab[i3]
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def rv_dte(t, y, args):
     """Dynamic transmission error θ_o − θ_s / i [rad] of state ``y`` at time ``t`` [s]; ``args``
     as for :func:`rv_rhs`."""
