@@ -7,9 +7,10 @@ with string formatting: about 5–7 s of first-run compile for every kernel that
 unknowns, where plain loops are as fast as LAPACK; these kernels compile in a fraction of a
 second and are shared by every solver that needs them (``docs/numba.md``).
 
-Each function works in caller-provided arrays (no allocation) and is ``@njit(cache=True,
-nogil=True)``; the plain-Python twin is ``f.py_func`` (tested against numpy in
-``tests/test_dense.py``).
+Each function works in caller-provided arrays (no allocation) and is an inner kernel
+(:func:`gearte._jit.inner_kernel`: no Python entry point; called from Python it runs its Python
+code, ``f.py_func``); both are tested against numpy in ``tests/test_dense.py``, the compiled code
+through small test kernels.
 """
 
 from __future__ import annotations
