@@ -672,6 +672,20 @@ def _line_contact_kernel(
     return F, dmax, nev, status, approach, force, in_mesh, pressure
 
 
+def compile_line_contact_kernel() -> None:
+    """Compile (or load from numba's cache) the tooth-contact kernel of the line-contact law.
+
+    The rv_reducer kind's warm-up case (``hu2020_rv80e_initial_reducer``) analyses its cycloid
+    stage with the Hu 2020 law; a case on the line-contact law (``li2023_rv_errors``) compiled
+    this kernel on its first run after ``gearte warm-cache``, which calls this function after
+    that case (:data:`gearte.warm.WARM_ALSO`). A one-position call with the argument types of
+    :func:`tooth_contact`'s (its numbers are not used)."""
+    one = np.ones((1, 3))
+    _line_contact_kernel(
+        one, 0.0 * one, 1.0, 1.0, 1e-12, 1e-12, 1, one.copy(), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0
+    )
+
+
 def _tooth_contact_plain(
     stage: CycloidStage,
     torque: float,
