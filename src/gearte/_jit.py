@@ -1,22 +1,32 @@
-"""Compiled helper kernels without a Python entry point (a cheaper first compile).
+"""gearte's kernel decorators: numba kernels without the wrappers they do not need.
 
 numba compiles every ``@njit`` function with two wrappers besides its machine code: a CPython
 wrapper (unboxes each argument from a Python object, boxes the result, turns a raised error
 into a Python exception; the larger, the more array and tuple arguments and results) and a
-C-callable ``cfunc`` wrapper (for use as a first-class function). A kernel that only other
-kernels call uses neither: a compiled caller calls the machine code directly. Compiling a
-helper without them (numba's ``no_cpython_wrapper`` and ``no_cfunc_wrapper`` options) saves
-~30–60 ms of typing, lowering and LLVM work per helper — ~1.1 s of a cold first
-``gearte run hu2020_rv80e_initial_reducer`` (12.0 → 10.9 s CPU, four paired runs,
-``docs/numba.md``, "Wrappers"). The compiled code, and so every result, is the same.
+C-callable ``cfunc`` wrapper (for use as a first-class function, which gearte does not do). A
+kernel that only other kernels call uses neither: a compiled caller calls its machine code
+directly.
 
-Such a dispatcher has no compiled entry for a call from Python (numba would jump to a null
-address). :func:`inner_kernel` therefore gives it the class :class:`InnerKernel`, whose call
-from Python runs the kernel's Python code (``py_func``, as :func:`gearte.solvers.twins.
-plain_twins` does), so a Python caller gets the right result — at Python speed — and never a
-crash. Use it only for a kernel that is called from compiled kernels; a kernel that Python
-code calls (a solver's entry point, a function tested compiled from Python) stays
-``@njit(cache=True, nogil=True)``.
+* :func:`inner_kernel`: a kernel only other kernels call, compiled without either wrapper
+  (numba's ``no_cpython_wrapper`` and ``no_cfunc_wrapper`` options);
+* :func:`kernel`: a kernel Python calls, compiled without the cfunc wrapper.
+
+A cold first ``gearte run hu2020_rv80e_initial_reducer``: 10.67 → 9.81 s CPU (medians of six
+alternated pairs, every pair 0.8–1.1 s less; ``docs/numba.md``, "The wrappers numba compiles
+beside every kernel"). The compiled code, and so every result, is the same.
+
+An inner kernel has no compiled entry for a call from Python (numba would jump to a null
+address: a segmentation fault). :func:`inner_kernel` therefore gives it the class
+:class:`InnerKernel`, whose call from Python runs the kernel's Python code (``py_func``, as
+:func:`gearte.solvers.twins.plain_twins` does): a Python caller gets the result — at Python
+speed — and never a crash. A kernel that Python code calls (a solver's entry point, a function
+tested compiled from Python) is a :func:`kernel`.
+
+numba compiles a numpy or builtin overload (``np.empty``, ``max``, …) once per set of compile
+flags, and these options are flags: every gearte kernel is a :func:`kernel` or an
+:func:`inner_kernel` (or ``inline="always"``, typed inside its callers), so that a run compiles
+each overload at most twice (``tests/test_jit.py``). Written for numba 0.68
+(``numba.core.registry.CPUDispatcher`` is the class ``njit`` returns).
 """
 
 from __future__ import annotations
