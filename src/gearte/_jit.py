@@ -56,8 +56,19 @@ class InnerKernel(CPUDispatcher):
 
 def inner_kernel(fn: Callable[..., Any]) -> Any:
     """``@njit(cache=True, nogil=True)`` for a kernel called only from other kernels: compiled
-    without the CPython and cfunc wrappers (``no_cpython_wrapper``, ``no_cfunc_wrapper``), a
-    call from Python runs ``fn`` itself (:class:`InnerKernel`)."""
+    without the CPython and cfunc wrappers (``no_cpython_wrapper``, ``no_cfunc_wrapper``).
+
+    Parameters
+    ----------
+    fn : callable
+        The kernel's Python function; a call of the result from Python runs it
+        (:class:`InnerKernel`).
+
+    Returns
+    -------
+    InnerKernel
+        The numba dispatcher.
+    """
     dispatcher = _njit(cache=True, nogil=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)(fn)
     dispatcher.__class__ = InnerKernel
     return dispatcher
@@ -68,6 +79,19 @@ def kernel(fn: Callable[..., Any] | None = None, /, **options: Any) -> Any:
     Python code calls (it keeps the CPython wrapper). Every gearte kernel is a :func:`kernel`
     or an :func:`inner_kernel` (or ``inline="always"``): numba compiles a numpy or builtin
     overload once per set of compile flags, so one flag set for all entry points keeps
-    ``np.empty``, ``max`` & co. compiled once per run."""
+    ``np.empty``, ``max`` & co. compiled once per run.
+
+    Parameters
+    ----------
+    fn : callable, optional
+        The kernel's Python function (``@kernel``); omitted, a decorator
+        (``@kernel(fastmath=...)``).
+    **options
+        Further ``njit`` options (``fastmath``, ``no_rewrites``).
+
+    Returns
+    -------
+    numba dispatcher, or a decorator where ``fn`` is omitted.
+    """
     jit = _njit(cache=True, nogil=True, no_cfunc_wrapper=True, **options)
     return jit if fn is None else jit(fn)
