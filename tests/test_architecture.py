@@ -25,6 +25,7 @@ LAYERS: list[tuple[str, ...]] = [
         "gearte._version",
         "gearte._blas",
         "gearte._gc",
+        "gearte._jit",
         "gearte.errors",
         "gearte.limits",
         "gearte.units",

@@ -63,11 +63,14 @@ first ``gear_chain`` run compiled for ~15 s CPU)."""
 
 WARM_ALSO: dict[str, tuple[str, ...]] = {
     "jiang2024_spur_pair": ("gearte.tolerance.montecarlo:compile_general_kernel",),
+    "hu2020_rv80e_initial_reducer": ("gearte.models.cycloid_contact:compile_line_contact_kernel",),
 }
 """Per warm-up case, ``module:function`` compiles run after it: kernel specialisations that no
 bundled case reaches but a user's case may (the Monte-Carlo kernel for a stack with a
 non-normal contributor, e.g. a ``[distributions]`` override: the bundled stacks are all
-normal and compile a specialisation without those draws)."""
+normal and compile a specialisation without those draws); the tooth contact on the
+line-contact law (the rv_reducer warm-up case's stage is on Hu 2020's law; ``li2023_rv_errors``
+compiled it after the warm-up)."""
 
 WARM_CHAINS: tuple[tuple[str, ...], ...] = (
     ("han2023_rv110e_yield",),  # the batched RV solver (solvers/rv_batch.py)

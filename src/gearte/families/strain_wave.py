@@ -369,8 +369,9 @@ FAMILY = DriveFamily(
     drive=drive,
     chain_yield=chain_yield,
     drive_kinds=("strain_wave",),
-    warm_cases=(),
-    warm_uses=("planetary",),  # its TE peak-to-peak calls trig_extremes' kernel
+    # its TE peak-to-peak calls trig_extremes' batch kernel, which no other kind's warm-up case
+    # compiles (the planetary kind's TE kernel has the extremes search written in)
+    warm_cases=("harmonicdrive_csf32_100",),
     bench_case="harmonicdrive_csf32_100",
     labels={
         "te_once_per_wg_revolution": "TE once per wave-generator revolution",

@@ -20,12 +20,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from gearte._jit import kernel
 
 __all__ = ["pin_mesh_table"]
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _pin_mesh_table(theta, z_p, K1, R, r, dr_rp, dr_p):  # pragma: no cover - compiled
     n = theta.shape[0]
     phase = np.empty((n, z_p))

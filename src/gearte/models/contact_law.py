@@ -70,9 +70,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike
 
+from gearte._jit import inner_kernel, kernel
 from gearte.errors import ParameterError
 from gearte.geometry.cycloid import CycloidStage
 from gearte.limits import MAX_CONTACT_PRESSURE_MPA, check_floor
@@ -837,7 +837,7 @@ def force(
 # against them to 1e-12.
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _relative_radius_scalar(rho, r):  # pragma: no cover - compiled
     """Twin of :func:`relative_radius` for one pin [mm]."""
     curv = 1.0 / r
@@ -848,7 +848,7 @@ def _relative_radius_scalar(rho, r):  # pragma: no cover - compiled
     return 1.0 / curv if curv != 0.0 else math.inf
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def line_contact_a0_scalar(rho, r, E_star, b, a1, rho_cap):  # pragma: no cover - compiled
     """Coefficient a0 [mm/N] of the ``"line_contact"`` law for one pin (compiled twin).
 
@@ -884,7 +884,7 @@ def line_contact_a0_scalar(rho, r, E_star, b, a1, rho_cap):  # pragma: no cover 
     return a1 * (math.log(16.0 * rho_abs * r / q) - 1.0)  # one log: ln(16|ρ|r) − ln q
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def max_contact_pressure_scalar(F, rho, r, E_star, b):  # pragma: no cover - compiled
     """Hertz pressure p0 [MPa] of one pin (compiled twin of :func:`max_contact_pressure`).
 

@@ -35,6 +35,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
+from gearte._jit import kernel
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.geometry.cycloid import CycloidStage, geometry_radii
 from gearte.geometry.cycloid_kernels import pin_mesh_table
@@ -561,7 +562,7 @@ def _check_deformation(dmax: np.ndarray, stage: CycloidStage, torque: float) -> 
         )
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _outputs(n, z):  # pragma: no cover - compiled
     """F_max, δ_max, evaluations, status (n,); approach, force, in-mesh, pressure (n, z)."""
     return (
@@ -576,7 +577,7 @@ def _outputs(n, z):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _hu2020_kernel(
     lr, clr, r_c, A, B, F0, warm, T_c, rtol, max_iter, rho, r, E_star, b
 ):  # pragma: no cover - compiled
@@ -615,7 +616,7 @@ def _hu2020_kernel(
     return F, dmax, nev, status, approach, force, in_mesh, pressure
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _line_contact_kernel(
     lr, clr, r_c, T_c, rtol, frtol, max_iter, rho, r, E_star, b, a1, rho_cap, b0
 ):  # pragma: no cover - compiled
@@ -669,6 +670,20 @@ def _line_contact_kernel(
                 in_mesh[k, i] = True
                 pressure[k, i] = max_contact_pressure_scalar(f[i], rho[k, i], r, E_star, b)
     return F, dmax, nev, status, approach, force, in_mesh, pressure
+
+
+def compile_line_contact_kernel() -> None:
+    """Compile (or load from numba's cache) the tooth-contact kernel of the line-contact law.
+
+    The rv_reducer kind's warm-up case (``hu2020_rv80e_initial_reducer``) analyses its cycloid
+    stage with the Hu 2020 law; a case on the line-contact law (``li2023_rv_errors``) compiled
+    this kernel on its first run after ``gearte warm-cache``, which calls this function after
+    that case (:data:`gearte.warm.WARM_ALSO`). A one-position call with the argument types of
+    :func:`tooth_contact`'s (its numbers are not used)."""
+    one = np.ones((1, 3))
+    _line_contact_kernel(
+        one, 0.0 * one, 1.0, 1.0, 1e-12, 1e-12, 1, one.copy(), 1.0, 1.0, 1.0, 1.0, 1.0, 1.0
+    )
 
 
 def _tooth_contact_plain(

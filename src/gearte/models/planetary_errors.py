@@ -40,6 +40,7 @@ from fractions import Fraction
 import numpy as np
 from numba import njit
 
+from gearte._jit import kernel
 from gearte.errors import ParameterError
 from gearte.geometry.planetary import PlanetarySet, SunPlanetErrors
 from gearte.models.planetary_terms import CoupledTE, ErrorTerm, TermSet
@@ -394,7 +395,7 @@ MODE_PHASORS = 2
 """:func:`_te_kernel` mode: extremes per row of given constant parts and phasors."""
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _te_kernel(mode, mags, angs, cz, pos, tf, ti, nh, M, fx, fn, sim, fsim, vec, ist, tol):
     """The planetary's one compiled entry point: exact extremes of Σe for many assemblies, or
     the assembly that minimises the amplitude max|Σe| (compiled Nelder–Mead).

@@ -38,8 +38,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from gearte._jit import inner_kernel, kernel
 from gearte.errors import ConvergenceError, ParameterError
 
 __all__ = [
@@ -61,12 +61,12 @@ def compliance_limit(B: float) -> float:
     return B * math.exp(-1.0 / 3.0)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _delta(F, A, B):  # pragma: no cover - compiled
     return A * F * (2.0 / 3.0 + math.log(B / F))
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _resid(F, lr, clr, T_c, r_c, A, B):  # pragma: no cover - compiled
     """g(F) and dg/dF: g = r_c (F/δ) Σ max(lr_i δ − Δ_i, 0) lr_i − T_c with δ = δ_max(F)."""
     lbf = math.log(B / F)
@@ -85,7 +85,7 @@ def _resid(F, lr, clr, T_c, r_c, A, B):  # pragma: no cover - compiled
     return g, dg
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _solve_one(lr, clr, T_c, r_c, A, B, F0, rtol, max_iter):  # pragma: no cover - compiled
     """Safeguarded Newton on g(F) = 0 inside (lo, hi), hi = the compliance limit until a
     point with g ≥ 0 is met; a step leaving the bracket is replaced by bisection."""
@@ -121,7 +121,7 @@ def _solve_one(lr, clr, T_c, r_c, A, B, F0, rtol, max_iter):  # pragma: no cover
     return F, n_eval, _NO_CONV
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _solve_batch(lr, clr, T_c, r_c, A, B, F0, rtol, max_iter):  # pragma: no cover - compiled
     n = lr.shape[0]
     F = np.empty(n)
@@ -331,7 +331,7 @@ def _solve_load_sharing_plain(lr, clr, T_c, r_c, A, B, F_start, rtol, max_iter):
 _U_SPAN = 60.0  # lower end of the ln F bracket: ln δ − 60 (F below δ e^-60 / a1 is never met)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _log_force(delta, a0, a1, u0, rtol):  # pragma: no cover - compiled
     """(F, ln F) with δ = F (a0 − a1 ln F) on its increasing branch; (0, nan) for δ ≤ 0,
     (inf, inf) at or beyond δ* = a1 exp(a0/a1 − 1), (nan, nan) if Newton did not converge.
@@ -375,7 +375,7 @@ def _log_force(delta, a0, a1, u0, rtol):  # pragma: no cover - compiled
     return math.nan, math.nan
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _log_force_flat(delta, a0, a1, rtol):  # pragma: no cover - compiled
     out = np.empty(delta.shape[0])
     for i in range(delta.shape[0]):
@@ -487,7 +487,7 @@ def _log_law_force_plain(delta, a0, a1, rtol):
     return out
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _torque_at(rot, arm, clr, a0, a1, u, f, frtol):  # pragma: no cover - compiled
     """T(Δφ) = Σ F_i l_i and dT/dΔφ = Σ k_t,i l_i²; fills f (forces) and u (ln F, warm start)."""
     t = 0.0
@@ -507,7 +507,7 @@ def _torque_at(rot, arm, clr, a0, a1, u, f, frtol):  # pragma: no cover - compil
     return t, slope
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _rotation_one(arm, clr, a0, a1, T, rot, u, f, rtol, frtol, max_iter):  # pragma: no cover
     """Disc rotation carrying T at one position: (Δφ, evaluations, status); forces into f."""
     if not rot > 0.0:
@@ -537,7 +537,7 @@ def _rotation_one(arm, clr, a0, a1, T, rot, u, f, rtol, frtol, max_iter):  # pra
     return rot, n, _NO_CONV
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _rotation_batch(arm, clr, a0, a1, T, rot0, rtol, frtol, max_iter):  # pragma: no cover
     n, z = arm.shape
     rot = np.empty(n)

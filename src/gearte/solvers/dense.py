@@ -7,20 +7,22 @@ with string formatting: about 5–7 s of first-run compile for every kernel that
 unknowns, where plain loops are as fast as LAPACK; these kernels compile in a fraction of a
 second and are shared by every solver that needs them (``docs/numba.md``).
 
-Each function works in caller-provided arrays (no allocation) and is ``@njit(cache=True,
-nogil=True)``; the plain-Python twin is ``f.py_func`` (tested against numpy in
-``tests/test_dense.py``).
+Each function works in caller-provided arrays (no allocation) and is an inner kernel
+(:func:`gearte._jit.inner_kernel`: no Python entry point; called from Python it runs its Python
+code, ``f.py_func``); both are tested against numpy in ``tests/test_dense.py``, the compiled code
+through small test kernels.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from gearte._jit import inner_kernel
 
 __all__ = ["copy_into", "matvec_into", "dot", "max_abs", "solve_spd_into", "solve_lu_into"]
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def dot(a, b):
     """Σ a[i] b[i] of two 1-D arrays."""
     s = 0.0
@@ -29,7 +31,7 @@ def dot(a, b):
     return s
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def copy_into(src, out):
     """out[i] = src[i] for 1-D arrays of the same length: ``out[:] = src`` inside a kernel
     compiles numba's broadcasting and its shape-mismatch message (string formatting, ~1 s per
@@ -38,7 +40,7 @@ def copy_into(src, out):
         out[i] = src[i]
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def matvec_into(A, x, out):
     """out[i] = Σ_j A[i, j] x[j] for a 2-D ``A``."""
     for i in range(A.shape[0]):
@@ -48,7 +50,7 @@ def matvec_into(A, x, out):
         out[i] = s
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def max_abs(x):
     """max |x[i]| of a 1-D array (0 for an empty one; NaN if any element is NaN)."""
     m = 0.0
@@ -61,7 +63,7 @@ def max_abs(x):
     return m
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def solve_lu_into(A, b, LU, x):
     """Solve ``A x = b`` by Gaussian elimination with partial pivoting (LAPACK ``dgesv``'s
     algorithm, unblocked); ``LU`` (n, n) work array, result in ``x``. A zero pivot gives
@@ -100,7 +102,7 @@ def solve_lu_into(A, b, LU, x):
         x[k] = s / LU[k, k]
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def solve_spd_into(H, b, L, x):
     """Solve ``H x = b`` for a symmetric positive definite ``H`` by Cholesky (the lower factor
     in the work array ``L``, its diagonal stored as reciprocals: one division per column, the

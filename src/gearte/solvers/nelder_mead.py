@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from gearte._jit import kernel
+
 __all__ = ["nm_best", "nm_start", "nm_tell"]
 
 
@@ -87,7 +89,7 @@ def nm_start(
     ist[:] = (0, 0, 1, maxiter)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def nm_tell(f, xatol, fatol, sim, fsim, vec, ist):
     """The objective's value ``f`` at ``vec[2]``: advance the method; True when it has converged
     (SciPy's test on ``xatol``, ``fatol``) or run ``ist[3]`` iterations, else the next point to

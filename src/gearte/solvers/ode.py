@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from gearte._jit import kernel
 from gearte.errors import DivergenceError, ParameterError
 
 #: Lower estimate of the time of one compiled RK4 step of a 30-DOF system [s], for the time
@@ -397,7 +398,7 @@ def _specialise(template, rhs, output, key: str, name: str):
     fn = types.FunctionType(template.__code__, g, f"{name}_{key}", template.__defaults__, None)
     fn.__qualname__ = f"{name}_{key}"
     fn.__module__ = template.__module__
-    return njit(cache=True, nogil=True)(fn)
+    return kernel(fn)
 
 
 def _source_key(*funcs) -> str:

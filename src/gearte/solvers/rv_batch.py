@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from gearte._jit import inner_kernel, kernel
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.solvers.dense import copy_into as _copy
 from gearte.solvers.dense import solve_spd_into as _spd_solve
@@ -195,7 +196,7 @@ class BatchSolution:
     iterations: np.ndarray
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _rows_dot(idx, val, q, r):
     s = 0.0
     for w in range(idx.shape[1]):
@@ -203,7 +204,7 @@ def _rows_dot(idx, val, q, r):
     return s
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _rows_times(idx, val, x, out):
     """``out[r] = B[r]·x`` for every stored row (rows of three columns: the columns' values
     read once per run of rows on the same columns)."""
@@ -242,7 +243,7 @@ def law_columns(coef: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([coef, fstar, dstar], axis=-1))
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _law_force(d, a0, a1, a2, a3, fstar, dstar, f_prev, d_prev):
     """Force ``F`` with ``δ(F) = F (a0 − a1 ln F) + a2 F^a3 = d`` for an approach ``d > 0`` [N].
 
@@ -281,7 +282,7 @@ def _law_force(d, a0, a1, a2, a3, fstar, dstar, f_prev, d_prev):
     return F
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _law_force_start(d, a0, a1, a2, a3, fstar):
     """One-term estimate of the force at approach ``d > 0``: ``F ≈ d / (a0 − a1 ln(d/a))`` for
     the log law; for a power law the force of its power part, ``(d/a2)^(1/a3)``, combined with
@@ -293,7 +294,7 @@ def _law_force_start(d, a0, a1, a2, a3, fstar):
     return fp if a0 <= 0.0 else 1.0 / (1.0 / fp + a0 / d)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, Fp, dp, F, d, kt,
             exact_law):  # fmt: skip
     """Π at ``q``; fills the approaches ``d``, contact forces ``F`` and tangent stiffnesses
@@ -354,7 +355,7 @@ def _energy(exact, K0, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, kc, q, 
     return e
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _assemble_rows3(cidx, cval, F, kt, H, grad):
     """:func:`_assemble`'s contact rows where each row has three columns (a disc's x, y and
     rotation): consecutive rows on the same columns are summed in registers and added to ``H``
@@ -388,7 +389,7 @@ def _assemble_rows3(cidx, cval, F, kt, H, grad):
         _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad)
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad):
     """Add a symmetric 3 × 3 block and its gradient on columns (i0, i1, i2) (repeated columns,
     the padding of :func:`sparse_rows`, carry zero entries and add nothing)."""
@@ -406,7 +407,7 @@ def _add_block3(i0, i1, i2, g0, g1, g2, h00, h01, h02, h11, h12, h22, H, grad):
     H[i2, i1] += h12
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _assemble(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, F, kt, q, H, grad):
     """Gradient ``K0 q − f0 + Σ F_c B_c + bearings`` and Hessian ``K0 + Σ kt_c B_c B_cᵀ +
     bearings + reg I`` at ``q`` — the one contact-row assembly of every Newton variant here
@@ -624,7 +625,7 @@ def _newton_mixed(K0, reg, f0, nidx, nval, en, kn, cn, cidx, cval, gc, coef, q, 
     return maxit, False
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _log_update(lf, f, r):
     """``ln f`` from ``lf = ln(f / (1 + r))``: ``lf + log1p(r)`` by its series where
     ``|r| < 2⁻¹⁰`` (five terms: the first omitted, ``r⁶/6``, is below 2e-19 — under the
@@ -635,7 +636,7 @@ def _log_update(lf, f, r):
     return np.log(f)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _solve_batch(
     K0s, us, regs, cidx, cvals, nidx, nvals, kn, cn, group, ngroups, law, coefs, kstart, Hs, ENs,
     GAPs, step_g, step_T, start, rec, nrec, out_u, out_h, out_q, tol, maxit, exact, given_state,

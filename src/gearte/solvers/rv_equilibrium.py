@@ -31,8 +31,8 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from gearte._jit import inner_kernel, kernel
 from gearte.errors import ConvergenceError, ParameterError
 from gearte.solvers.dense import dot, max_abs, solve_spd_into
 
@@ -159,7 +159,7 @@ class EquilibriumSolution:
 N_COEF = 4
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def law_terms(lf, a0, a1, a2, a3):
     """``(δ/F, δ'(F))`` of the law ``δ(F) = F (a0 − a1 ln F) + a2 F^a3`` at ``lf = ln F``.
 
@@ -175,13 +175,13 @@ def law_terms(lf, a0, a1, a2, a3):
     return rest, slope
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def law_delta(f, a0, a1, a2, a3):
     """Approach ``δ = F (a0 − a1 ln F) + a2 F^a3`` [mm] of the solver's law form at ``F = f``."""
     return f * law_terms(np.log(f), a0, a1, a2, a3)[0]
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _secant_update(law, force, coef, group, ngroups, k, kc):
     """One step of the secant fixed point of the law: the new stiffnesses from ``force``.
 
@@ -232,7 +232,7 @@ def _secant_update(law, force, coef, group, ngroups, k, kc):
     return change, True
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q):
     """Π(q) (scalar loops: no array expressions, cheap to compile; ``docs/numba.md``)."""
     nd = q.size
@@ -255,7 +255,7 @@ def _energy(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q):
     return e
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _bearing_terms(wx, wy, k, c):
     """Gradient (gx, gy) and Hessian (hxx, hyy, hxy) in w-space of a bearing with radial
     clearance ``c`` [mm] and stiffness ``k`` [N/mm] at relative displacement (wx, wy) [mm]:
@@ -277,7 +277,7 @@ def _bearing_terms(wx, wy, k, c):
     return gx, gy, hxx, hyy, hxy
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
     """Minimise Π for fixed contact stiffness; returns (q, iterations, ok).
 
@@ -368,7 +368,7 @@ def _newton(K0, f0, Bn, en, kn, cn, Bc, gc, kc, q, tol, maxit):
     return q, maxit, False
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _solve_all(
     K0s, f0s, Bns, ens, kn, cn, Bcs, gcs, group, ngroups, law, coefs, k0, q0, tol, maxit
 ):

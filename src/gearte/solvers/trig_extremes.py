@@ -41,6 +41,7 @@ from collections.abc import Sequence
 import numpy as np
 from numba import njit
 
+from gearte._jit import kernel
 from gearte.errors import ParameterError
 
 __all__ = [
@@ -87,7 +88,7 @@ def _sincos_kernel(r):
     return s, w + (((1.0 - w) - hz) + z * rc)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def sincos_into(x, s, c):
     """s[i], c[i] = sin x[i], cos x[i] for 1-D arrays, |x| <= SINCOS_MAX_ARG unchecked (the
     compiled core of :func:`sincos`, callable from other kernels); branch-free, so the loop
@@ -151,7 +152,7 @@ def node_tables(nh, M):
     return tab
 
 
-@njit(cache=True, nogil=True, fastmath=_FAST)
+@kernel(fastmath=_FAST)
 def _grid_fill(c, zr, zi, tab, buf):
     """buf[j] = f(u_j); returns the largest and smallest node value."""
     M = buf.shape[0]
@@ -174,7 +175,7 @@ def _grid_fill(c, zr, zi, tab, buf):
     return mx, mn
 
 
-@njit(cache=True, nogil=True, fastmath=_FAST)
+@kernel(fastmath=_FAST)
 def _count_beyond(buf, tx, tn):
     """Nodes above tx (count, sum of indices) and below tn (count, sum of indices); with a count
     of one the sum is the index. One vectorised pass."""
@@ -213,7 +214,7 @@ def _eval_at(d, c, wr, wi, nh):
     return f, d1, d2, d3
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _refine(j, sgn, buf, tab, c, zr, zi, nh, h, stol, wr, wi):
     """Largest sgn*f on [u_j - h, u_j + h]: Halley on f' from the parabolic vertex; if an
     iterate leaves the interval, meets f'' >= 0 or 30 steps do not converge, golden-section
@@ -354,7 +355,7 @@ def extremes_kernel(c, zr, zi, nh, tab, buf, wr, wi):
     return max(fmax, mx), min(fmin, mn)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _extremes_batch(c, zr, zi, nh, M):
     n = c.shape[0]
     G = nh.shape[0]

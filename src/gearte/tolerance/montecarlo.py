@@ -31,8 +31,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit, uint64
+from numba import uint64
 
+from gearte._jit import kernel
 from gearte.errors import ParameterError
 from gearte.execution import spawn_seeds
 from gearte.tolerance.rng import (
@@ -105,7 +106,7 @@ def _group(codes: np.ndarray, params: np.ndarray, sens: np.ndarray) -> tuple[flo
 _BIN_OFFSET = 1.0 + 2.0**52
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _bin(y, lo, inv_width, top):  # pragma: no cover - compiled
     """Histogram bin + 1 of ``y`` as the low bits of a double (no branch: vector registers)."""
     t = (y - lo) * inv_width
@@ -114,12 +115,12 @@ def _bin(y, lo, inv_width, top):  # pragma: no cover - compiled
     return math.floor(t) + _BIN_OFFSET
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _min(a, b):  # pragma: no cover - compiled
     return a if a < b else b
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _max(a, b):  # pragma: no cover - compiled
     return a if a > b else b
 
@@ -128,7 +129,7 @@ _BIN_MASK = uint64(0xFFFFFFFF)
 _FLUSH = 1 << 30  # samples between additions of the int32 counts into the int64 ones
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _linear_stack_kernel(
     states, lanes0, n, tk, tw, tf, group, base, gsd, others, params, codes, sens, pool,
     shift, lo, hi, nbins, lsl, usl, keep,

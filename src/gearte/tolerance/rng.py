@@ -45,6 +45,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import int64, njit, uint64
 
+from gearte._jit import kernel
+
 __all__ = [
     "ZigguratTables",
     "ziggurat_tables",
@@ -149,13 +151,13 @@ def stream_states(seed: int | np.random.SeedSequence, streams: int = STREAMS) ->
 # typed a copy at each of their ~40 call sites and cost the Monte-Carlo kernel ~4 s of its first
 # compile (docs/numba.md). zig_slow, with one call site, stays inlined.
 # ------------------------------------------------------------------------------------------------
-@njit(cache=True, nogil=True)
+@kernel
 def _rotl(x, k):  # pragma: no cover - compiled
     """``x`` rotated left by ``k`` bits (both uint64: one signature, no literal ints)."""
     return (x << k) | (x >> (uint64(64) - k))
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def next_u64(s0, s1, s2, s3):  # pragma: no cover - compiled
     """xoshiro256++: ``(output, s0, s1, s2, s3)``."""
     r = _rotl(s0 + s3, uint64(23)) + s0
@@ -169,13 +171,13 @@ def next_u64(s0, s1, s2, s3):  # pragma: no cover - compiled
     return r, s0, s1, s2, s3
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def u64_to_unit(r):  # pragma: no cover - compiled
     """Uniform ``[0, 1)`` from the top 53 bits."""
     return float(r >> uint64(11)) * _INV_2_53
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def zig_fast(r, k, w):  # pragma: no cover - compiled
     """Fast path of the ziggurat: ``(x, accepted, layer, v)`` from one 64-bit output."""
     idx = int64(r & uint64(0xFF))  # int64, as the layer index zig_slow is also called with

@@ -28,7 +28,8 @@ import hashlib
 from pathlib import Path
 
 import numpy as np
-from numba import njit
+
+from gearte._jit import inner_kernel, kernel
 
 __all__ = [
     "rv_rhs",
@@ -170,7 +171,7 @@ def kernel_table(inv_mass, err_g, err_m, err_mn, err_n, geo_m, geo_n, clear, fsp
     return np.concatenate([a.ravel() for a in parts])
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _bearing(dx, dy, vx, vy, k, c, cl):
     """Force (on body a) of an isotropic bearing with radial clearance cl; returns fx, fy."""
     if cl <= 0.0:
@@ -182,7 +183,7 @@ def _bearing(dx, dy, vx, vy, k, c, cl):
     return -s * dx - c * vx, -s * dy - c * vy
 
 
-@njit(cache=True, nogil=True)
+@inner_kernel
 def _fourier2(mean, tab, o, n, c1, s1):
     """mean + Σ_l a_l cos(l s) + b_l sin(l s) given cos s and sin s (angle-addition recurrence);
     a_l = ``tab[o + l]``, b_l = ``tab[o + n + l]`` (l < n)."""
@@ -198,7 +199,7 @@ def _fourier2(mean, tab, o, n, c1, s1):
 # no_rewrites (a numba target option its type stubs do not list): numba's IR rewrite passes
 # (array expressions, constant getitems, raises) find nothing to rewrite in this kernel; skipping
 # them saves ~10 % of its compile's Python work, for the same LLVM IR
-@njit(cache=True, nogil=True, no_rewrites=True)  # type: ignore[call-overload]
+@kernel(no_rewrites=True)
 def rv_rhs(t, y, args, dydt, work):
     """dy/dt of the lumped RV model at time ``t`` [s], written into ``dydt`` (compiled; plain twin:
     ``RVDynamicModel.rhs_numpy``).
@@ -494,7 +495,7 @@ def rv_rhs(t, y, args, dydt, work):
         f[i3] *= tab[i3]
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def rv_dte(t, y, args):
     """Dynamic transmission error θ_o − θ_s / i [rad] of state ``y`` at time ``t`` [s]; ``args``
     as for :func:`rv_rhs`."""
