@@ -16,8 +16,10 @@ alternated pairs, every pair 0.8–1.1 s less; ``docs/numba.md``, "The wrappers 
 beside every kernel"). The compiled code, and so every result, is the same.
 
 An inner kernel has no compiled entry for a call from Python (numba would jump to a null
-address: a segmentation fault). :func:`inner_kernel` therefore gives it the class
-:class:`InnerKernel`, whose call from Python runs the kernel's Python code (``py_func``, as
+address: a segmentation fault). :func:`inner_kernel` therefore makes it an
+:class:`InnerKernel` (a subclass of numba's CPU dispatcher, built the way numba builds its
+own; no object's class is swapped), whose call from Python runs the kernel's Python code
+(``py_func``, as
 :func:`gearte.solvers.twins.plain_twins` does): a Python caller gets the result — at Python
 speed — and never a crash. A kernel that Python code calls (a solver's entry point, a function
 tested compiled from Python) is a :func:`kernel`.
@@ -69,8 +71,19 @@ def inner_kernel(fn: Callable[..., Any]) -> Any:
     InnerKernel
         The numba dispatcher.
     """
-    dispatcher = _njit(cache=True, nogil=True, no_cpython_wrapper=True, no_cfunc_wrapper=True)(fn)
-    dispatcher.__class__ = InnerKernel
+    from numba import config
+
+    if getattr(config, "DISABLE_JIT", False):  # as numba's own decorator: the function itself
+        return fn
+    # made as numba's ``njit`` makes a dispatcher (``numba.core.decorators._jit``), with this
+    # subclass of the CPU target's dispatcher class: no object's class is changed afterwards
+    dispatcher = InnerKernel(
+        py_func=fn,
+        locals={},
+        targetoptions={"nopython": True, "boundscheck": None, "nogil": True,
+                       "no_cpython_wrapper": True, "no_cfunc_wrapper": True},
+    )  # fmt: skip
+    dispatcher.enable_caching()
     return dispatcher
 
 
