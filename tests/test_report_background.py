@@ -247,12 +247,15 @@ def _report_side(case: str, samples: int, *, numba_first: bool, preload: bool):
     return result, numba, html.removesuffix("\n")
 
 
-@pytest.mark.parametrize("case", ["wang2013_2kh_eq9", "wang2013_2kh_eq9_yield"])
-def test_planetary_report_is_drawn_without_importing_numba(case: str) -> None:
-    """The report process of a kind whose plotting module says ``NUMBA_FREE_RESULTS``
-    imports none of the parent's modules: unpickling the case and every analysis, drawing the
-    figures early and rendering the page import no numba (~0.5 s CPU beside the analyses); the
-    page (the histogram built alone after the result: ``OTHERS_READ_ALONE``) is the page drawn
+@pytest.mark.parametrize(
+    "case", ["wang2013_2kh_eq9", "wang2013_2kh_eq9_yield", "hu2020_rv80e_initial"]
+)
+def test_numba_free_report_is_drawn_without_importing_numba(case: str) -> None:
+    """The report process of a kind whose plotting module says ``NUMBA_FREE_RESULTS`` (the
+    planetary and the cycloid-stage kinds) imports none of the parent's modules: unpickling
+    the case and every analysis, drawing the figures early and rendering the page import no
+    numba (~0.5 s CPU beside the analyses); the page (for the planetary kind the histogram
+    built alone after the result: ``OTHERS_READ_ALONE``) is the page drawn
     in one process from the whole result."""
     from gearte.report.background import _plotting_module
     from gearte.report.html import render_report
@@ -264,7 +267,7 @@ def test_planetary_report_is_drawn_without_importing_numba(case: str) -> None:
     assert _page(html) == _page(render_report(result))
 
 
-@pytest.mark.parametrize("case", ["hu2020_rv80e_initial", "li2023_rv_errors"])
+@pytest.mark.parametrize("case", ["hu2020_rv80e_initial_reducer", "li2023_rv_errors"])
 def test_report_process_of_kernel_results_draws_the_same_page(case: str) -> None:
     """The report process of a kind whose results live in modules that define kernels (tooth
     contact, load sharing, TE, catalogue, mesh contact, modal, DTE, ODE results) imports the

@@ -17,10 +17,18 @@ __all__ = [
     "contact_figures",
     "sensitivity_figure",
     "pareto_figure",
+    "SELF_CONTAINED",
+    "NUMBA_FREE_RESULTS",
 ]
 
 #: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`).
 SELF_CONTAINED = frozenset({"geometry", "geometric_te", "tooth_contact"}) | _YIELD
+
+#: A result of this kind unpickles and its figures draw without numba (the tooth contact's record
+#: lives in :mod:`gearte.models.cycloid_contact_record`, apart from its kernels): the report
+#: process is forked before the parent imports numba and imports none of the parent's kernel
+#: modules (tests/test_report_background.py checks it).
+NUMBA_FREE_RESULTS = True
 
 
 def _exaggeration(max_dev_mm: float, tooth_height_mm: float) -> float:

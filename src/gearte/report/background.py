@@ -102,7 +102,7 @@ def _import_numba_for(case: Any) -> None:
     plotting module).
 
     The report process unpickles analyses whose result classes live in modules that define
-    kernels (``LoadSharing``, ``ODEResult``, ``ToothContact``, ...), so it imports numba; this
+    kernels (the RV kinds' ``LoadSharing``, ``ODEResult``, ...), so it imports numba; this
     process imports it anyway for its kernels. Imported once before the fork, the report process
     inherits it (copy-on-write) instead of importing it a second time (~0.15 s CPU). Nothing is
     compiled or started here: importing numba starts no thread, so the fork stays safe."""
