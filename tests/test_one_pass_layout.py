@@ -142,3 +142,43 @@ def test_a_user_figure_keeps_constrained_layout_until_the_report_draws_it():
 
     fig, _ = _line_figure()
     assert isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine)
+
+
+def test_the_margins_are_measured_in_one_pass_with_the_places_of_two(monkeypatch):
+    """Tight layout with a ``rect`` (its default, the whole figure) measures every label a
+    second time to fit the margins into the rect; the one-pass layout asks for none (one
+    measuring pass) and gets the same margins to 1e-9 of the figure."""
+    import warnings
+
+    import matplotlib as mpl
+    from matplotlib.layout_engine import TightLayoutEngine
+    from matplotlib.text import Text
+
+    calls = []
+    layout = Text._get_layout
+
+    def counting(self: Any, renderer: Any) -> Any:
+        calls.append(1)
+        return layout(self, renderer)
+
+    monkeypatch.setattr(Text, "_get_layout", counting)
+    fig, _ = _line_figure(2, 2, twin=True)
+    assert one_pass_layout(fig)
+    once = len(calls)
+    calls.clear()
+    other, _ = _line_figure(2, 2, twin=True)
+    pads = other.get_layout_engine().get()
+    fontsize = mpl.font_manager.FontProperties(size=mpl.rcParams["font.size"]).get_size_in_points()
+    two = TightLayoutEngine(
+        pad=72.0 * max(pads["w_pad"], pads["h_pad"]) / fontsize,
+        w_pad=72.0 * pads["w_pad"] / fontsize,
+        h_pad=72.0 * pads["h_pad"] / fontsize,
+    )  # rect (0, 0, 1, 1)
+    other.set_layout_engine(None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        two.execute(other)
+    assert len(calls) > 1.8 * once
+    for name in ("left", "right", "top", "bottom", "wspace", "hspace"):
+        a, b = getattr(fig.subplotpars, name), getattr(other.subplotpars, name)
+        assert abs(a - b) < 1e-9, name

@@ -194,6 +194,9 @@ def one_pass_layout(fig: Any) -> bool:
         pad=72.0 * max(pads["w_pad"], pads["h_pad"]) / fontsize,
         w_pad=72.0 * pads["w_pad"] / fontsize,
         h_pad=72.0 * pads["h_pad"] / fontsize,
+        # the margins of one measuring pass: with a rect (the default (0, 0, 1, 1)) tight
+        # layout measures every label a second time to fit the result into the rect
+        rect=None,
     )
     with mpl.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
         fig.set_layout_engine(None)  # (subplots_adjust is refused under constrained layout)
