@@ -164,7 +164,7 @@ def one_pass_layout(fig: Any) -> bool:
     (once without rendering, to run the layout, then for real): on gearte's report figures that
     is about a third of the Python calls of drawing one (``docs/report.md``, "Drawing a figure
     once"). Here the decorations are measured once by matplotlib's tight layout
-    (:class:`matplotlib.layout_engine.TightLayoutEngine`, run once: each axes' tight box, the
+    (:meth:`matplotlib.figure.Figure.tight_layout`, one pass: each axes' tight box, the
     room it needs on each side, the margins shared by a row or column of the grid, set with
     ``subplots_adjust``), with the pads of constrained layout, and the layout engine removed, so
     ``savefig`` draws once.
@@ -178,7 +178,7 @@ def one_pass_layout(fig: Any) -> bool:
     import warnings
 
     import matplotlib as mpl
-    from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     engine = fig.get_layout_engine()
     # "compressed" is ConstrainedLayoutEngine(compress=True); read where the engine keeps it
@@ -190,19 +190,19 @@ def one_pass_layout(fig: Any) -> bool:
         return False
     pads = engine.get()
     fontsize = mpl.font_manager.FontProperties(size=mpl.rcParams["font.size"]).get_size_in_points()
-    tight = TightLayoutEngine(
-        pad=72.0 * max(pads["w_pad"], pads["h_pad"]) / fontsize,
-        w_pad=72.0 * pads["w_pad"] / fontsize,
-        h_pad=72.0 * pads["h_pad"] / fontsize,
-        # the margins of one measuring pass: with a rect (the default (0, 0, 1, 1)) tight
-        # layout measures every label a second time to fit the result into the rect
-        rect=None,
-    )
+    pad = 72.0 * max(pads["w_pad"], pads["h_pad"]) / fontsize
+    w_pad, h_pad = 72.0 * pads["w_pad"] / fontsize, 72.0 * pads["h_pad"] / fontsize
     with mpl.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
         fig.set_layout_engine(None)  # (subplots_adjust is refused under constrained layout)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        tight.execute(fig)
+        # Figure.tight_layout without a rect: one measuring pass (TightLayoutEngine's own
+        # default rect, the whole figure, makes tight layout measure every label a second
+        # time to fit the same margins into it); it leaves a place-holder engine behind, which
+        # would make savefig draw twice: removed below
+        fig.tight_layout(pad=pad, w_pad=w_pad, h_pad=h_pad)
+    with mpl.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(None)
     if caught:  # tight layout found no margins and set nothing: constrained layout again
         fig.set_layout_engine(engine)
         return False
