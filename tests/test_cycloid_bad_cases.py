@@ -213,3 +213,14 @@ def test_cycloid_stage_api_raises_only_parameter_error(z_p, r_p, r_rp, a, b, dr_
         return
     assert 0 < stage.K1 < 1
     assert stage.root_radius < stage.tip_radius
+
+
+@pytest.mark.parametrize("a", [1e-300, 5e-324, 1e-9])
+def test_an_eccentricity_lost_to_round_off_is_refused(a):
+    """An eccentricity far below any drive's (the random search above once found a = 1e-300 mm,
+    where the root radius equals the tip radius in floating point) is refused, naming ``a``."""
+    from gearte.geometry.cycloid import CycloidStage
+
+    with pytest.raises(ParameterError) as err:
+        CycloidStage(z_p=40, r_p=76.0, r_rp=3.0, a=a, b=11.0)
+    assert err.value.field == "a" and "eccentricity" in err.value.reason

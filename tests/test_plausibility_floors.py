@@ -32,6 +32,8 @@ KEYS = [
     ("li2023_rv", "reducer.dynamics.input_torsional_stiffness_Nm_per_rad", "torsional_stiffness"),
     ("li2023_rv", "reducer.dynamics.crank_torsional_stiffness_Nm_per_rad", "torsional_stiffness"),
     ("han2023_rv110e_no_errors", "reducer.cranks.cam_bearing.roller_length_mm", "part_length"),
+    ("han2023_rv110e_no_errors", "reducer.cranks.eccentricity_mm", "eccentricity"),
+    ("hu2020_rv80e_initial", "stage.eccentricity_mm", "eccentricity"),
     (
         "han2023_rv110e_yield",  # the no_errors case linearises at rated torque
         "reducer.cranks.cam_bearing.reference_load_N",

@@ -84,6 +84,12 @@ FLOORS: dict[str, tuple[float, str, str]] = {
         "mm",
         "thinner than any gear, disc or bearing roller (needle rollers start at about 1 mm)",
     ),
+    "eccentricity": (
+        1e-3,
+        "mm",
+        "no cycloid or crank eccentricity is below 0.2 mm; far below it the tooth height 2a "
+        "is lost to the round-off of the radii (the root radius equals the tip radius)",
+    ),
     "bearing_reference_load": (
         1.0,
         "N",

@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from gearte.errors import ParameterError
+from gearte.limits import check_floor
 
 __all__ = [
     "CycloidStage",
@@ -921,6 +922,7 @@ class CycloidStage:
         for name in ("r_p", "r_rp", "a", "b"):
             if getattr(self, name) <= 0.0:
                 raise ParameterError(name, getattr(self, name), "must be > 0")
+        check_floor("a", self.a, "eccentricity", unit="mm")
         if self.r_rp + self.dr_rp <= 0.0:
             raise ParameterError(
                 "dr_rp", self.dr_rp, f"r_rp + dr_rp must be > 0 (r_rp = {self.r_rp})"

@@ -94,7 +94,7 @@ class Stage(_Section):
     )
     pin_circle_radius_mm: float = Field(gt=0, le=5000, description="Pin-centre-circle radius r_p.")
     pin_radius_mm: float = Field(gt=0, le=500, description="Pin radius r_rp.")
-    eccentricity_mm: float = Field(gt=0, le=200, description="Eccentricity a.")
+    eccentricity_mm: float = floored("eccentricity", le=200, description="Eccentricity a.")
     face_width_mm: float = floored(
         "part_length", ..., le=1000, description="Face width b of one disc."
     )

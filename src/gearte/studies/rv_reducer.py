@@ -457,7 +457,9 @@ class CranksSection(StrictModel):
     circle_radius_mm: float = Field(
         gt=0, le=1000, description="Radius of the circle of crank centres on the carrier [mm]."
     )
-    eccentricity_mm: float = Field(gt=0, le=50, description="Crank (cam) eccentricity a [mm].")
+    eccentricity_mm: float = floored(
+        "eccentricity", le=50, description="Crank (cam) eccentricity a [mm]."
+    )
     cam_bearing: Bearing
     carrier_bearing: Bearing
     shaft_diameter_mm: float | None = Field(
