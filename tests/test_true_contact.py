@@ -182,6 +182,8 @@ def test_true_contact_normal_passes_through_the_pin_centre():
 def test_true_contact_remembered_answers_are_fresh_arrays_of_the_callers_shape():
     """Repeated phases are answered from memory: the same values, in the caller's shape, and
     arrays the caller may change without changing the next answer."""
+    from gearte.geometry.cycloid import _REMEMBER_UP_TO
+
     phi = np.linspace(0.1, 0.9, 12).reshape(3, 4)
     kw = {"z_p": 40, "r_p": 76.0, "a": 1.5, "dr_p": -0.0437}
     first = true_contact(phi, **kw)
@@ -193,6 +195,6 @@ def test_true_contact_remembered_answers_are_fresh_arrays_of_the_callers_shape()
     for v, e in zip(again, expect, strict=True):
         assert v.shape == (12,)
         np.testing.assert_array_equal(v, e.ravel())
-    big = np.linspace(-3.0, 3.0, (1 << 16) + 1)  # above the size that is remembered
+    big = np.linspace(-3.0, 3.0, _REMEMBER_UP_TO + 1)  # above the size that is remembered
     t_big = true_contact(big, **kw)[0]
     np.testing.assert_array_equal(t_big[:1], true_contact(big[:1], **kw)[0])

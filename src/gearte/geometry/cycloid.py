@@ -514,11 +514,12 @@ def true_contact(
     return tuple(v.reshape(phi_in.shape).copy() for v in out)  # type: ignore[return-value]
 
 
-#: Phase arrays up to this size [-] are remembered by :func:`true_contact` (64 of them).
-_REMEMBER_UP_TO = 1 << 16
+#: Phase arrays up to this size [-] are remembered by :func:`true_contact`, the last 32 of them
+#: (at most 32 MB: phases and three answers; the RV cases' arrays are 320-28 800 phases).
+_REMEMBER_UP_TO = 1 << 15
 
 
-@functools.lru_cache(maxsize=64)
+@functools.lru_cache(maxsize=32)
 def _true_contact_flat(
     phi_bytes: bytes, z_p: int, r_p: float, a: float, dr_p: float, tol: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
