@@ -150,9 +150,10 @@ def test_the_margins_are_measured_in_one_pass_with_the_places_of_two(monkeypatch
     measuring pass) and gets the same margins to 1e-9 of the figure."""
     import warnings
 
-    import matplotlib as mpl
     from matplotlib.layout_engine import TightLayoutEngine
     from matplotlib.text import Text
+
+    from gearte.plotting.display import _tight_pads
 
     calls = []
     layout = Text._get_layout
@@ -167,13 +168,7 @@ def test_the_margins_are_measured_in_one_pass_with_the_places_of_two(monkeypatch
     once = len(calls)
     calls.clear()
     other, _ = _line_figure(2, 2, twin=True)
-    pads = other.get_layout_engine().get()
-    fontsize = mpl.font_manager.FontProperties(size=mpl.rcParams["font.size"]).get_size_in_points()
-    two = TightLayoutEngine(
-        pad=72.0 * max(pads["w_pad"], pads["h_pad"]) / fontsize,
-        w_pad=72.0 * pads["w_pad"] / fontsize,
-        h_pad=72.0 * pads["h_pad"] / fontsize,
-    )  # rect (0, 0, 1, 1)
+    two = TightLayoutEngine(**_tight_pads(other.get_layout_engine()))  # rect (0, 0, 1, 1)
     other.set_layout_engine(None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

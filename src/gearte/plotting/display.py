@@ -154,6 +154,26 @@ def _legends_outside(fig: Any) -> None:
         )
 
 
+def _tight_pads(engine: Any) -> dict[str, float]:
+    """The pads of a constrained-layout ``engine`` (``w_pad``, ``h_pad`` [inch]) as tight layout
+    takes them (``pad``, ``w_pad``, ``h_pad`` [fractions of the font size], ``pad`` the larger),
+    for :func:`one_pass_layout`."""
+    import matplotlib as mpl
+
+    pads = engine.get()
+    fontsize = mpl.font_manager.FontProperties(size=mpl.rcParams["font.size"]).get_size_in_points()
+    w_pad, h_pad = 72.0 * pads["w_pad"] / fontsize, 72.0 * pads["h_pad"] / fontsize
+    return {"pad": max(w_pad, h_pad), "w_pad": w_pad, "h_pad": h_pad}
+
+
+def _drop_layout_engine(fig: Any) -> None:
+    """Leave ``fig`` without a layout engine (not the one the rc parameters would give it)."""
+    import matplotlib as mpl
+
+    with mpl.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(None)
+
+
 def one_pass_layout(fig: Any) -> bool:
     """Replace the constrained layout of ``fig`` (a matplotlib figure) by margins measured once,
     where that gives the same picture; True where it did, False where the figure is left as it
@@ -177,7 +197,6 @@ def one_pass_layout(fig: Any) -> bool:
     """
     import warnings
 
-    import matplotlib as mpl
     from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     engine = fig.get_layout_engine()
@@ -188,21 +207,15 @@ def one_pass_layout(fig: Any) -> bool:
         return False
     if any(ax.get_subplotspec() is None for ax in fig.axes):
         return False
-    pads = engine.get()
-    fontsize = mpl.font_manager.FontProperties(size=mpl.rcParams["font.size"]).get_size_in_points()
-    pad = 72.0 * max(pads["w_pad"], pads["h_pad"]) / fontsize
-    w_pad, h_pad = 72.0 * pads["w_pad"] / fontsize, 72.0 * pads["h_pad"] / fontsize
-    with mpl.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
-        fig.set_layout_engine(None)  # (subplots_adjust is refused under constrained layout)
+    _drop_layout_engine(fig)  # (subplots_adjust is refused under constrained layout)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         # Figure.tight_layout without a rect: one measuring pass (TightLayoutEngine's own
         # default rect, the whole figure, makes tight layout measure every label a second
         # time to fit the same margins into it); it leaves a place-holder engine behind, which
-        # would make savefig draw twice: removed below
-        fig.tight_layout(pad=pad, w_pad=w_pad, h_pad=h_pad)
-    with mpl.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
-        fig.set_layout_engine(None)
+        # would make savefig draw twice: dropped below
+        fig.tight_layout(**_tight_pads(engine))
+    _drop_layout_engine(fig)
     if caught:  # tight layout found no margins and set nothing: constrained layout again
         fig.set_layout_engine(engine)
         return False
