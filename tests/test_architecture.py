@@ -24,6 +24,7 @@ LAYERS: list[tuple[str, ...]] = [
     (
         "gearte._version",
         "gearte._blas",
+        "gearte._frames",
         "gearte._gc",
         "gearte._jit",
         "gearte.errors",

@@ -218,7 +218,20 @@ def run_case(
         The run was stopped (SIGINT/SIGTERM) or lost its cluster during sampled work after
         chunks had finished: ``exc.partial`` is the result computed from the finished chunks,
         marked partial (``result.partial``, first warning), see :mod:`gearte.execution.stop`.
+
+    Notes
+    -----
+    The run happens inside :func:`gearte._frames.with_frame_room`: its loops never pay CPython
+    3.11's frame-stack chunk allocation per call, wherever the caller's frames end.
     """
+    from gearte._frames import with_frame_room
+
+    return with_frame_room(lambda: _run_case(case, options))
+
+
+def _run_case(
+    case: CaseBase | str | os.PathLike[str] | dict[str, Any], options: RunOptions | None
+) -> StudyResult:
     if isinstance(case, str | os.PathLike | dict):
         from gearte.io.case_file import load_case
 
