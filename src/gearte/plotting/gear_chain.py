@@ -26,7 +26,15 @@ __all__ = [
     "chain_diagram",
     "compensation",
     "joint_te",
+    "NUMBA_FREE_RESULTS",
 ]
+
+#: A gear pair's or gear chain's result unpickles and its figures draw without numba (the
+#: Monte-Carlo record lives in :mod:`gearte.tolerance.mc_result`, apart from its kernels; a
+#: chain's RV, cycloid and strain-wave stages keep plain values): the report process is forked
+#: before the parent imports numba and imports none of the parent's kernel modules
+#: (tests/test_report_background.py checks it for every bundled case of both kinds).
+NUMBA_FREE_RESULTS = True
 
 
 def backlash_histogram(backlash: Any, mc: Any, title: str) -> Figure:

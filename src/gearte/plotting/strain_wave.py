@@ -13,10 +13,14 @@ import numpy as np
 from gearte.plotting import PALETTE, Figure, new_figure
 from gearte.plotting.yield_figures import SELF_CONTAINED as _YIELD
 
-__all__ = ["figures", "stiffness_figure", "te_figure", "SELF_CONTAINED"]
+__all__ = ["figures", "stiffness_figure", "te_figure", "SELF_CONTAINED", "NUMBA_FREE_RESULTS"]
 
 #: Each figure reads its own analysis only.
 SELF_CONTAINED = frozenset({"stiffness", "transmission_error"}) | _YIELD
+
+#: A strain-wave result unpickles and its figures draw without numba: the report process is
+#: forked before the parent imports numba (tests/test_report_background.py checks it).
+NUMBA_FREE_RESULTS = True
 
 
 def stiffness_figure(result: Any) -> Figure | None:

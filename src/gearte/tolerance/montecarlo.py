@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -36,6 +36,7 @@ from numba import uint64
 from gearte._jit import kernel
 from gearte.errors import ParameterError
 from gearte.execution import spawn_seeds
+from gearte.tolerance.mc_result import MCResult
 from gearte.tolerance.rng import (
     DRAWS,
     LANES,
@@ -567,46 +568,6 @@ def process_capability(
     if lower is not None:
         sides.append((mean - lower) / (3 * sd))
     return (cp, min(sides) if sides else None)
-
-
-@dataclass
-class MCResult:
-    """Statistics of a Monte-Carlo run.
-
-    Attributes are in the unit of the stacked quantity. ``percentiles`` maps the percent level
-    (e.g. ``0.135``) to the value, read off the histogram (``hist_edges``, ``hist_counts``; the
-    first and last counts are the under- and overflow). ``samples`` holds the first ``keep``
-    samples for plots.
-    """
-
-    n: int
-    mean: float
-    sd: float
-    min: float
-    max: float
-    percentiles: dict[float, float]
-    lower_spec: float | None
-    upper_spec: float | None
-    below_fraction: float
-    above_fraction: float
-    cp: float | None
-    cpk: float | None
-    hist_edges: np.ndarray
-    hist_counts: np.ndarray
-    samples: np.ndarray
-    seed: int
-    chunk_size: int
-    engine: str
-    extra: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def std_error(self) -> float:
-        """Standard error of the mean, ``sd/√n``."""
-        return self.sd / math.sqrt(self.n)
-
-    @property
-    def out_of_spec_fraction(self) -> float:
-        return self.below_fraction + self.above_fraction
 
 
 def _percentiles_from_hist(
