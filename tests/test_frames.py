@@ -50,6 +50,17 @@ def test_the_cli_and_run_case_use_it() -> None:
     assert "with_frame_room(" in inspect.getsource(gearte.studies.run_case)
 
 
+def test_pool_chunks_run_in_the_room() -> None:
+    """A local pool runs each chunk through the room, in threads and in processes, with the
+    chunk's own result."""
+    from gearte.execution import map_chunks
+
+    for scheduler in ("threads", "processes"):
+        out = map_chunks(_chunk_faults, [0, 1, 2], workers=2, scheduler=scheduler, progress=False)
+        assert [o[0] for o in out] == [0, 1, 2]
+        assert max(max(o[1]) for o in out) < CALLS // 10, scheduler
+
+
 CALLS = 2000
 
 
@@ -85,3 +96,9 @@ def test_no_chunk_churn_inside_the_room() -> None:
     if sys.version_info < (3, 13):
         outside = _faults_at_each_depth()
         assert max(outside) >= CALLS, max(outside)
+
+
+def _chunk_faults(task: int) -> tuple[int, list[int]]:
+    """A chunk function (module level: process pools pickle it): the depth scan, in whatever
+    frame the pool runs its chunks."""
+    return task, _faults_at_each_depth()

@@ -23,8 +23,9 @@ public API): entering it allocates one chunk of 1 MiB, of which ~0.5 MiB is free
 frame below it, so a command's frames (recursion included, up to ~1 000 frames) share one
 chunk and no boundary is crossed in its loops. The unused slots are never touched (no page
 is faulted in for them) and are not scanned by the garbage collector; results are unchanged.
-The CLI runs each command through it (:func:`gearte.cli._guarded`); the report process and the
-local worker processes forked from it inherit the room.
+The ``gearte`` command runs through it (:func:`gearte.cli.entry`; the report process forked
+from it inherits the room), so does :func:`gearte.run_case`, and the local pools run each chunk
+through it in their worker threads and processes (``execution.backends._in_frame_room``).
 """
 
 from __future__ import annotations

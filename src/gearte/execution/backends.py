@@ -23,6 +23,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 from urllib.parse import urlsplit
 
+from gearte._frames import with_frame_room
 from gearte.errors import ClusterLostError, ParameterError, SchedulerError
 from gearte.execution.stop import POLL_S, signals_deferred
 from gearte.execution.streams import default_workers
@@ -141,6 +142,13 @@ class SequentialExecutor(ChunkExecutor):
         return _SequentialBatch((shared,) if has_shared else ())
 
 
+def _in_frame_room(func: Callable[..., Any], *args: Any) -> Any:
+    """``func(*args)`` in a pool worker (thread or process), inside one roomy frame of CPython's
+    frame stack (:mod:`gearte._frames`): a chunk's loops never allocate a stack chunk per call,
+    whatever the worker's frames below."""
+    return with_frame_room(lambda: func(*args))
+
+
 class _PoolBatch(Batch):
     def __init__(self, executor: PoolExecutor, extra: tuple[Any, ...]) -> None:
         super().__init__(extra)
@@ -149,7 +157,7 @@ class _PoolBatch(Batch):
 
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
         with signals_deferred():  # the pool's locks: no interrupt inside (gearte.execution.stop)
-            fut = self._ex._pool.submit(func, task, *self.extra)
+            fut = self._ex._pool.submit(_in_frame_room, func, task, *self.extra)
             self.pending[fut] = index
             self._jobs[fut] = (func, task, self._ex._generation)
 
