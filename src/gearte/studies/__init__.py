@@ -331,6 +331,13 @@ def _numba_timer() -> Iterator[dict[str, float]]:
 
     hook = None
     if "numba" in sys.modules:
+        # another thread (a sweep's or a yield's other point) may still be importing numba:
+        # wait for that import to finish before importing its submodules here. start() importing
+        # numba.core.event while the other thread was inside numba/__init__ made the import
+        # system hand one of them a partially initialised module ("numba.core.event has no
+        # attribute 'start_event'", or a stalled sweep)
+        import numba  # noqa: F401
+
         start()
     else:
         hook = _AfterImport("numba", out, start)
