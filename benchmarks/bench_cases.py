@@ -75,9 +75,7 @@ def run_once(case: str, cache_dir: str, out_dir: str) -> dict[str, float]:
     for k, v in t.items():
         if k.startswith(("numba", "imports: numba")):  # its import and cache load / compile
             out["numba"] += v
-            if k.endswith(": before the report process"):
-                pass  # its own interval (before the report process's fork)
-            elif not k.endswith(": preflight"):
+            if not k.endswith(": preflight"):
                 in_analyses += v
             else:  # inside the preflight's interval
                 out["imports"] -= v

@@ -390,7 +390,8 @@ def run(
         if not no_report:
             from gearte.report.background import ReportWorker
 
-            renderer = ReportWorker.start(case)  # (numba imported first, for both processes)
+            # (numba imported first, for both processes, where the kind's results need it)
+            renderer = ReportWorker.start(case)
         t1b = time.perf_counter()
         try:
             beat.stage("loading the case")
@@ -422,7 +423,7 @@ def run(
                     raise
             result.timings = {
                 "imports: gearte": t1 - t0,
-                "imports: numba: before the report process": t1b - t1,
+                "imports: before the report process": t1b - t1,
                 "load case": t2 - t1b,
                 **result.timings,
             }

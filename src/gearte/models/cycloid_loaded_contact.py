@@ -22,7 +22,7 @@ doi:10.3390/machines11060626
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -38,6 +38,7 @@ from gearte.models.contact_law import (
     law_coefficients,
     max_contact_pressure,
 )
+from gearte.models.cycloid_loaded_contact_record import LoadedContact, MeshPeriodContact
 from gearte.solvers.contact import solve_rotation as _solve_rotation
 
 __all__ = [
@@ -368,41 +369,6 @@ def hertz_line_force(
     return force_from_coefficients(deflection_mm, a0, a1, rtol=rtol)
 
 
-@dataclass(frozen=True)
-class LoadedContact:
-    """Loaded contact at one or more mesh positions (arrays over positions × pins).
-
-    Attributes (units in brackets)
-    ----------------------------------
-    phi : meshing phase of each pin [rad], shape (n_pos, z_p)
-    arm : l_i [mm]; clearance : Δ_i [mm]; backlash : φ_bl,i [rad]
-    force : F_i [N] (0 out of contact); in_contact : bool mask
-    rotation : Δφ_c, elastic rotation from first contact [rad], shape (n_pos,)
-    tangential_force, radial_force : F_t, F_r [N] (eq 5, F_r summed without sign as printed)
-    radial_force_signed : Σ F_i (K1 − cos φ_i)/S_i [N], the physical resultant's radial part
-    pressure_angle : β = atan(F_r/F_t) [rad] (eq 7)
-    mesh_stiffness : k_cr = F_cr / (r_c Δφ_c cos β) [N/mm] (eq 7, reading A)
-    torsional_stiffness : T / Δφ_c [N·mm/rad]
-    pressure : Hertz pressure of each pin with its own flank curvature [MPa] (0 out of contact)
-    """
-
-    phi: np.ndarray
-    arm: np.ndarray
-    clearance: np.ndarray
-    backlash: np.ndarray
-    force: np.ndarray
-    in_contact: np.ndarray
-    rotation: np.ndarray
-    tangential_force: np.ndarray
-    radial_force: np.ndarray
-    radial_force_signed: np.ndarray
-    pressure_angle: np.ndarray
-    mesh_stiffness: np.ndarray
-    torsional_stiffness: np.ndarray
-    pins_in_contact: np.ndarray = field(default=None)  # type: ignore[arg-type]  # set in __post_init__
-    pressure: np.ndarray = field(default=None)  # type: ignore[arg-type]  # set by loaded_contact
-
-
 def solve_rotation(
     arm: np.ndarray,
     clearance: np.ndarray,
@@ -558,33 +524,6 @@ def loaded_contact(
             pair.face_width_mm,
         ),
     )
-
-
-@dataclass(frozen=True)
-class MeshPeriodContact:
-    """Equivalent pressure angle and mesh stiffness over one mesh period (paper 004 Fig 9)."""
-
-    mesh_position: np.ndarray  # [rad], over [0, 2π/z_p)
-    pressure_angle: np.ndarray  # β [rad]
-    mesh_stiffness: np.ndarray  # k_cr [N/mm]
-    pins_in_contact: np.ndarray
-    max_force: np.ndarray  # [N]
-    contact: LoadedContact
-
-    @property
-    def max_contact_pressure(self) -> float:
-        """Largest Hertz pin pressure over the mesh period [MPa]."""
-        return float(np.max(self.contact.pressure))
-
-    @property
-    def pressure_angle_mean(self) -> float:
-        """Mean β over the mesh period [rad]."""
-        return float(np.mean(self.pressure_angle))
-
-    @property
-    def mesh_stiffness_mean(self) -> float:
-        """Mean k_cr over the mesh period [N/mm]."""
-        return float(np.mean(self.mesh_stiffness))
 
 
 def mesh_period_contact(

@@ -25,8 +25,6 @@ These are stated limitations, not fitted quantities.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -40,6 +38,7 @@ from gearte.models.rv_load_sharing import (
     contact_law,
     solver_law,
 )
+from gearte.models.rv_records import CatalogueValues, TorsionTest
 from gearte.solvers.rv_batch import solve_positions
 from gearte.solvers.rv_equilibrium import ContactLaw
 
@@ -97,19 +96,6 @@ def torque_path(turning_points: ArrayLike, steps_per_segment: int = 20) -> np.nd
             seg = np.sort(np.concatenate([seg, [0.0]]))[:: 1 if b > a else -1]
         pieces.append(seg)
     return np.concatenate(pieces)
-
-
-@dataclass(frozen=True)
-class TorsionTest:
-    """Output torsion angle along a torque path (input locked).
-
-    Attributes
-    ----------
-    torque : (K,) [N·mm]; angle : (K,) output torsion angle [rad] (positive with the torque).
-    """
-
-    torque: np.ndarray
-    angle: np.ndarray
 
 
 def _rated(reducer: RVReducer) -> float:
@@ -256,24 +242,6 @@ def backlash(
     pos = -solve_positions(system, eps, slaw).q[:, out]
     neg = -solve_positions(system, -eps, slaw).q[:, out]
     return float(np.min(pos - neg))
-
-
-@dataclass(frozen=True)
-class CatalogueValues:
-    """Catalogue quantities [N·mm/rad, rad] and the curves they were read from.
-
-    ``loop`` is the virtual hysteresis loop the quantities are read from by the shared
-    definitions of :mod:`gearte.models.catalogue` (exactly as from a measured curve); ``curve``
-    is the dense sweep for plots.
-    """
-
-    torsional_rigidity: float
-    lost_motion: float
-    backlash: float
-    hysteresis_loss: float
-    curve: TorsionTest
-    loop: TorsionTest | None = None
-    loop_direction: np.ndarray | None = None
 
 
 def virtual_loop(

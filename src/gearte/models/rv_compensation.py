@@ -24,14 +24,14 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from dataclasses import dataclass
 
 import numpy as np
 
 from gearte.errors import ParameterError
 from gearte.geometry.rv import PinRing, RVReducer
 from gearte.models.rv_catalogue import backlash
-from gearte.models.rv_load_sharing import LoadSharing, output_positions, transmission_error
+from gearte.models.rv_load_sharing import output_positions, transmission_error
+from gearte.models.rv_records import Compensation, DesignPoint
 
 __all__ = ["VARIABLES", "apply_changes", "DesignPoint", "Compensation", "compensate"]
 
@@ -59,31 +59,6 @@ def apply_changes(reducer: RVReducer, changes: dict[str, float]) -> RVReducer:
         p.tangential_position_errors,
     )
     return reducer.replace(discs=discs, pins=pins)
-
-
-@dataclass(frozen=True)
-class DesignPoint:
-    """A design and what the model predicts for it (angles [rad], forces [N])."""
-
-    changes: dict[str, float]
-    total_te_peak_to_peak: float
-    mean_lag: float
-    backlash: float
-    peak_pin_load: float
-    pairs_in_mesh_min: int
-    pairs_in_mesh_max: int
-    load: LoadSharing
-
-
-@dataclass(frozen=True)
-class Compensation:
-    """Before/after of a compensation."""
-
-    before: DesignPoint
-    after: DesignPoint
-    objective: str
-    min_backlash: float
-    evaluations: int
 
 
 def _evaluate(reducer, changes, torque, theta) -> DesignPoint:

@@ -67,6 +67,7 @@ from gearte.models.contact_law import (
     law_coefficients,
     max_contact_pressure,
 )
+from gearte.models.rv_records import LoadSharing, TransmissionError
 from gearte.solvers.rv_batch import solve_positions, solve_system
 from gearte.solvers.rv_equilibrium import (
     CLEARANCE_RESIDUAL,
@@ -814,56 +815,6 @@ def assemble(reducer: RVReducer, theta: ArrayLike) -> RVSystem:
 # ------------------------------------------------------------------------------------------
 # Analyses over one output revolution
 # ------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class LoadSharing:
-    """Quasi-static load sharing over output positions.
-
-    Attributes
-    ----------
-    theta : (P,) output angles [rad].
-    torque : float
-        Output torque [N·mm].
-    pin_force : (P, N, z_p) contact force of every pin on every disc [N].
-    pairs_in_mesh : (P, N) loaded pins per disc [-].
-    cam_bearing_load : (P, M, N) radial load of each crank's cam bearing in each disc [N].
-    carrier_bearing_load : (P, M) radial load of each crank's bearing in the carrier [N].
-    mesh_force : (P, M) sun–planet mesh force [N].
-    disc_torque : (P, N) moment of the pin forces about each disc centre [N·mm].
-    output_error : (P,) output angle error ``theta_actual − theta_nominal`` [rad]
-        (negative = output lags).
-    contact_stiffness : (P, N) secant pin stiffness per disc [N/mm].
-    q : (P, nd) all displacements [mm, rad].
-    contact_pressure : (P, N, z_p) Hertz pressure of every pin with its own flank curvature [MPa].
-    contact_law : str
-        Name of the pin-contact law used.
-    pin_phase : (P, N, z_p) meshing phase of every pin [rad]: its angle from the line of
-        centres (the disc's eccentric direction), as :func:`contact_phase`.
-    """
-
-    theta: np.ndarray
-    torque: float
-    pin_force: np.ndarray
-    pairs_in_mesh: np.ndarray
-    cam_bearing_load: np.ndarray
-    carrier_bearing_load: np.ndarray
-    mesh_force: np.ndarray
-    disc_torque: np.ndarray
-    output_error: np.ndarray
-    contact_stiffness: np.ndarray
-    q: np.ndarray
-    contact_pressure: np.ndarray
-    contact_law: str
-    pin_phase: np.ndarray | None = None
-
-    @property
-    def peak_pin_load(self) -> float:
-        """Largest pin force over the revolution [N]."""
-        return float(self.pin_force.max())
-
-    @property
-    def max_contact_pressure(self) -> float:
-        """Largest Hertz pin pressure over the revolution [MPa]."""
-        return float(np.max(self.contact_pressure))
 
 
 def _postprocess(
@@ -1176,33 +1127,6 @@ def mesh_period(reducer: RVReducer) -> float:
         The mesh period of the output angle [rad].
     """
     return 2.0 * np.pi / (reducer.pins.count * reducer.cycloid_teeth)
-
-
-@dataclass(frozen=True)
-class TransmissionError:
-    """Loaded output angle error over a revolution, split into geometric and elastic parts.
-
-    ``total = geometric + elastic``; geometric is the output angle error at (nearly) zero load
-    ``zero_load_torque`` (errors, clearances and the preload they cause), elastic the rest.
-    All [rad]. ``theta, total, geometric, elastic`` are on the requested positions (for plots);
-    ``*_pp`` are peak-to-peak values over those positions *plus* one finely resolved mesh period
-    around each extreme, since the mesh ripple (period :func:`mesh_period`, ``z_p z_c`` cycles per
-    revolution) is aliased by any practical uniform sampling.
-    """
-
-    theta: np.ndarray
-    total: np.ndarray
-    geometric: np.ndarray
-    elastic: np.ndarray
-    loaded: LoadSharing
-    unloaded: LoadSharing
-    total_pp: float
-    geometric_pp: float
-    elastic_pp: float
-
-    @staticmethod
-    def peak_to_peak(x: np.ndarray) -> float:
-        return float(np.max(x) - np.min(x))
 
 
 def _sweeps(

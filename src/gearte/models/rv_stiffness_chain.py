@@ -25,8 +25,6 @@ compliances (they carry the same force increment).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from gearte.errors import ParameterError
@@ -39,6 +37,7 @@ from gearte.models.rv_load_sharing import (
     load_sharing,
     pin_series_compliance,
 )
+from gearte.models.rv_records import StiffnessChain
 from gearte.solvers.rv_equilibrium import CLEARANCE_RESIDUAL
 
 __all__ = ["ELEMENTS", "StiffnessChain", "stiffness_chain", "left_out_elements"]
@@ -57,50 +56,6 @@ ELEMENTS = (
     "first_stage_mesh",
     "sun_support",
 )
-
-
-@dataclass(frozen=True)
-class StiffnessChain:
-    """Output torsional compliance of an RV reducer and its breakdown per element.
-
-    Attributes
-    ----------
-    torque : float
-        Output torque of the linearisation [N·mm].
-    theta : float
-        Output angle [rad].
-    compliance : dict
-        Element → its part of the output torsional compliance [rad/(N·mm)] (elements left out
-        are absent).
-    left_out : tuple of str
-        Elements the reducer does not describe (rigid), named.
-    cam_bearing_load, carrier_bearing_load : float
-        Largest radial load of a cam bearing and of a crank's carrier bearing at ``torque`` [N]
-        (the operating loads to compare with the loads the bearings' stiffness was read at).
-    """
-
-    torque: float
-    theta: float
-    compliance: dict[str, float]
-    left_out: tuple[str, ...]
-    cam_bearing_load: float = float("nan")
-    carrier_bearing_load: float = float("nan")
-
-    @property
-    def total_compliance(self) -> float:
-        """Tangent output torsional compliance [rad/(N·mm)]."""
-        return float(sum(self.compliance.values()))
-
-    @property
-    def rigidity(self) -> float:
-        """Tangent output torsional rigidity [N·mm/rad]."""
-        return 1.0 / self.total_compliance
-
-    @property
-    def shares(self) -> dict[str, float]:
-        """Element → share of the output torsional compliance [-] (sum 1)."""
-        total = self.total_compliance
-        return {k: v / total for k, v in self.compliance.items()}
 
 
 def left_out_elements(reducer: RVReducer) -> tuple[str, ...]:

@@ -9,11 +9,16 @@ import numpy as np
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import rad_to_arcmin, rad_to_arcsec, rad_to_deg
 
-__all__ = ["figures", "SELF_CONTAINED"]
+__all__ = ["figures", "SELF_CONTAINED", "NUMBA_FREE_RESULTS"]
 
 #: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`);
 #: not the catalogue (its hysteresis figure draws the calibrated model beside the bench curve).
 SELF_CONTAINED = frozenset({"te_orders", "load_series"})
+
+#: A bench result unpickles and its figures draw without numba (the calibrated model's catalogue
+#: values live in :mod:`gearte.models.rv_records`, apart from their kernels): the report process
+#: is forked before the parent imports numba (tests/test_report_background.py checks it).
+NUMBA_FREE_RESULTS = True
 
 
 def _analysis(result, name):

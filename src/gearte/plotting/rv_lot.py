@@ -9,7 +9,12 @@ import numpy as np
 from gearte.plotting import PALETTE, Figure, for_analysis, new_figure
 from gearte.units import rad_to_arcsec
 
-__all__ = ["figures"]
+__all__ = ["figures", "NUMBA_FREE_RESULTS"]
+
+#: A lot's result unpickles and its figures draw without numba (the lot, its score table and
+#: assembly live in :mod:`gearte.runners.rv_records`, apart from the solvers): the report process
+#: is forked before the parent imports numba (tests/test_report_background.py checks it).
+NUMBA_FREE_RESULTS = True
 
 
 def figures(result) -> list[Figure]:

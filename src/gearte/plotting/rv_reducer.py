@@ -17,7 +17,7 @@ from gearte.units import (
     rad_to_deg,
 )
 
-__all__ = ["figures", "SELF_CONTAINED"]
+__all__ = ["figures", "SELF_CONTAINED", "NUMBA_FREE_RESULTS"]
 
 #: Analyses whose figures read that analysis alone (:func:`gearte.plotting.self_contained`):
 #: this kind's own, the cycloid stage's, the dynamics' and the yield's. ``cycloid_compensation``
@@ -31,6 +31,14 @@ SELF_CONTAINED = (
     | rv_dynamics.SELF_CONTAINED
     | _YIELD
 )
+
+#: A result of the ``rv_reducer`` and ``rv_serial`` kinds unpickles and its figures draw without
+#: numba (its records live in :mod:`gearte.models.rv_records`,
+#: :mod:`gearte.models.cycloid_loaded_contact_record`, :mod:`gearte.solvers.ode_result` and
+#: :mod:`gearte.runners.rv_records`, apart from their kernels): the report process is forked
+#: before the parent imports numba and imports none of the parent's kernel modules
+#: (tests/test_report_background.py checks it for every bundled case of both kinds).
+NUMBA_FREE_RESULTS = True
 
 
 #: Width of the pin-load maps' colorbar and its gap to the last map [inch].

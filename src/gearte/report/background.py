@@ -7,8 +7,10 @@ building the figures and drawing them. :class:`ReportWorker` forks, at the comma
 and imports the case's study kind and its plotting module
 while the parent loads the case, imports numba, loads its kernels and runs the analyses on the
 other core. Once the case is loaded the parent sends it, with the names of the gearte modules it
-imported (the worker imports them too: unpickling an analysis needs them, and some import
-numba). Each analysis result is streamed to the worker as soon as the study makes it
+imported: the worker imports them too where the kind's plotting module does not say
+``NUMBA_FREE_RESULTS`` (its results hold records of modules that import numba; every bundled
+kind says it: unpickling imports what it needs, numba not among it). Each analysis result is
+streamed to the worker as soon as the study makes it
 (:func:`gearte.results.analysis_listener`); the worker draws the figures of each analysis whose
 figures read that analysis alone (:func:`gearte.plotting.self_contained`) while the next
 analyses run. The parent then sends the final result; each analysis unchanged since it was
@@ -101,9 +103,10 @@ def _import_numba_for(case: Any) -> None:
     the case's study kind says its results unpickle without it (``NUMBA_FREE_RESULTS`` in its
     plotting module).
 
-    The report process unpickles analyses whose result classes live in modules that define
-    kernels (the RV kinds' ``LoadSharing``, ``ODEResult``, ...), so it imports numba; this
-    process imports it anyway for its kernels. Imported once before the fork, the report process
+    The report process of a kind without the flag (none is bundled: every bundled kind keeps its
+    records in numba-free modules, e.g. :mod:`gearte.models.rv_records`) unpickles analyses
+    whose result classes live in modules that define kernels, so it imports numba; this process
+    imports it anyway for its kernels. Imported once before the fork, the report process
     inherits it (copy-on-write) instead of importing it a second time (~0.15 s CPU). Nothing is
     compiled or started here: importing numba starts no thread, so the fork stays safe."""
     with contextlib.suppress(Exception):

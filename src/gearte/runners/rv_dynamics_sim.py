@@ -7,7 +7,7 @@ integrators) and :mod:`gearte.execution` (parallel chunks); no physics here.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
@@ -22,7 +22,8 @@ from gearte.models.rv_dynamics import (
     rv_dte,
     rv_rhs,
 )
-from gearte.solvers.ode import ODEResult, ODESystem, cached_stability_limit, integrate
+from gearte.runners.rv_records import DTEResult
+from gearte.solvers.ode import ODESystem, cached_stability_limit, integrate
 from gearte.units import ARCSEC_PER_RAD
 
 __all__ = [
@@ -79,52 +80,6 @@ RECORD_POINTS = 65536
 TRACE_POINTS = 262144
 #: Buckets of the full-rate DTE envelope (min/max) over the whole span.
 ENVELOPE_POINTS = 4096
-
-
-@dataclass(frozen=True)
-class DTEResult:
-    """Dynamic transmission error of one run (after settling).
-
-    ``peak_to_peak``, ``rms`` [arcsec] and ``dte_mean`` [arcsec] (the static wind-up) come
-    from the DTE at every integration step over the whole span. The recorded trace — t [s] and
-    dte [arcsec] (mean removed) every ``record_dt`` [s] — is the whole span when it has at most
-    ``trace_points`` samples, else its last ``trace_points`` (``covers_span`` tells which); the
-    recorded states (columns ``state_names``, times ``states_t`` [s]) likewise with
-    ``record_points`` rows. Memory is independent of the duration. ``envelope_t`` [s],
-    ``envelope`` [arcsec] (buckets × [min, max], mean removed): the full-rate DTE's extremes in
-    equal buckets over the whole span. ``solver``: the solver result; ``dt`` [s] the RK4 step.
-    """
-
-    t: np.ndarray
-    dte: np.ndarray
-    dte_mean: float
-    peak_to_peak: float
-    rms: float
-    states: np.ndarray
-    state_names: list[str]
-    solver: ODEResult
-    dt: float
-    record_dt: float = float("nan")
-    covers_span: bool = True
-    states_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    envelope_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    envelope: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
-
-    @property
-    def recorded_span(self) -> float:
-        """Span of the recorded trace [s] (the spectrum's window: resolution 1/this)."""
-        return float(self.t[-1] - self.t[0]) + self.record_dt if self.t.size else 0.0
-
-    @property
-    def states_span(self) -> float:
-        """Span of the recorded states [s] (trajectories and phase portraits)."""
-        t = self.states_t
-        return float(t[-1] - t[0]) + self.record_dt if t.size else 0.0
-
-    @property
-    def states_cover_span(self) -> bool:
-        """Whether the recorded states cover the whole span after settling."""
-        return self.states_t.size == self.solver.records
 
 
 def default_step(model: RVDynamicModel, fraction: float = 0.85) -> float:

@@ -36,6 +36,7 @@ from numba import njit
 
 from gearte._jit import kernel
 from gearte.errors import DivergenceError, ParameterError
+from gearte.solvers.ode_result import ODEResult
 
 #: Lower estimate of the time of one compiled RK4 step of a 30-DOF system [s], for the time
 #: budget (``gearte.limits.check_time``) checked before an integration.
@@ -84,39 +85,6 @@ class ODESystem:
     stability_eigenvalues: np.ndarray | None = field(default=None, repr=False)
     work_size: int = 0
     stability_limit: float | None = None
-
-
-@dataclass(frozen=True)
-class ODEResult:
-    """Result of :func:`integrate`.
-
-    t [s] and output (plus the recorded states ``states``, columns = ``record_states``) on the
-    recording grid after the settling time — the last ``output_window`` / ``record_window`` rows
-    when a window was asked for (``states_t`` [s]: the times of the states' rows); ``records``
-    the rows recorded over the whole span (more than ``t.size`` when the window dropped the
-    first ones); ``stats`` of the output after settling (min, max, mean,
-    rms, peak_to_peak, count); ``envelope`` (buckets × [min, max]) of the output over the span
-    after settling, ``envelope_t`` [s] the buckets' centres; ``y_final``; counters and wall
-    time [s].
-    """
-
-    method: str
-    t: np.ndarray
-    output: np.ndarray
-    states: np.ndarray
-    y_final: np.ndarray
-    stats: dict[str, float]
-    n_steps: int
-    n_rhs: int
-    wall_time: float
-    records: int = 0
-    states_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    envelope: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
-    envelope_t: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-
-    @property
-    def peak_to_peak(self) -> float:
-        return self.stats["peak_to_peak"]
 
 
 def _rk4_amp(z: np.ndarray) -> np.ndarray:

@@ -13,11 +13,11 @@ doi:10.3390/machines11060626
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gearte.models.rv_records import ModalResult
 from gearte.units import deg_to_rad
 
 if TYPE_CHECKING:  # the model calls these functions; typing only
@@ -31,15 +31,6 @@ __all__ = [
     "damped_eigenvalues",
     "resonance_warnings",
 ]
-
-
-@dataclass(frozen=True)
-class ModalResult:
-    """Natural frequencies [Hz] (ascending) and mass-normalised mode shapes (columns)."""
-
-    frequencies: np.ndarray
-    shapes: np.ndarray
-    dof_names: list[str]
 
 
 def modal_analysis(
