@@ -280,6 +280,8 @@ def test_numba_free_kinds_are_the_expected_ones() -> None:
     }
     # every kind a bundled case uses (kinds other tests register in this process aside)
     assert kinds == {_kind_of(name) for name in list_cases()}
+    # every quick case is a bundled one (a renamed case would drop out of the quick suite)
+    assert set(_QUICK_NUMBA_FREE) <= set(_numba_free_cases())
 
 
 #: Monte-Carlo samples of the numba-free report test: the RV kinds' dynamics batches and yields
@@ -293,7 +295,33 @@ def _samples(case: str) -> int:
     return 64 if _kind_of(case) in _RV_KINDS else 2000
 
 
-@pytest.mark.parametrize("case", _numba_free_cases())
+#: The cases of the numba-free report test in the quick suite: each kind, each kind's yield, and
+#: the RV cases holding the other record types (load sharing, loaded contact, catalogue,
+#: stiffness chain, compensation, modal, DTE/ODE, serial, bench, lot); the other bundled cases
+#: run with ``make test-slow`` (each is 3–5 s).
+_QUICK_NUMBA_FREE = {
+    "wang2013_2kh_eq9_yield",
+    "hu2020_rv80e_initial",
+    "jiang2024_spur_pair",
+    "robot_joint_spur_rv_yield",
+    "harmonicdrive_csf32_100",
+    "han2023_rv110e",
+    "han2023_rv110e_yield",
+    "li2023_rv_errors",
+    "hu2020_rv80e_initial_reducer",
+    "synthetic_rv110e_serial",
+    "synthetic_rv_bench",
+    "synthetic_rv110e_lot",
+}
+
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        c if c in _QUICK_NUMBA_FREE else pytest.param(c, marks=pytest.mark.slow)
+        for c in _numba_free_cases()
+    ],
+)
 def test_numba_free_report_is_drawn_without_importing_numba(case: str) -> None:
     """The report process of a kind whose plotting module says ``NUMBA_FREE_RESULTS`` (every
     bundled kind; every bundled case of them) imports none of the parent's modules: unpickling
