@@ -51,11 +51,13 @@ def test_the_cli_and_run_case_use_it() -> None:
 
 
 def test_pool_chunks_run_in_the_room() -> None:
-    """A local pool runs each chunk through the room, in threads and in processes, with the
-    chunk's own result."""
+    """A local pool runs each chunk through the room, in threads and in processes, and so does a
+    Dask cluster (gearte's local one here), with the chunk's own result."""
     from gearte.execution import map_chunks
 
-    for scheduler in ("threads", "processes"):
+    for scheduler in ("threads", "processes", "local-cluster"):
+        if scheduler == "local-cluster":
+            pytest.importorskip("distributed")
         out = map_chunks(_chunk_faults, [0, 1, 2], workers=2, scheduler=scheduler, progress=False)
         assert [o[0] for o in out] == [0, 1, 2]
         assert max(max(o[1]) for o in out) < CALLS // 10, scheduler

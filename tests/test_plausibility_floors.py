@@ -48,8 +48,24 @@ KEYS = [
 ]
 
 
+#: Keys whose floor lies outside the validity of a law the bundled case selects: the floor runs
+#: with a law valid there (Palmgren's is steel on steel only: docs/contact-law.md).
+LAW_FOR_FLOOR = {"reducer.discs.youngs_modulus_MPa": ("reducer.contact_law", "line_contact")}
+
+
 def _with(name: str, key: str, value: float) -> str:
-    data = json.loads(json.dumps(CORPUS[name]))
+    return _with_data(json.loads(json.dumps(CORPUS[name])), key, value)
+
+
+def _with_data(data: dict, key: str, value: object, *more: object) -> str:
+    """``data`` with ``key`` set to ``value`` (and further ``key, value`` pairs), as TOML."""
+    _set(data, key, value)
+    for k, v in zip(more[::2], more[1::2], strict=True):
+        _set(data, str(k), v)
+    return to_toml(data)
+
+
+def _set(data: dict, key: str, value: object) -> None:
     path = tuple(key.split("."))
     node = data
     for i, part in enumerate(path[:-1]):  # a dotted key of a tolerance table stays one key
@@ -58,9 +74,8 @@ def _with(name: str, key: str, value: float) -> str:
             node = node[rest]
             break
         node = node[part]
-    assert path[-1] in node, f"{name} has no {key}"
+    assert path[-1] in node, f"the case has no {key}"
     node[path[-1]] = value
-    return to_toml(data)
 
 
 def _errors(text: str, tmp_path) -> list[tuple[str, str]]:
@@ -95,7 +110,10 @@ def test_the_floor_itself_validates(tmp_path, name, key, quantity):
     # the torque): that is a refusal naming a key, not a solver failure
     assert out.status in ("accepted", "rejected"), out
     if out.status == "rejected":
-        assert "torque" in out.detail, out
+        if key in LAW_FOR_FLOOR:  # the law's range, not the floor, refuses it (the section's
+            assert out.detail == "reducer", out  # check; its message: the test above)
+        else:
+            assert "torque" in out.detail, out
 
 
 def test_the_tooth_contact_runs_at_the_torque_and_share_floors(tmp_path):
@@ -104,10 +122,26 @@ def test_the_tooth_contact_runs_at_the_torque_and_share_floors(tmp_path):
     assert run_cli(text, tmp_path, 600.0).status == "run_exit_0"
 
 
+def test_a_young_modulus_outside_palmgrens_steel_is_refused_at_validation(tmp_path):
+    """With contact_law 'palmgren' (Palmgren's fit for steel on steel) a Young's modulus outside
+    steel's is refused when the case is validated, naming the key and the law to select; it
+    was refused only when the run reached the contact law."""
+    text = _with("han2023_rv110e_yield", "reducer.discs.youngs_modulus_MPa", 7.0e4)
+    errors = _errors(text, tmp_path)
+    assert len(errors) == 1, errors
+    assert "discs.youngs_modulus_MPa = 70000" in errors[0][1], errors
+    assert "'palmgren'" in errors[0][1] and "'line_contact'" in errors[0][1], errors
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(("name", "key", "quantity"), KEYS, ids=[k[1] for k in KEYS])
 def test_every_key_at_its_floor_runs(tmp_path, name, key, quantity):
     text = _with(name, key, FLOORS[quantity][0])
+    if key in LAW_FOR_FLOOR:
+        law_key, law = LAW_FOR_FLOOR[key]
+        assert check_text(text, tmp_path).status == "rejected"  # the law's range, named
+        data = json.loads(json.dumps(CORPUS[name]))
+        text = _with_data(data, key, FLOORS[quantity][0], law_key, law)
     if check_text(text, tmp_path).status != "accepted":
         pytest.skip("refused at validation (the torque check), see the test above")
     out = run_cli(text, tmp_path, 600.0)

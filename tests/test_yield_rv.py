@@ -131,17 +131,25 @@ def _hu_modified_with_eccentricities():
 
 
 @pytest.mark.slow
-def test_rv_small_tolerances_mc_sigma_of_lost_motion_and_te_within_3_percent_of_first_order():
+def test_rv_small_tolerances_mc_sigma_of_te_within_3_percent_of_first_order():
     """Eccentricity tolerances ±0.3 µm (σ 0.1 µm) around a nominal reducer: the Monte-Carlo σ
-    of lost motion, angular (unloaded) TE and loaded TE from 2000 reducers is within 3 % of the
-    first-order prediction Σ (∂y/∂x σ)² (central differences of ±1 tolerance). In han2023_rv110e
-    (no profile modification: pins at zero clearance) lost motion is not linear even at this
-    scale (contact loss; -7 % measured), so the smooth modified stage is used."""
+    of angular (unloaded) TE and loaded TE from 2000 reducers is within 3 % of the first-order
+    prediction Σ (∂y/∂x σ)² (central differences of ±1 tolerance; measured +0.8 % and +0.7 %).
+
+    Lost motion is left out: it is the gap between the first pins to close in either direction,
+    a minimum over the pins, not differentiable where the closing pin changes, and the
+    first-order σ misses by more than 3 % at any scale. Measured in the modified stage (2000
+    reducers, seeds 5 and 6): Monte-Carlo σ / first-order σ = 1.05 at ±0.3 µm (where lost
+    motion's σ, 3e-5 arcmin, is also near the solver's resolution: a step of 0.3 tolerance moves
+    the first-order σ by 40 %), 1.16 at ±1 µm, 0.87 at ±3 µm. (This test asserted 3 % for lost
+    motion too when it was written; the slow suite found it failing at b1759aa, after the model
+    had gained the stiffness chain and the true contact point. In han2023_rv110e, with pins at
+    zero clearance, it missed by -7 %.)"""
     from gearte.tolerance.yield_contributions import linear_prediction
 
     red, ts = _hu_modified_with_eccentricities()
     model = RVReducerYield(red, positions=12)
-    qs = ["lost_motion [arcmin]", "angular_te [arcmin]", "loaded_te [arcmin]"]
+    qs = ["angular_te [arcmin]", "loaded_te [arcmin]"]
     lin = linear_prediction(model, ts, qs, step=1.0)
     r = run_yield(model, ts, [], 2000, seed=5, chunk_size=500)
     for q in qs:

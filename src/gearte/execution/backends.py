@@ -143,9 +143,9 @@ class SequentialExecutor(ChunkExecutor):
 
 
 def _in_frame_room(func: Callable[..., Any], *args: Any) -> Any:
-    """``func(*args)`` in a pool worker (thread or process), inside one roomy frame of CPython's
-    frame stack (:mod:`gearte._frames`): a chunk's loops never allocate a stack chunk per call,
-    whatever the worker's frames below."""
+    """``func(*args)`` in a pool worker (thread or process) or a Dask worker, inside one roomy
+    frame of CPython's frame stack (:mod:`gearte._frames`): a chunk's loops never allocate a
+    stack chunk per call, whatever the worker's frames below."""
     return with_frame_room(lambda: func(*args))
 
 
@@ -658,7 +658,9 @@ class _DaskBatch(Batch):
     def submit(self, func: Callable[[Any], Any], task: Any, index: int, label: str) -> None:
         ex = self._ex
         key = f"gearte-{label}-{ex._token}-{index}"
-        fut = ex.client.submit(func, task, *self.extra, key=key, retries=ex.retries, pure=False)
+        fut = ex.client.submit(
+            _in_frame_room, func, task, *self.extra, key=key, retries=ex.retries, pure=False
+        )
         self.pending[fut] = index
         if self._ac is None:
             self._ac = _import_distributed().as_completed([fut], loop=ex.client.loop)
