@@ -24,8 +24,8 @@ frame below it, so a command's frames (recursion included, up to ~1 000 frames) 
 chunk and no boundary is crossed in its loops. The unused slots are never touched (no page
 is faulted in for them) and are not scanned by the garbage collector; results are unchanged.
 The ``gearte`` command runs through it (:func:`gearte.cli.entry`; the report process forked
-from it inherits the room), so does :func:`gearte.run_case`, and the local pools run each chunk
-through it in their worker threads and processes (``execution.backends._in_frame_room``).
+from it inherits the room), so does :func:`gearte.run_case`, and the local pools and Dask run each
+chunk through it in their worker threads and processes (``execution.backends._in_frame_room``).
 """
 
 from __future__ import annotations
