@@ -233,6 +233,7 @@ def entry() -> None:
     joins them). Embedded use (``main()``, click's test runner) exits normally.
     """
     import atexit
+    import signal
     import threading
 
     from gearte._frames import with_frame_room
@@ -256,7 +257,17 @@ def entry() -> None:
             print(exc.code, file=sys.stderr)
             code = 1
     if threading.active_count() > 1:
-        sys.exit(code)
+        if code in (128 + signal.SIGINT, 128 + signal.SIGTERM):
+            # after a stop the outputs are written and flushed; a thread left is pool machinery,
+            # and the process pool's manager thread can wait for ever on a worker the signal
+            # killed mid-message (seen: interpreter shutdown joining it, 1 of ~20 SIGTERMs to a
+            # Monte-Carlo on worker processes), or print a traceback when multiprocessing's
+            # exit handlers close its pipes under it: end at once, as _exit_after_stop does
+            for stream in (sys.stdout, sys.stderr):
+                with contextlib.suppress(Exception):
+                    stream.flush()
+            os._exit(code)
+        sys.exit(code)  # the normal exit joins the threads
     atexit._run_exitfuncs()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
