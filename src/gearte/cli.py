@@ -58,11 +58,17 @@ def _exit_after_stop(code: int) -> None:
     from gearte.execution.backends import stuck_worker_threads
 
     if stuck_worker_threads():
-        with contextlib.suppress(Exception):
-            sys.stdout.flush()
-            sys.stderr.flush()
-        os._exit(code)
+        _flushed_exit(code)
     sys.exit(code)
+
+
+def _flushed_exit(code: int) -> None:
+    """Flush stdout and stderr, then end the process with ``code`` at once (``os._exit``: no
+    interpreter teardown, no joining of threads)."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
 
 
 def _error(title: str, message: str) -> None:
@@ -256,23 +262,17 @@ def entry() -> None:
         else:  # sys.exit("message")
             print(exc.code, file=sys.stderr)
             code = 1
-    if threading.active_count() > 1:
-        if code in (128 + signal.SIGINT, 128 + signal.SIGTERM):
-            # after a stop the outputs are written and flushed; a thread left is pool machinery,
-            # and the process pool's manager thread can wait for ever on a worker the signal
-            # killed mid-message (seen: interpreter shutdown joining it, 1 of ~20 SIGTERMs to a
-            # Monte-Carlo on worker processes), or print a traceback when multiprocessing's
-            # exit handlers close its pipes under it: end at once, as _exit_after_stop does
-            for stream in (sys.stdout, sys.stderr):
-                with contextlib.suppress(Exception):
-                    stream.flush()
-            os._exit(code)
+    threads_left = threading.active_count() > 1
+    if threads_left and code not in (128 + signal.SIGINT, 128 + signal.SIGTERM):
         sys.exit(code)  # the normal exit joins the threads
-    atexit._run_exitfuncs()
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(Exception):
-            stream.flush()
-    os._exit(code)
+    # After a stop the outputs are written and flushed, and a thread left is pool machinery: the
+    # process pool's manager thread can wait for ever on a worker the signal killed mid-message
+    # (seen: interpreter shutdown joining it, 1 of ~20 SIGTERMs to a Monte-Carlo on worker
+    # processes), and multiprocessing's exit handlers, run under it, close its pipes and make it
+    # print a traceback: end at once, without them, as _exit_after_stop does.
+    if not threads_left:
+        atexit._run_exitfuncs()
+    _flushed_exit(code)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})

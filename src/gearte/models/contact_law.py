@@ -93,6 +93,7 @@ __all__ = [
     "pin_pressure_estimate",
     "implausible_pin_pressure",
     "check_pin_pressure",
+    "check_palmgren_modulus",
     "log_law_coefficients",
     "law_coefficients",
     "palmgren_approach",
@@ -155,6 +156,24 @@ def check_law(law: str, field: str = "contact_law") -> str:
     if not isinstance(law, str) or law not in LAWS:
         raise ParameterError(field, law, f"must be one of {', '.join(repr(x) for x in LAWS)}")
     return law
+
+
+def check_palmgren_modulus(E: float, field: str = "youngs_modulus_MPa") -> None:
+    """A :class:`ParameterError` naming ``field`` unless ``E`` [MPa] lies in
+    :data:`PALMGREN_STEEL_E_RANGE_MPA`: Palmgren's law is a fit for steel on steel.
+
+    References
+    ----------
+    Palmgren (1959); Harris & Kotzalas (2007) ch. 7, doi:10.1201/9781420006612.
+    """
+    lo, hi = PALMGREN_STEEL_E_RANGE_MPA
+    if not lo <= E <= hi:
+        raise ParameterError(
+            field,
+            E,
+            f"contact_law 'palmgren' is Palmgren's fit for steel on steel (E in [{lo:g}, "
+            f"{hi:g}] MPa); select 'line_contact' for another material",
+        )
 
 
 def check_material(E: float, nu: float, *, fields: tuple[str, str] = ("E", "nu")) -> None:
@@ -603,14 +622,7 @@ def law_coefficients(
         a0, a1 = log_law_coefficients(law, rho, r, E, nu, b, rho_cap=rho_cap)
         return a0, a1, np.zeros_like(a0), np.ones_like(a0)
     _check_material(E, nu, b)
-    lo, hi = PALMGREN_STEEL_E_RANGE_MPA
-    if not lo <= E <= hi:
-        raise ParameterError(
-            "youngs_modulus_MPa",
-            E,
-            f"contact_law 'palmgren' is Palmgren's fit for steel on steel (E in [{lo:g}, "
-            f"{hi:g}] MPa); select 'line_contact' for another material",
-        )
+    check_palmgren_modulus(E)
     shape = np.shape(np.asarray(rho, dtype=float))
     a2 = PALMGREN_COEFFICIENT / b**PALMGREN_LENGTH_EXPONENT
     return (np.zeros(shape), np.zeros(shape), np.full(shape, a2),

@@ -814,16 +814,12 @@ class ReducerSection(StrictModel):
         if self.material is not None and self.density_kg_per_m3 is not None:
             problems.append("give material or density_kg_per_m3, not both")
         if self.contact_law == "palmgren":
-            from gearte.models.contact_law import PALMGREN_STEEL_E_RANGE_MPA
+            from gearte.models.contact_law import check_palmgren_modulus
 
-            lo, hi = PALMGREN_STEEL_E_RANGE_MPA
-            modulus = self.discs.youngs_modulus_MPa
-            if not lo <= modulus <= hi:
-                problems.append(
-                    f"discs.youngs_modulus_MPa = {modulus:g}: contact_law 'palmgren' is "
-                    f"Palmgren's fit for steel on steel (E in [{lo:g}, {hi:g}] MPa); select "
-                    "'line_contact' for another material"
-                )
+            try:
+                check_palmgren_modulus(self.discs.youngs_modulus_MPa, "discs.youngs_modulus_MPa")
+            except ParameterError as exc:
+                problems.append(str(exc))
         if self.first_stage.planets != self.cranks.count:
             problems.append(
                 f"first_stage.planets = {self.first_stage.planets}: must equal cranks.count = "
